@@ -1,0 +1,55 @@
+# Shared by scripts/run_main.sh and scripts/run_tests.sh: install what is missing, then build.
+# Idempotent: with everything present it costs one dpkg query and an incremental build.
+set -euo pipefail
+
+# A pyenv python3 may shadow the system one and lacks catkin_pkg: pin /usr/bin first.
+export PATH="/usr/bin:/bin:/usr/sbin:/sbin:${PATH}"
+export PYTHONNOUSERSITE=1
+
+HAMERITT_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD_DIR="${HAMERITT_BUILD_DIR:-$HAMERITT_ROOT/build}"
+JOBS="${HAMERITT_JOBS:-$(nproc)}"
+
+# Debian 12 packages the project needs to build, run and test.
+HAMERITT_PACKAGES=(
+  build-essential cmake pkg-config
+  catkin python3-catkin-pkg ros-base-dev ros-message-generation ros-message-runtime
+  libroscpp-dev libstd-msgs-dev libgeometry-msgs-dev librostest-dev
+  rosbash python3-roslaunch python3-rostest python3-rosbag ros-environment
+  libgtest-dev googletest
+  libeigen3-dev nlohmann-json3-dev libopencv-dev
+  python3-jsonschema
+)
+
+install_deps() {
+  local missing=()
+  local status
+  for p in "${HAMERITT_PACKAGES[@]}"; do
+    status="$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)"
+    [[ "$status" == "install ok installed" ]] || missing+=("$p")
+  done
+  if ((${#missing[@]} == 0)); then
+    echo "hameritt: all ${#HAMERITT_PACKAGES[@]} Debian packages present"
+    return 0
+  fi
+  echo "hameritt: installing ${missing[*]}"
+  local sudo=""
+  [[ "$(id -u)" == 0 ]] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+build() {
+  cmake -S "$HAMERITT_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING="${1:-ON}" >/dev/null
+  cmake --build "$BUILD_DIR" -j "$JOBS"
+}
+
+source_devel() {
+  # setup.bash reads unset variables; relax -u while sourcing it.
+  set +u
+  # shellcheck disable=SC1091
+  source "$BUILD_DIR/devel/setup.bash"
+  set -u
+}
