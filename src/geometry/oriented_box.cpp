@@ -1,0 +1,139 @@
+#include "hameritt/geometry/oriented_box.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hameritt::geometry {
+
+namespace {
+
+// Touching tolerance of a box, relative to the size of its coordinates. OccluderIndex pads its
+// grid registration by twice this amount, so the two must stay in step.
+double boxTolerance(const OrientedBox& b) {
+  return kEpsilon * std::max({1.0, b.center.cwiseAbs().maxCoeff(), b.size.cwiseAbs().maxCoeff()});
+}
+
+}  // namespace
+
+std::array<Vec2, 4> OrientedBox::corners2() const {
+  const double hl = 0.5 * size.x();
+  const double hw = 0.5 * size.y();
+  const Vec2 u(std::cos(yaw), std::sin(yaw));  // body x in the world
+  const Vec2 v(-u.y(), u.x());                 // body y in the world
+  const Vec2 c = center2();
+  return {c - hl * u - hw * v, c + hl * u - hw * v, c + hl * u + hw * v, c - hl * u + hw * v};
+}
+
+Polygon OrientedBox::footprint() const {
+  const auto c = corners2();
+  return Polygon({c[0], c[1], c[2], c[3]});
+}
+
+Aabb2 OrientedBox::bounds2() const {
+  const auto c = corners2();
+  Aabb2 b{c[0], c[0]};
+  for (const Vec2& p : c) {
+    b.min = b.min.cwiseMin(p);
+    b.max = b.max.cwiseMax(p);
+  }
+  return b;
+}
+
+Vec3 OrientedBox::toBody(const Vec3& p) const {
+  const Vec3 d = p - center;
+  const double cy = std::cos(yaw);
+  const double sy = std::sin(yaw);
+  return Vec3(cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z());
+}
+
+bool OrientedBox::contains(const Vec3& p) const {
+  const Vec3 q = toBody(p).cwiseAbs();
+  const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(boxTolerance(*this));
+  return q.x() <= half.x() && q.y() <= half.y() && q.z() <= half.z();
+}
+
+// Liang-Barsky clipping of the segment against the three slabs of the (slightly padded) box in
+// its body frame; all intervals closed, so grazing an edge or a corner counts as touching.
+bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b) const {
+  if (!a.allFinite() || !b.allFinite()) return false;
+  const Vec3 p = toBody(a);
+  const Vec3 d = toBody(b) - p;
+  const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(boxTolerance(*this));
+  double t0 = 0.0;
+  double t1 = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0.0) {
+      if (p[k] < -half[k] || p[k] > half[k]) return false;
+      continue;
+    }
+    double enter = (-half[k] - p[k]) / d[k];
+    double leave = (half[k] - p[k]) / d[k];
+    if (enter > leave) std::swap(enter, leave);
+    t0 = std::max(t0, enter);
+    t1 = std::min(t1, leave);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+namespace {
+
+// Separating-axis test for two rectangles given by their corners (touching counts as overlap).
+bool rectanglesOverlap(const std::array<Vec2, 4>& ca, const std::array<Vec2, 4>& cb) {
+  for (const auto* c : {&ca, &cb}) {
+    for (int k = 0; k < 2; ++k) {
+      const Vec2 axis = (*c)[k + 1] - (*c)[k];
+      double amin = 1e300, amax = -1e300, bmin = 1e300, bmax = -1e300;
+      for (const Vec2& p : ca) {
+        const double d = axis.dot(p);
+        amin = std::min(amin, d);
+        amax = std::max(amax, d);
+      }
+      for (const Vec2& p : cb) {
+        const double d = axis.dot(p);
+        bmin = std::min(bmin, d);
+        bmax = std::max(bmax, d);
+      }
+      const double tol = kEpsilon * std::max(1.0, axis.squaredNorm()) *
+                         std::max(1.0, std::max(std::abs(amax), std::abs(bmax)));
+      if (amax < bmin - tol || bmax < amin - tol) return false;
+    }
+  }
+  return true;
+}
+
+double pointSegmentDistanceSq(const Vec2& p, const Vec2& a, const Vec2& b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  double t = len2 > 0.0 ? (p - a).dot(ab) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return (a + t * ab - p).squaredNorm();
+}
+
+}  // namespace
+
+// Rectangles are convex: when they are apart, the closest pair is a corner of one and an edge
+// of the other, so 32 corner-edge distances give the exact answer without building polygons.
+double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
+  const auto ca = a.corners2();
+  const auto cb = b.corners2();
+  if (rectanglesOverlap(ca, cb)) return 0.0;
+  double best = 1e300;
+  for (int i = 0; i < 4; ++i) {
+    const Vec2& a0 = ca[i];
+    const Vec2& a1 = ca[(i + 1) % 4];
+    const Vec2& b0 = cb[i];
+    const Vec2& b1 = cb[(i + 1) % 4];
+    for (int j = 0; j < 4; ++j) {
+      best = std::min(best, pointSegmentDistanceSq(cb[j], a0, a1));
+      best = std::min(best, pointSegmentDistanceSq(ca[j], b0, b1));
+    }
+  }
+  return std::sqrt(best);
+}
+
+bool footprintsOverlap(const OrientedBox& a, const OrientedBox& b) {
+  return rectanglesOverlap(a.corners2(), b.corners2());
+}
+
+}  // namespace hameritt::geometry
