@@ -1,0 +1,29 @@
+#pragma once
+// Typed errors of the scenario module. Each message names the file (when there is one), the
+// field (a JSON path) and what was expected.
+
+#include <stdexcept>
+#include <string>
+
+namespace hameritt::scenario {
+
+// Bad configuration or input document: exit code 2 in the command-line tools.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Output could not be written (unwritable directory, full disk): exit code 2.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A scenario could not be generated with the given settings (e.g. no placement satisfies the
+// constraints): exit code 1, with the class and seed in the message.
+class GenerationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace hameritt::scenario

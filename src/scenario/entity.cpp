@@ -1,0 +1,96 @@
+#include "hameritt/scenario/entity.h"
+
+#include <cmath>
+
+namespace hameritt::scenario {
+
+namespace {
+struct ClassName {
+  EntityClass cls;
+  const char* name;
+  int semantic;
+};
+constexpr ClassName kClassNames[] = {
+    {EntityClass::kStreet, "street", 2},     {EntityClass::kDriveway, "driveway", 3},
+    {EntityClass::kHouse, "house", 4},       {EntityClass::kGarage, "garage", 5},
+    {EntityClass::kFence, "fence", 6},       {EntityClass::kTree, "tree", 7},
+    {EntityClass::kCar, "car", 8},           {EntityClass::kPedestrian, "pedestrian", 9},
+};
+}  // namespace
+
+const char* toString(EntityClass c) {
+  for (const auto& n : kClassNames) {
+    if (n.cls == c) return n.name;
+  }
+  return "unknown";
+}
+
+bool parseEntityClass(const std::string& s, EntityClass* out) {
+  for (const auto& n : kClassNames) {
+    if (s == n.name) {
+      *out = n.cls;
+      return true;
+    }
+  }
+  return false;
+}
+
+int semanticId(EntityClass c) {
+  for (const auto& n : kClassNames) {
+    if (n.cls == c) return n.semantic;
+  }
+  return 0;
+}
+
+void Attributes::set(const std::string& key, AttributeValue v) {
+  for (auto& kv : items) {
+    if (kv.first == key) {
+      kv.second = std::move(v);
+      return;
+    }
+  }
+  items.emplace_back(key, std::move(v));
+}
+
+std::string Attributes::str(const std::string& key) const {
+  for (const auto& kv : items) {
+    if (kv.first == key) {
+      if (const auto* s = std::get_if<std::string>(&kv.second)) return *s;
+      return "";
+    }
+  }
+  return "";
+}
+
+std::int64_t Attributes::integer(const std::string& key, std::int64_t fallback) const {
+  for (const auto& kv : items) {
+    if (kv.first == key) {
+      if (const auto* i = std::get_if<std::int64_t>(&kv.second)) return *i;
+      return fallback;
+    }
+  }
+  return fallback;
+}
+
+bool Attributes::has(const std::string& key) const {
+  for (const auto& kv : items) {
+    if (kv.first == key) return true;
+  }
+  return false;
+}
+
+geometry::OrientedBox boxFromPose(const geometry::Vec3& bottom_center, double yaw,
+                                  const geometry::Vec3& size) {
+  geometry::OrientedBox b;
+  b.center = {bottom_center.x(), bottom_center.y(), bottom_center.z() + 0.5 * size.z()};
+  b.size = size;
+  b.yaw = yaw;
+  return b;
+}
+
+double roundMilli(double v) {
+  const double r = std::round(v * 1000.0) / 1000.0;
+  return r == 0.0 ? 0.0 : r;  // no negative zero in the output
+}
+
+}  // namespace hameritt::scenario
