@@ -1,0 +1,86 @@
+// Benchmark: scenarios per second, all relations computed and files written.
+//   bench_generate [--count N] [--jobs J] [--out DIR]
+// Default: 9000 scenarios of all three classes on every core, into a temporary directory
+// that is removed afterwards. Prints one line per figure.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "hameritt/scenario/batch.h"
+#include "hameritt/scenario/generator.h"
+
+using namespace hameritt::scenario;
+namespace fs = std::filesystem;
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::uintmax_t dirBytes(const std::string& dir) {
+  std::uintmax_t total = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) total += e.file_size();
+  }
+  return total;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int count = 9000;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::string out;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string a = argv[i];
+    if (a == "--count") count = std::stoi(argv[i + 1]);
+    else if (a == "--jobs") jobs = std::stoi(argv[i + 1]);
+    else if (a == "--out") out = argv[i + 1];
+  }
+  const bool temp = out.empty();
+  if (temp) out = fs::temp_directory_path().string() + "/hameritt_bench_" + std::to_string(::getpid());
+
+  const WorldParams wp = loadWorldParams(defaultConfigDir() + "/world.json");
+  const GeneratorConfig gc = loadGeneratorConfig(defaultConfigDir() + "/generator.json");
+  auto t0 = std::chrono::steady_clock::now();
+  const World world = generateWorld(wp);
+  const double world_s = seconds(t0);
+
+  BatchRequest req;
+  req.classes = parseClassList("all");
+  req.count = count;
+  req.seed = 2026;
+  req.out_dir = out;
+  req.jobs = jobs;
+  t0 = std::chrono::steady_clock::now();
+  generateBatch(world, gc, req);
+  const double batch_s = seconds(t0);
+  const std::uintmax_t bytes = dirBytes(out);
+
+  // Generation alone (no files), one thread, to separate compute from I/O.
+  const int solo = std::min(count, 900);
+  t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < solo; ++i) {
+    generateScenario(world, gc, req.classes[static_cast<std::size_t>(i) % 3], batchSeed(7, i));
+  }
+  const double solo_s = seconds(t0);
+
+  std::printf("machine_threads            %u\n", std::thread::hardware_concurrency());
+  std::printf("world_entities             %zu\n", world.entities().size());
+  std::printf("world_generation_ms        %.1f\n", world_s * 1e3);
+  std::printf("batch_scenarios            %d (all classes, %d jobs)\n", count, jobs);
+  std::printf("batch_wall_s               %.3f\n", batch_s);
+  std::printf("batch_scenarios_per_s      %.0f\n", count / batch_s);
+  std::printf("batch_output_mb            %.1f\n", bytes / 1e6);
+  std::printf("generate_only_per_s_1core  %.0f (%d scenarios, no files)\n", solo / solo_s, solo);
+  std::printf("target_9000_under_5s       %s\n",
+              count == 9000 ? (batch_s < 5.0 ? "met" : "NOT met") : "n/a (count != 9000)");
+  if (temp) fs::remove_all(out);
+  return 0;
+}

@@ -1,0 +1,37 @@
+#pragma once
+// Batch generation: many scenarios on several threads, byte-identical whatever the thread
+// count, each written atomically, with a manifest.json written last.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hameritt/scenario/generator.h"
+
+namespace hameritt::scenario {
+
+struct BatchRequest {
+  std::vector<ScenarioClass> classes;  // scenario i has class classes[i % classes.size()]
+  int count = 1;
+  std::uint64_t seed = 1;
+  std::string out_dir;
+  int jobs = 1;
+  bool write_world = true;  // also write DIR/world.json
+};
+
+struct ManifestEntry {
+  int index = 0;
+  std::string id;
+  ScenarioClass cls = ScenarioClass::kAreaSearch;
+  std::uint64_t seed = 0;
+};
+
+// Generates and writes the batch. On any failure nothing that this call created is left
+// behind and the error is rethrown (ConfigError, OutputError or GenerationError).
+std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConfig& config,
+                                         const BatchRequest& request);
+
+// Parses "area_search", "route_search", "pursuit", "all" or a comma-separated list.
+std::vector<ScenarioClass> parseClassList(const std::string& s);
+
+}  // namespace hameritt::scenario

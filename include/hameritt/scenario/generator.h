@@ -1,0 +1,90 @@
+#pragma once
+// Random scenario generation: a seed and a class in, a complete, self-consistent scenario out.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hameritt/scenario/relations.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::scenario {
+
+// A closed interval a parameter is drawn from.
+struct Range {
+  double min = 0.0;
+  double max = 0.0;
+};
+
+// Randomization ranges of the generator (config/generator.json). Lengths in metres, times in
+// seconds, speeds in m/s, angles in degrees.
+struct GeneratorConfig {
+  GeoOrigin origin;
+  RelationConfig relations;
+  Range time_limit_area_search{420, 900};
+  Range time_limit_route_search{240, 480};
+  Range time_limit_pursuit{240, 480};
+  int aoi_count_min = 1;
+  int aoi_count_max = 3;
+  Range aoi_length{160, 320};
+  Range aoi_width{120, 260};
+  double aoi_window_probability = 0.3;
+  int prior_depth_min = 1;
+  int prior_depth_max = 2;
+  int koz_count_min = 1;
+  int koz_count_max = 3;
+  int confuser_count_min = 1;
+  int confuser_count_max = 4;
+  int traffic_count_min = 12;
+  int traffic_count_max = 16;
+  int pedestrian_count_min = 8;
+  int pedestrian_count_max = 12;
+  Range car_speed{8, 13};
+  Range pedestrian_speed{1.0, 1.6};
+  Range runner_speed{3.0, 4.5};
+  Range band_width{30, 60};
+  int route_edges_min = 3;
+  int route_edges_max = 6;
+  Range depart_time{20, 60};
+  Range uav_altitude_min{15, 30};
+  Range uav_altitude_max{45, 120};
+  double uav_max_speed = 12.0;
+  Range time_of_day{6, 20};
+  double weather_probability = 0.3;  // chance of each of snow/rain, dust, fog being present
+  Range foliage{0.2, 1.0};
+  Range wind_speed{0, 8};
+  Range gust_intensity{0, 1};
+  int camera_width = 640;
+  int camera_height = 480;
+  double camera_rate_hz = 10.0;
+  Range front_pitch{5, 30};
+  Range front_hfov{70, 100};
+  Range down_hfov{60, 90};
+  Range noise_std{0, 0.05};
+  Range salt_pepper{0, 0.01};
+  Range motion_blur_px{0, 3};
+
+  // Throws ConfigError naming the field ("generator.<field>") and the bad value.
+  void validate() const;
+};
+
+// Reads config/world.json; unknown or missing keys are errors naming the file and the key.
+WorldParams loadWorldParams(const std::string& path);
+// Reads config/generator.json, strictly likewise.
+GeneratorConfig loadGeneratorConfig(const std::string& path);
+// The shipped configuration directory (the package's config/).
+std::string defaultConfigDir();
+
+// "<class>-<16 hex digits of the seed>", e.g. "area_search-00000000000004d2".
+std::string scenarioId(ScenarioClass cls, std::uint64_t seed);
+
+// Generates one scenario. Deterministic: the same world, config, class and seed give the same
+// scenario. Throws GenerationError when no placement satisfies the constraints.
+Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
+                          std::uint64_t seed);
+
+// Seed of the i-th scenario of a batch with base seed `seed`.
+std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index);
+
+}  // namespace hameritt::scenario

@@ -1,0 +1,214 @@
+#pragma once
+// The scenario data model: the mission description (what a client algorithm is told) and the
+// simulation configuration (what the simulator needs). Written as mission.json and
+// sim_config.json; see README "Scenario files".
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hameritt/geometry/polygon.h"
+#include "hameritt/geometry/time_window.h"
+#include "hameritt/scenario/entity.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::scenario {
+
+constexpr int kSchemaVersion = 1;
+
+enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit };
+const char* toString(ScenarioClass c);
+bool parseScenarioClass(const std::string& s, ScenarioClass* out);
+
+// A timed pose sample of a moving entity; the simulator interpolates linearly in position and
+// along the shorter arc in yaw between samples, and holds the last sample afterwards.
+struct TrajectoryPoint {
+  double t = 0, x = 0, y = 0, z = 0, yaw = 0;
+};
+using Trajectory = std::vector<TrajectoryPoint>;
+// The pose of a trajectory at time t (clamped to its first and last samples).
+TrajectoryPoint sampleTrajectory(const Trajectory& traj, double t);
+
+// Soft spatial constraint: where the target is expected, optionally only within a window.
+struct AreaOfInterest {
+  std::string id;
+  geometry::Polygon polygon;
+  geometry::TimeWindow window;
+};
+
+// Hard spatial constraint: the UAV must not enter the polygon between alt_min and alt_max
+// (metres above ground; absent means unbounded) while the window is active.
+struct KeepOutZone {
+  std::string id;
+  geometry::Polygon polygon;
+  std::optional<double> alt_min;
+  std::optional<double> alt_max;
+  geometry::TimeWindow window;
+  std::string purpose;  // vantage_denial | access_denial | restricted
+};
+
+// One cell of an AOI's prior grid.
+struct PriorCell {
+  std::string id;
+  int row = 0;
+  int col = 0;
+  geometry::Polygon polygon;
+  double probability = 0.0;
+};
+
+// The prior belief over where the target is inside one AOI: a 2^depth x 2^depth grid of
+// sub-quadrants whose probabilities sum to 1.
+struct AreaPrior {
+  std::string aoi_id;
+  int depth = 1;
+  std::vector<PriorCell> cells;
+};
+
+// A route of interest along streets with its search band.
+struct RouteOfInterest {
+  std::string id;
+  std::vector<geometry::Vec2> polyline;
+  std::vector<std::string> streets;
+  double band_width = 0.0;
+  geometry::Polygon band;
+};
+
+enum class RelationOp {
+  kNextTo,
+  kNotNextTo,
+  kOnTopOf,
+  kNotOnTopOf,
+  kOrthogonalTo,
+  kInFrontOf,
+  kRightOf,
+  kLeftOf,
+  kPartOf,
+};
+// "NEXT_TO", ..., "PART_OF"; with eventually = true, "EVENTUALLY_NEXT_TO" and so on.
+std::string toString(RelationOp op, bool eventually = false);
+bool parseRelationOp(const std::string& s, RelationOp* op, bool* eventually);
+
+// [related] [OPERATOR] [target] [related attributes], with the geometric evidence that made
+// it true. For PART_OF the related entity is a group.
+struct SceneRelation {
+  std::string related_id;
+  std::string related_class;  // entity class, or "group"
+  Attributes related_attributes;
+  RelationOp op = RelationOp::kNextTo;
+  bool eventually = false;
+  std::string target_id;
+  // Evidence at the time the relation holds (t = 0, or `time` for EVENTUALLY_*).
+  double distance = 0.0;     // footprint-to-footprint, metres
+  double bearing_deg = 0.0;  // of the related centre in the target body frame, CCW, [0, 360)
+  double dz = 0.0;           // target min z - related max z
+  bool line_of_sight = false;
+  std::optional<double> time;  // first time it holds (EVENTUALLY_* only)
+};
+
+// What the client is asked to find or track.
+struct TargetDescription {
+  std::string id;
+  std::string cls = "car";
+  std::string vehicle_class;
+  std::string make;
+  std::string model;
+  std::string color;
+};
+
+struct Objective {
+  std::string type;  // find | track
+  std::string text;
+  std::vector<TargetDescription> targets;
+};
+
+// The geodetic origin of the local ENU frame.
+struct GeoOrigin {
+  double latitude = 42.4851;
+  double longitude = -71.1873;
+  double altitude = 40.0;
+};
+
+struct Mission {
+  std::string scenario_id;
+  ScenarioClass cls = ScenarioClass::kAreaSearch;
+  std::uint64_t seed = 0;
+  GeoOrigin origin;
+  double time_limit = 0.0;
+  Objective objective;
+  std::vector<AreaOfInterest> aois;
+  std::vector<KeepOutZone> kozs;
+  std::vector<AreaPrior> priors;
+  std::vector<RouteOfInterest> routes;
+  std::vector<SceneRelation> relations;
+};
+
+// An entity added by the scenario (targets, confusers, traffic, pedestrians), with its timed
+// trajectory when it moves (empty for a parked car).
+struct ScenarioEntity {
+  Entity entity;
+  std::string role;  // target | confuser | traffic | pedestrian | vignette
+  Trajectory trajectory;
+};
+
+// A named group of entities (PART_OF relations refer to groups).
+struct Group {
+  std::string id;
+  std::string kind;  // block | convoy | vignette
+  std::vector<std::string> members;
+};
+
+struct Environment {
+  double time_of_day = 12.0;  // hours, local solar time
+  double snow = 0, rain = 0, dust = 0, fog = 0;  // intensities in [0, 1]
+  double foliage = 1.0;                          // density in [0, 1]
+  geometry::Vec3 wind_mean{0, 0, 0};             // ENU m/s, the air's velocity
+  double gust_intensity = 0.0;                   // [0, 1]
+};
+
+struct CameraSpec {
+  std::string name;
+  geometry::Vec3 mount_xyz{0, 0, 0};  // body frame (FLU), metres
+  geometry::Vec3 mount_rpy{0, 0, 0};  // degrees, roll-pitch-yaw; positive pitch looks down
+  int width = 640;
+  int height = 480;
+  double hfov_deg = 90.0;
+  double rate_hz = 10.0;
+  std::vector<std::string> modalities;  // rgb, depth, segmentation, instances
+};
+
+struct UavSpec {
+  std::string model = "sentinel";
+  TrajectoryPoint start;  // t = 0
+  double altitude_min = 20.0;
+  double altitude_max = 60.0;
+  double max_speed = 12.0;
+  std::vector<CameraSpec> cameras;
+};
+
+struct Perturbations {
+  double gaussian_noise_std = 0.0;  // fraction of full scale
+  double salt_pepper_probability = 0.0;
+  double motion_blur_px = 0.0;
+};
+
+struct SimConfig {
+  std::string scenario_id;
+  ScenarioClass cls = ScenarioClass::kAreaSearch;
+  std::uint64_t seed = 0;
+  double duration = 0.0;
+  WorldParams world;
+  std::uint64_t world_fingerprint = 0;
+  std::vector<ScenarioEntity> entities;
+  std::vector<Group> groups;
+  Environment environment;
+  UavSpec uav;
+  Perturbations perturbations;
+};
+
+struct Scenario {
+  Mission mission;
+  SimConfig sim;
+};
+
+}  // namespace hameritt::scenario

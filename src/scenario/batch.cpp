@@ -1,0 +1,153 @@
+#include "hameritt/scenario/batch.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/json_writer.h"
+#include "hameritt/scenario/scenario_io.h"
+
+namespace hameritt::scenario {
+
+namespace fs = std::filesystem;
+
+std::vector<ScenarioClass> parseClassList(const std::string& s) {
+  if (s == "all") {
+    return {ScenarioClass::kAreaSearch, ScenarioClass::kRouteSearch, ScenarioClass::kPursuit};
+  }
+  std::vector<ScenarioClass> out;
+  std::size_t start = 0;
+  while (start <= s.size()) {
+    const std::size_t comma = s.find(',', start);
+    const std::string name = s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    ScenarioClass c;
+    if (!parseScenarioClass(name, &c)) {
+      throw ConfigError("--class: expected area_search, route_search, pursuit, all or a "
+                        "comma-separated list of them, got '" + name + "'");
+    }
+    out.push_back(c);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+namespace {
+
+std::string manifestJson(const World& world, const BatchRequest& req,
+                         const std::vector<ManifestEntry>& entries) {
+  JsonWriter w;
+  w.beginObject();
+  w.key("schema").value("hameritt/manifest");
+  w.key("schema_version").value(kSchemaVersion);
+  w.key("seed").value(req.seed);
+  w.key("count").value(req.count);
+  w.key("classes").beginArray();
+  for (auto c : req.classes) w.value(toString(c));
+  w.endArray();
+  w.key("world").beginObject();
+  w.key("fingerprint").value(hex64(world.fingerprint()));
+  w.key("file").value(req.write_world ? "world.json" : "");
+  w.endObject();
+  w.key("scenarios").beginArray();
+  for (const auto& e : entries) {
+    w.beginObject();
+    w.key("index").value(e.index).key("id").value(e.id).key("class").value(toString(e.cls));
+    w.key("seed").value(e.seed).key("path").value(e.id);
+    w.endObject();
+  }
+  w.endArray();
+  w.endObject();
+  return w.str();
+}
+
+}  // namespace
+
+std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConfig& config,
+                                         const BatchRequest& req) {
+  if (req.classes.empty()) throw ConfigError("--class: at least one scenario class is required");
+  if (req.count < 1) throw ConfigError("--count: expected a positive number of scenarios, got " + std::to_string(req.count));
+  if (req.jobs < 1) throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
+  if (req.out_dir.empty()) throw ConfigError("--out: an output directory is required");
+  std::error_code ec;
+  fs::create_directories(req.out_dir, ec);
+  if (ec || !fs::is_directory(req.out_dir)) {
+    throw OutputError(req.out_dir + ": cannot create output directory: " +
+                      (ec ? ec.message() : std::string("not a directory")));
+  }
+  if (::access(req.out_dir.c_str(), W_OK) != 0) {
+    throw OutputError(req.out_dir + ": output directory is not writable: " + std::strerror(errno));
+  }
+
+  std::vector<ManifestEntry> entries(static_cast<std::size_t>(req.count));
+  std::vector<char> written(entries.size(), 0);
+  std::atomic<int> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  int error_index = -1;
+  std::mutex mu;
+  auto work = [&]() {
+    for (;;) {
+      const int i = next.fetch_add(1);
+      if (i >= req.count || failed.load()) return;
+      try {
+        ManifestEntry& e = entries[static_cast<std::size_t>(i)];
+        e.index = i;
+        e.cls = req.classes[static_cast<std::size_t>(i) % req.classes.size()];
+        e.seed = batchSeed(req.seed, static_cast<std::uint64_t>(i));
+        const Scenario s = generateScenario(world, config, e.cls, e.seed);
+        e.id = s.mission.scenario_id;
+        writeScenarioDir(req.out_dir, s);
+        written[static_cast<std::size_t>(i)] = 1;
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mu);
+        // Keep the lowest failing index so the reported error does not depend on timing.
+        if (!error || i < error_index) {
+          error = std::current_exception();
+          error_index = i;
+        }
+        failed.store(true);
+      }
+    }
+  };
+  const int jobs = std::min(req.jobs, req.count);
+  std::vector<std::thread> threads;
+  for (int j = 1; j < jobs; ++j) threads.emplace_back(work);
+  work();
+  for (auto& t : threads) t.join();
+
+  try {
+    if (!error) {
+      // Two seeds mapping to one id would overwrite a scenario: refuse rather than lose one.
+      std::vector<std::string> ids;
+      for (const auto& e : entries) ids.push_back(e.id);
+      std::sort(ids.begin(), ids.end());
+      if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) {
+        throw GenerationError("two scenarios of the batch share an id");
+      }
+      if (req.write_world) writeFileAtomic(req.out_dir + "/world.json", worldJson(world));
+      writeFileAtomic(req.out_dir + "/manifest.json", manifestJson(world, req, entries));
+    }
+  } catch (...) {
+    error = std::current_exception();
+  }
+  if (error) {
+    // Roll back: remove every scenario directory this call wrote.
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      if (written[i]) fs::remove_all(req.out_dir + "/" + entries[i].id, ec);
+    }
+    std::rethrow_exception(error);
+  }
+  return entries;
+}
+
+}  // namespace hameritt::scenario

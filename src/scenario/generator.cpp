@@ -1,0 +1,1056 @@
+#include "hameritt/scenario/generator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "hameritt/geometry/segment.h"
+#include "hameritt/scenario/catalog.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/rng.h"
+#include "hameritt/scenario/trajectory.h"
+
+namespace hameritt::scenario {
+
+using geometry::OrientedBox;
+using geometry::Polygon;
+using geometry::TimeWindow;
+using geometry::Vec2;
+using geometry::Vec3;
+
+std::string scenarioId(ScenarioClass cls, std::uint64_t seed) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%s-%016llx", toString(cls),
+                static_cast<unsigned long long>(seed));
+  return buf;
+}
+
+std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index) {
+  return deriveSeed(seed, 0x5343454E00000000ULL + index);
+}
+
+namespace {
+
+constexpr double kLaneOffsetFromKerb = 3.45;  // lane centre = half width - this
+constexpr int kMaxAttempts = 200;
+
+Vec2 round2(const Vec2& v) { return {roundMilli(v.x()), roundMilli(v.y())}; }
+
+Polygon roundPolygon(const Polygon& p) {
+  std::vector<Vec2> v;
+  v.reserve(p.size());
+  for (const auto& q : p.vertices()) v.push_back(round2(q));
+  return Polygon(v);
+}
+
+double rangeDraw(Rng& rng, const Range& r) { return r.max > r.min ? rng.uniform(r.min, r.max) : r.min; }
+
+class ScenarioBuilder {
+ public:
+  ScenarioBuilder(const World& world, const GeneratorConfig& cfg, ScenarioClass cls,
+                  std::uint64_t seed)
+      : world_(world), cfg_(cfg), cls_(cls), seed_(seed), rng_(seed), eval_(world, cfg.relations) {
+    slot_taken_.assign(world.slots().size(), 0);
+    for (std::size_t i = 0; i < world.slots().size(); ++i) {
+      if (world.slots()[i].occupant >= 0) slot_taken_[i] = 1;
+    }
+    int world_cars = 0, world_peds = 0;
+    for (const auto& e : world.entities()) {
+      if (e.cls == EntityClass::kCar) ++world_cars;
+      if (e.cls == EntityClass::kPedestrian) ++world_peds;
+    }
+    // Scenario ids are drawn from a shuffled pool so that neither order nor number reveals a role.
+    for (int i = 1; i <= 96; ++i) car_ids_.push_back(world_cars + i);
+    for (int i = 1; i <= 48; ++i) ped_ids_.push_back(world_peds + i);
+    rng_.shuffle(car_ids_);
+    rng_.shuffle(ped_ids_);
+  }
+
+  Scenario build() {
+    Mission& m = sc_.mission;
+    SimConfig& s = sc_.sim;
+    m.scenario_id = s.scenario_id = scenarioId(cls_, seed_);
+    m.cls = s.cls = cls_;
+    m.seed = s.seed = seed_;
+    m.origin = cfg_.origin;
+    s.world = world_.params();
+    s.world_fingerprint = world_.fingerprint();
+    drawUav();
+    switch (cls_) {
+      case ScenarioClass::kAreaSearch:
+        buildAreaSearch();
+        break;
+      case ScenarioClass::kRouteSearch:
+        buildRouteSearch();
+        break;
+      case ScenarioClass::kPursuit:
+        buildPursuit();
+        break;
+    }
+    placeUavStart();
+    addTraffic();
+    drawEnvironment();
+    s.duration = m.time_limit;
+    finalizeRelations();
+    finishGroups();
+    return std::move(sc_);
+  }
+
+ private:
+  // ------------------------------------------------------------------ entities
+  std::string nextCarId() {
+    const int n = car_ids_.back();
+    car_ids_.pop_back();
+    return "car_" + std::to_string(n);
+  }
+  std::string nextPedId() {
+    const int n = ped_ids_.back();
+    ped_ids_.pop_back();
+    return "pedestrian_" + std::to_string(n);
+  }
+
+  Entity makeCar(const catalog::CarModel& model, const std::string& color, const Vec3& bottom,
+                 double yaw) {
+    Entity e;
+    e.id = nextCarId();
+    e.cls = EntityClass::kCar;
+    e.attributes.set("vehicle_class", model.vehicle_class);
+    e.attributes.set("make", model.make);
+    e.attributes.set("model", model.model);
+    e.attributes.set("color", color);
+    e.box = boxFromPose(Vec3(roundMilli(bottom.x()), roundMilli(bottom.y()), roundMilli(bottom.z())),
+                        roundMilli(geometry::wrapPi(yaw)),
+                        Vec3(model.length, model.width, model.height));
+    e.block = world_.blockAt(e.box.center2());
+    return e;
+  }
+
+  Entity parkCar(int slot, const catalog::CarModel& model, const std::string& color) {
+    const auto& sl = world_.slots()[static_cast<std::size_t>(slot)];
+    slot_taken_[static_cast<std::size_t>(slot)] = 1;
+    return makeCar(model, color, Vec3(sl.position.x(), sl.position.y(), sl.ground_z), sl.yaw);
+  }
+
+  ScenarioEntity& add(Entity e, const std::string& role, Trajectory traj = {}) {
+    ScenarioEntity se;
+    se.entity = std::move(e);
+    se.role = role;
+    se.trajectory = std::move(traj);
+    if (se.trajectory.empty()) eval_.addOccluder(se.entity.id, se.entity.box);
+    sc_.sim.entities.push_back(std::move(se));
+    return sc_.sim.entities.back();
+  }
+
+  Subject subjectOf(const Entity& e) const {
+    Subject s;
+    s.id = e.id;
+    s.cls = e.cls;
+    s.attributes = &e.attributes;
+    s.box = e.box;
+    return s;
+  }
+
+  // Parked scenario cars other than `except`, as relation subjects.
+  std::vector<Subject> parkedSubjects(const std::string& except) const {
+    std::vector<Subject> out;
+    for (const auto& se : sc_.sim.entities) {
+      if (se.trajectory.empty() && se.entity.id != except) out.push_back(subjectOf(se.entity));
+    }
+    return out;
+  }
+
+  // A free slot satisfying `ok`, or -1.
+  template <typename Pred>
+  int pickSlot(Pred ok, bool kerb_only = false) {
+    const auto& slots = world_.slots();
+    for (int attempt = 0; attempt < 4 * kMaxAttempts; ++attempt) {
+      const int i = static_cast<int>(rng_.uniformInt(0, static_cast<long>(slots.size()) - 1));
+      if (slot_taken_[static_cast<std::size_t>(i)]) continue;
+      if (kerb_only && slots[static_cast<std::size_t>(i)].driveway) continue;
+      if (ok(slots[static_cast<std::size_t>(i)])) return i;
+    }
+    return -1;
+  }
+
+  // ------------------------------------------------------------------ routes and motion
+  // A random walk of `n` street edges from `start` without turning back or reusing a node.
+  std::vector<int> randomWalk(int start, int n) {
+    std::vector<int> nodes{start};
+    std::set<int> seen{start};
+    while (static_cast<int>(nodes.size()) <= n) {
+      std::vector<int> next;
+      for (int ei : world_.adjacency()[static_cast<std::size_t>(nodes.back())]) {
+        const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
+        const int other = e.a == nodes.back() ? e.b : e.a;
+        if (!seen.count(other)) next.push_back(other);
+      }
+      if (next.empty()) break;
+      const int pick = rng_.pick(next);
+      nodes.push_back(pick);
+      seen.insert(pick);
+    }
+    return nodes;
+  }
+
+  int randomNode() {
+    return static_cast<int>(rng_.uniformInt(0, static_cast<long>(world_.nodes().size()) - 1));
+  }
+
+  std::vector<Vec2> nodePositions(const std::vector<int>& nodes) const {
+    std::vector<Vec2> out;
+    for (int n : nodes) out.push_back(world_.nodes()[static_cast<std::size_t>(n)].position);
+    return out;
+  }
+
+  DriveSpec driveSpec(double speed) const {
+    DriveSpec d;
+    d.lane_offset = 0.5 * world_.params().street_width - kLaneOffsetFromKerb;
+    d.corner_clearance = 0.5 * world_.params().street_width + 1.0;
+    d.cruise_speed = speed;
+    return d;
+  }
+
+  // ------------------------------------------------------------------ constraints
+  AreaOfInterest makeAoi(const std::string& id, const Vec2& contains, double yaw, double len,
+                         double wid, std::vector<Vec2>* grid_origin_axes) {
+    (void)grid_origin_axes;
+    AreaOfInterest a;
+    a.id = id;
+    const Vec2 ax(std::cos(yaw), std::sin(yaw)), ay(-std::sin(yaw), std::cos(yaw));
+    const auto b = world_.bounds();
+    const double hx = 0.5 * (std::abs(len * ax.x()) + std::abs(wid * ay.x()));
+    const double hy = 0.5 * (std::abs(len * ax.y()) + std::abs(wid * ay.y()));
+    // The point sits off-centre; the AOI is kept inside the neighborhood where that still
+    // contains the point, else centred on it.
+    for (int attempt = 0; attempt < 10; ++attempt) {
+      const double ox = rng_.uniform(-0.4, 0.4) * len, oy = rng_.uniform(-0.4, 0.4) * wid;
+      Vec2 c = contains - ox * ax - oy * ay;
+      c.x() = std::clamp(c.x(), b.min.x() + hx, std::max(b.min.x() + hx, b.max.x() - hx));
+      c.y() = std::clamp(c.y(), b.min.y() + hy, std::max(b.min.y() + hy, b.max.y() - hy));
+      a.polygon = roundPolygon(geometry::orientedRectangle(c, len, wid, yaw));
+      if (a.polygon.contains(contains) && a.polygon.boundaryDistance(contains) > 5.0) return a;
+    }
+    a.polygon = roundPolygon(geometry::orientedRectangle(contains, len, wid, yaw));
+    return a;
+  }
+
+  // Sub-quadrant grid of a rectangular AOI (vertices 0..3 counter-clockwise from the
+  // local (-x,-y) corner), with the target's cell (if any) holding the highest prior.
+  AreaPrior makePrior(const AreaOfInterest& aoi, const Vec2* target) {
+    AreaPrior p;
+    p.aoi_id = aoi.id;
+    p.depth = static_cast<int>(rng_.uniformInt(cfg_.prior_depth_min, cfg_.prior_depth_max));
+    const int n = 1 << p.depth;
+    const auto& v = aoi.polygon.vertices();
+    const Vec2 o = v[0], ex = v[1] - v[0], ey = v[3] - v[0];
+    std::vector<Vec2> grid;
+    for (int r = 0; r <= n; ++r) {
+      for (int c = 0; c <= n; ++c) grid.push_back(round2(o + (double(c) / n) * ex + (double(r) / n) * ey));
+    }
+    auto g = [&](int r, int c) { return grid[static_cast<std::size_t>(r * (n + 1) + c)]; };
+    std::vector<double> w;
+    int target_cell = -1;
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c) {
+        PriorCell cell;
+        char id[64];
+        std::snprintf(id, sizeof(id), "%s_r%dc%d", aoi.id.c_str(), r, c);
+        cell.id = id;
+        cell.row = r;
+        cell.col = c;
+        cell.polygon = Polygon({g(r, c), g(r, c + 1), g(r + 1, c + 1), g(r + 1, c)});
+        if (target && target_cell < 0 && cell.polygon.contains(*target)) {
+          target_cell = static_cast<int>(p.cells.size());
+        }
+        p.cells.push_back(cell);
+        w.push_back(rng_.uniform(0.2, 1.0));
+      }
+    }
+    if (target_cell >= 0) {
+      const double mx = *std::max_element(w.begin(), w.end());
+      w[static_cast<std::size_t>(target_cell)] = mx * rng_.uniform(1.4, 2.5);
+    }
+    double sum = 0;
+    for (double x : w) sum += x;
+    // Probabilities in units of 1e-4, summing to exactly 10000 units.
+    std::vector<long> units;
+    long total = 0;
+    for (double x : w) {
+      units.push_back(std::lround(x / sum * 10000.0));
+      total += units.back();
+    }
+    const std::size_t fix = target_cell >= 0 ? static_cast<std::size_t>(target_cell)
+                                             : static_cast<std::size_t>(std::max_element(units.begin(), units.end()) - units.begin());
+    units[fix] += 10000 - total;
+    for (std::size_t i = 0; i < units.size(); ++i) p.cells[i].probability = units[i] / 10000.0;
+    return p;
+  }
+
+  KeepOutZone makeKoz(const Polygon& poly, const std::string& purpose) {
+    KeepOutZone k;
+    k.id = "koz_" + std::to_string(sc_.mission.kozs.size() + 1);
+    k.polygon = roundPolygon(poly);
+    k.purpose = purpose;
+    return k;
+  }
+
+  // ------------------------------------------------------------------ relations
+  // Picks the mission's relations for a target from every true one, with per-operator caps
+  // so that the description mixes surface, direction, proximity and membership facts.
+  std::vector<SceneRelation> selectRelations(std::vector<SceneRelation> all) {
+    rng_.shuffle(all);
+    std::map<std::string, int> caps = {{"ON_TOP_OF", 1},  {"NOT_ON_TOP_OF", 1}, {"PART_OF", 1},
+                                       {"LEFT_OF", 1},    {"RIGHT_OF", 1},      {"IN_FRONT_OF", 1},
+                                       {"ORTHOGONAL_TO", 1}, {"NEXT_TO", 2},    {"NOT_NEXT_TO", 1}};
+    std::vector<SceneRelation> out;
+    std::set<std::string> used;
+    // Membership and surface first (always informative), then the rest in random order.
+    std::stable_partition(all.begin(), all.end(), [](const SceneRelation& r) {
+      return r.op == RelationOp::kPartOf || r.op == RelationOp::kOnTopOf;
+    });
+    for (auto& r : all) {
+      if (static_cast<int>(out.size()) >= cfg_.relations.max_relations) break;
+      const std::string name = toString(r.op, r.eventually);
+      auto it = caps.find(name);
+      if (it == caps.end() || it->second <= 0) continue;
+      if (used.count(r.related_id + name)) continue;
+      --it->second;
+      used.insert(r.related_id + name);
+      out.push_back(std::move(r));
+    }
+    return out;
+  }
+
+  // EVENTUALLY_* relations of a moving target: the first sample time (on the eventually_dt
+  // grid) at which NEXT_TO, LEFT_OF or RIGHT_OF holds with a static entity it did not hold
+  // with at t = 0. Stops after `want` relations.
+  std::vector<SceneRelation> eventuallyRelations(const Entity& target, const Trajectory& traj,
+                                                 const std::vector<SceneRelation>& at_start,
+                                                 int want) {
+    std::vector<SceneRelation> out;
+    std::set<std::string> seen;
+    for (const auto& r : at_start) seen.insert(r.related_id + toString(r.op));
+    const double dt = cfg_.relations.eventually_dt;
+    const double end = traj.back().t;
+    const std::vector<Subject> parked = parkedSubjects(target.id);
+    for (int k = 1; k * dt <= end && static_cast<int>(out.size()) < want; ++k) {
+      const double t = k * dt;
+      Subject s = subjectOf(target);
+      s.box = poseBox(target.box, sampleTrajectory(traj, t));
+      auto consider = [&](const Subject& rel) {
+        const RelationFacts f = eval_.measure(s, rel);
+        for (RelationOp op : {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf}) {
+          const std::string key = rel.id + toString(op);
+          if (seen.count(key) || !eval_.holds(op, f, rel.cls)) continue;
+          seen.insert(key);
+          if (rel.cls == EntityClass::kStreet || rel.cls == EntityClass::kFence) continue;
+          SceneRelation r;
+          r.related_id = rel.id;
+          r.related_class = toString(rel.cls);
+          if (rel.attributes) r.related_attributes = *rel.attributes;
+          r.op = op;
+          r.eventually = true;
+          r.target_id = target.id;
+          r.distance = f.distance;
+          r.bearing_deg = f.bearing_deg;
+          r.dz = f.dz;
+          r.line_of_sight = f.line_of_sight;
+          r.time = t;
+          out.push_back(r);
+        }
+      };
+      for (int i : eval_.nearbyWorld(s.box)) consider(worldSubject(world_, i));
+      for (const auto& p : parked) {
+        if (geometry::footprintDistance(s.box, p.box) <= cfg_.relations.radius) consider(p);
+      }
+    }
+    if (static_cast<int>(out.size()) > want) out.resize(static_cast<std::size_t>(want));
+    return out;
+  }
+
+  // True when the confuser does not match the target's symbolic description: outside every
+  // AOI that the target is in, or some listed relation fails for it.
+  bool disambiguated(const Entity& confuser, const std::vector<SceneRelation>& rels,
+                     const std::vector<const AreaOfInterest*>& target_aois) {
+    for (const auto* a : target_aois) {
+      if (!a->polygon.contains(confuser.box.center2())) return true;
+    }
+    const Subject c = subjectOf(confuser);
+    const std::vector<Subject> parked = parkedSubjects(confuser.id);
+    const std::vector<Group> groups = currentGroups();
+    for (const auto& r : rels) {
+      // A parked confuser and a static related entity keep their relation for all time, so the
+      // static test also answers EVENTUALLY_*; moving related entities are checked over time.
+      if (eval_.satisfiedBy(r, c, parked, groups)) continue;
+      if (r.eventually && movingSatisfies(r, confuser)) continue;
+      return true;
+    }
+    return false;
+  }
+
+  // True when a moving scenario entity of the relation's class and attributes satisfies it
+  // with the (static) candidate at some sample time.
+  bool movingSatisfies(const SceneRelation& r, const Entity& candidate) const {
+    EntityClass cls;
+    if (!parseEntityClass(r.related_class, &cls)) return false;
+    const Subject c = subjectOf(candidate);
+    const double dt = cfg_.relations.eventually_dt;
+    for (const auto& se : sc_.sim.entities) {
+      if (se.trajectory.empty() || se.entity.cls != cls || !(se.entity.attributes == r.related_attributes)) continue;
+      for (int k = 1; k * dt <= sc_.mission.time_limit; ++k) {
+        Subject m = subjectOf(se.entity);
+        m.box = poseBox(se.entity.box, sampleTrajectory(se.trajectory, k * dt));
+        if (eval_.holds(r.op, eval_.measure(c, m), cls)) return true;
+      }
+    }
+    return false;
+  }
+
+  const ScenarioEntity* scenarioEntity(const std::string& id) const {
+    for (const auto& se : sc_.sim.entities) {
+      if (se.entity.id == id) return &se;
+    }
+    return nullptr;
+  }
+
+  // The subject of a world or scenario entity posed at time t, or false if unknown.
+  bool subjectAt(const std::string& id, double t, Subject* out) const {
+    const int w = world_.find(id);
+    if (w >= 0) {
+      *out = worldSubject(world_, w);
+      return true;
+    }
+    const ScenarioEntity* se = scenarioEntity(id);
+    if (!se) return false;
+    *out = subjectOf(se->entity);
+    if (!se->trajectory.empty()) out->box = poseBox(se->entity.box, sampleTrajectory(se->trajectory, t));
+    return true;
+  }
+
+  // Re-evaluates relation r at time t with the final scene; fills its evidence when it holds.
+  bool holdsAt(SceneRelation* r, double t) const {
+    Subject target, related;
+    if (!subjectAt(r->target_id, t, &target) || !subjectAt(r->related_id, t, &related)) return false;
+    const RelationFacts f = eval_.measure(target, related);
+    if (!eval_.holds(r->op, f, related.cls)) return false;
+    r->distance = f.distance;
+    r->bearing_deg = f.bearing_deg;
+    r->dz = f.dz;
+    r->line_of_sight = f.line_of_sight;
+    return true;
+  }
+
+  // Final pass once every entity is placed: each listed relation is re-verified against the
+  // finished scene (EVENTUALLY_* get their first grid time again), and a confuser that the
+  // surviving description no longer tells apart from its target is removed. Repeats until
+  // stable, since removing a confuser changes the occluders.
+  void finalizeRelations() {
+    Mission& m = sc_.mission;
+    for (int round = 0; round < 4; ++round) {
+      std::vector<SceneRelation> kept;
+      const std::vector<Group> groups = currentGroups();
+      for (SceneRelation r : m.relations) {
+        if (r.op == RelationOp::kPartOf) {
+          for (const auto& g : groups) {
+            if (g.id == r.related_id &&
+                std::find(g.members.begin(), g.members.end(), r.target_id) != g.members.end()) {
+              kept.push_back(r);
+            }
+          }
+          continue;
+        }
+        if (!r.eventually) {
+          if (holdsAt(&r, 0.0)) kept.push_back(r);
+          continue;
+        }
+        SceneRelation at0 = r;
+        if (holdsAt(&at0, 0.0)) continue;
+        const double dt = cfg_.relations.eventually_dt;
+        for (int k = 1; k * dt <= m.time_limit; ++k) {
+          if (holdsAt(&r, k * dt)) {
+            r.time = k * dt;
+            kept.push_back(r);
+            break;
+          }
+        }
+      }
+      m.relations = kept;
+      bool removed = false;
+      std::vector<ScenarioEntity> entities;
+      for (auto& se : sc_.sim.entities) {
+        if (se.role == "confuser" && !confuserResolved(se.entity)) {
+          eval_.removeOccluder(se.entity.id);
+          removed = true;
+          continue;
+        }
+        entities.push_back(std::move(se));
+      }
+      sc_.sim.entities = std::move(entities);
+      if (!removed) break;
+    }
+  }
+
+  // Whether a confuser is told apart from every target that shares its look.
+  bool confuserResolved(const Entity& c) {
+    for (const auto& se : sc_.sim.entities) {
+      if (se.role != "target") continue;
+      const auto& t = se.entity.attributes;
+      if (t.str("make") != c.attributes.str("make") || t.str("model") != c.attributes.str("model") ||
+          t.str("color") != c.attributes.str("color")) {
+        continue;
+      }
+      if (!sc_.mission.routes.empty()) {
+        if (sc_.mission.routes.front().band.intersects(c.box.footprint())) return false;
+        continue;
+      }
+      std::vector<const AreaOfInterest*> aois;
+      for (const auto& a : sc_.mission.aois) {
+        if (a.polygon.contains(se.entity.box.center2())) aois.push_back(&a);
+      }
+      std::vector<SceneRelation> rels;
+      for (const auto& r : sc_.mission.relations) {
+        if (r.target_id == se.entity.id) rels.push_back(r);
+      }
+      if (!disambiguated(c, rels, aois)) return false;
+    }
+    return true;
+  }
+
+  // Block groups as they stand now (membership by geometry), plus the scenario's own groups.
+  std::vector<Group> currentGroups() const {
+    std::vector<Group> out = extra_groups_;
+    std::map<int, Group> blocks;
+    for (const auto& se : sc_.sim.entities) {
+      if (!se.trajectory.empty()) continue;
+      const int b = world_.blockAt(se.entity.box.center2());
+      if (b < 0) continue;
+      Group& g = blocks[b];
+      g.id = world_.blocks()[static_cast<std::size_t>(b)].name;
+      g.kind = "block";
+      g.members.push_back(se.entity.id);
+    }
+    for (auto& kv : blocks) out.push_back(kv.second);
+    return out;
+  }
+
+  std::vector<const Group*> groupsOf(const std::string& id, const std::vector<Group>& groups) {
+    std::vector<const Group*> out;
+    for (const auto& g : groups) {
+      if (std::find(g.members.begin(), g.members.end(), id) != g.members.end()) out.push_back(&g);
+    }
+    return out;
+  }
+
+  void addConfusers(const Entity& target, const std::vector<SceneRelation>& rels,
+                    const std::vector<const AreaOfInterest*>& target_aois,
+                    const Polygon* keep_out_of, double min_separation) {
+    auto resolves = [&](const Entity& c) {
+      if (keep_out_of) return !keep_out_of->intersects(c.box.footprint());
+      return disambiguated(c, rels, target_aois);
+    };
+    const auto* model = catalog::findCarModel(target.attributes.str("make"), target.attributes.str("model"));
+    const std::string color = target.attributes.str("color");
+    const int n = static_cast<int>(rng_.uniformInt(cfg_.confuser_count_min, cfg_.confuser_count_max));
+    for (int k = 0; k < n; ++k) {
+      // Alternate: outside the AOI first, then inside it but without the described context.
+      const bool want_inside = !target_aois.empty() && (k % 2 == 1);
+      bool placed = false;
+      for (int attempt = 0; attempt < 60 && !placed; ++attempt) {
+        const int slot = pickSlot([&](const ParkingSlot& sl) {
+          if ((sl.position - target.box.center2()).norm() < min_separation) return false;
+          if (keep_out_of && keep_out_of->distance(sl.position) < 8.0) return false;
+          if (!target_aois.empty()) {
+            const bool inside = target_aois.front()->polygon.contains(sl.position);
+            if (inside != want_inside) return false;
+          }
+          return true;
+        });
+        if (slot < 0) break;
+        Entity c = parkCar(slot, *model, color);
+        if (resolves(c)) {
+          add(std::move(c), "confuser");
+          placed = true;
+        } else {
+          slot_taken_[static_cast<std::size_t>(slot)] = 0;
+          car_ids_.push_back(std::stoi(c.id.substr(4)));
+        }
+      }
+    }
+  }
+
+  // ------------------------------------------------------------------ classes
+  void drawTargetLook(const catalog::CarModel** model, std::string* color) {
+    *model = &catalog::pickModel(rng_);
+    *color = catalog::pick(rng_, catalog::carColors());
+  }
+
+  TargetDescription describe(const Entity& e) {
+    TargetDescription d;
+    d.id = e.id;
+    d.vehicle_class = e.attributes.str("vehicle_class");
+    d.make = e.attributes.str("make");
+    d.model = e.attributes.str("model");
+    d.color = e.attributes.str("color");
+    return d;
+  }
+
+  static std::string lookText(const TargetDescription& d) {
+    return d.color + " " + d.make + " " + d.model + " (" + d.vehicle_class + ")";
+  }
+
+  void buildAreaSearch() {
+    Mission& m = sc_.mission;
+    m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_area_search));
+    const catalog::CarModel* model;
+    std::string color;
+    drawTargetLook(&model, &color);
+    const int slot = pickSlot([](const ParkingSlot&) { return true; });
+    if (slot < 0) throw GenerationError("no free parking slot for the target");
+    Entity target = parkCar(slot, *model, color);
+    const Vec2 tp = target.box.center2();
+    add(target, "target");
+    m.objective.type = "find";
+    m.objective.targets.push_back(describe(target));
+    m.objective.text = "Find the " + lookText(m.objective.targets.back()) + ".";
+
+    // AOIs: the first holds the target; the others lie elsewhere and do not overlap it.
+    const int n_aoi = static_cast<int>(rng_.uniformInt(cfg_.aoi_count_min, cfg_.aoi_count_max));
+    const double yaw0 = rng_.uniform(-0.3, 0.3);
+    for (int i = 0; i < n_aoi; ++i) {
+      const std::string id = "aoi_" + std::to_string(i + 1);
+      const double len = rangeDraw(rng_, cfg_.aoi_length), wid = rangeDraw(rng_, cfg_.aoi_width);
+      AreaOfInterest a;
+      if (i == 0) {
+        a = makeAoi(id, tp, yaw0, len, wid, nullptr);
+        if (!a.polygon.contains(tp)) throw GenerationError("target AOI does not contain the target");
+      } else {
+        bool ok = false;
+        for (int attempt = 0; attempt < 30 && !ok; ++attempt) {
+          const auto b = world_.bounds();
+          const Vec2 p(rng_.uniform(b.min.x(), b.max.x()), rng_.uniform(b.min.y(), b.max.y()));
+          a = makeAoi(id, p, rng_.uniform(-0.3, 0.3), len, wid, nullptr);
+          ok = !a.polygon.intersects(m.aois.front().polygon);
+        }
+        if (!ok) break;
+      }
+      if (rng_.bernoulli(cfg_.aoi_window_probability)) {
+        const double net = std::round(rng_.uniform(0.0, 0.3) * m.time_limit);
+        a.window.net = net;
+        if (rng_.bernoulli(0.5)) a.window.nlt = std::round(rng_.uniform(net + 60.0, m.time_limit));
+      }
+      m.aois.push_back(a);
+    }
+    for (const auto& a : m.aois) m.priors.push_back(makePrior(a, a.id == "aoi_1" ? &tp : nullptr));
+
+    // KOZs that deny the easy vantage points: over the target, and over the street beside it.
+    const int n_koz = static_cast<int>(rng_.uniformInt(cfg_.koz_count_min, cfg_.koz_count_max));
+    {
+      const Vec2 c = tp + Vec2(rng_.uniform(-8, 8), rng_.uniform(-8, 8));
+      KeepOutZone k = makeKoz(geometry::orientedRectangle(c, rng_.uniform(30, 60), rng_.uniform(30, 60), yaw0),
+                              "vantage_denial");
+      k.alt_min = 0.0;
+      k.alt_max = std::round(uav_.altitude_max + 20.0);
+      m.kozs.push_back(k);
+    }
+    if (n_koz >= 2) {
+      int best = -1;
+      double best_d = 1e18;
+      for (int ei = 0; ei < static_cast<int>(world_.edges().size()); ++ei) {
+        const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
+        const double d = geometry::pointSegmentDistance(tp, world_.nodes()[e.a].position, world_.nodes()[e.b].position);
+        if (d < best_d) best_d = d, best = ei;
+      }
+      const auto& e = world_.edges()[static_cast<std::size_t>(best)];
+      const Vec2 a = world_.nodes()[e.a].position, b = world_.nodes()[e.b].position;
+      const double w = e.width + 2 * world_.params().sidewalk_width;
+      KeepOutZone k = makeKoz(geometry::orientedRectangle(0.5 * (a + b), std::max(10.0, (b - a).norm() - e.width), w,
+                                                          std::atan2((b - a).y(), (b - a).x())),
+                              "vantage_denial");
+      k.alt_min = 0.0;
+      k.alt_max = std::round(rng_.uniform(25.0, 40.0));
+      m.kozs.push_back(k);
+    }
+    for (int i = 2; i < n_koz; ++i) {
+      const auto& aoi = m.aois.front().polygon;
+      const auto bb = aoi.bounds();
+      for (int attempt = 0; attempt < 20; ++attempt) {
+        const Vec2 c(rng_.uniform(bb.min.x(), bb.max.x()), rng_.uniform(bb.min.y(), bb.max.y()));
+        if (!aoi.contains(c)) continue;
+        KeepOutZone k = makeKoz(geometry::orientedRectangle(c, rng_.uniform(20, 50), rng_.uniform(20, 50), rng_.uniform(-0.5, 0.5)),
+                                "restricted");
+        if (rng_.bernoulli(0.5)) {
+          k.window.net = std::round(rng_.uniform(0.0, 0.5) * m.time_limit);
+          k.window.nlt = std::round(*k.window.net + rng_.uniform(60.0, 0.5 * m.time_limit));
+        }
+        m.kozs.push_back(k);
+        break;
+      }
+    }
+
+    finishStaticTarget(target, {&m.aois.front()}, nullptr);
+  }
+
+  // Relations and confusers of a parked target.
+  void finishStaticTarget(const Entity& target, const std::vector<const AreaOfInterest*>& aois,
+                          const Polygon* keep_out_of) {
+    const std::vector<Group> groups = currentGroups();
+    const auto all = eval_.allRelations(subjectOf(target), parkedSubjects(target.id),
+                                        groupsOf(target.id, groups));
+    std::vector<SceneRelation> rels = selectRelations(all);
+    addConfusers(target, rels, aois, keep_out_of, 40.0);
+    for (auto& r : rels) sc_.mission.relations.push_back(r);
+  }
+
+  void buildRouteSearch() {
+    Mission& m = sc_.mission;
+    m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_route_search));
+    // Route of interest: a walk of several street edges.
+    std::vector<int> nodes;
+    const int want = static_cast<int>(rng_.uniformInt(cfg_.route_edges_min, cfg_.route_edges_max));
+    for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
+      nodes = randomWalk(randomNode(), want);
+      if (static_cast<int>(nodes.size()) == want + 1) break;
+    }
+    if (static_cast<int>(nodes.size()) < 3) throw GenerationError("no route of interest found");
+    RouteOfInterest route;
+    route.id = "route_1";
+    route.polyline = nodePositions(nodes);
+    for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+      for (int ei : world_.adjacency()[static_cast<std::size_t>(nodes[i])]) {
+        const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
+        if ((e.a == nodes[i] && e.b == nodes[i + 1]) || (e.b == nodes[i] && e.a == nodes[i + 1])) {
+          if (route.streets.empty() || route.streets.back() != e.name) route.streets.push_back(e.name);
+        }
+      }
+    }
+    route.band_width = std::round(rangeDraw(rng_, cfg_.band_width));
+    route.band = roundPolygon(geometry::bufferPolyline(route.polyline, route.band_width));
+    m.routes.push_back(route);
+
+    // One or two target cars drive the route as a convoy.
+    const int n_targets = rng_.bernoulli(0.5) ? 2 : 1;
+    Group convoy;
+    convoy.id = "convoy_1";
+    convoy.kind = "convoy";
+    const double speed = rangeDraw(rng_, cfg_.car_speed);
+    const double start_s = rng_.uniform(0.0, 0.3) * (route.polyline[1] - route.polyline[0]).norm();
+    std::vector<Entity> targets;
+    std::vector<Trajectory> trajs;
+    for (int i = 0; i < n_targets; ++i) {
+      const catalog::CarModel* model;
+      std::string color;
+      drawTargetLook(&model, &color);
+      DriveSpec spec = driveSpec(speed);
+      spec.start_offset = std::max(0.0, start_s - 12.0 * i);
+      spec.start_time = 0.0;
+      spec.depart_delay = 2.5 * i;
+      Trajectory traj = planDrive(route.polyline, spec);
+      Entity e = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
+      targets.push_back(e);
+      trajs.push_back(traj);
+      convoy.members.push_back(e.id);
+      m.objective.targets.push_back(describe(e));
+    }
+    m.objective.type = "find";
+    m.objective.text = "Find the " + lookText(m.objective.targets[0]) +
+                       (n_targets == 2 ? " and the " + lookText(m.objective.targets[1]) : std::string()) +
+                       " travelling along route_1.";
+    if (n_targets == 2) extra_groups_.push_back(convoy);
+
+    // Access denial: the street the car is on, for exactly the time it is there.
+    for (int i = 0; i < n_targets; ++i) {
+      std::vector<int> edge_choices;
+      for (int k = 1; k + 1 < static_cast<int>(nodes.size()); ++k) edge_choices.push_back(k);
+      if (edge_choices.empty()) edge_choices.push_back(0);
+      const int k = rng_.pick(edge_choices);
+      const Vec2 a = route.polyline[static_cast<std::size_t>(k)], b = route.polyline[static_cast<std::size_t>(k) + 1];
+      const double w = world_.params().street_width;
+      const Polygon street = roundPolygon(geometry::orientedRectangle(
+          0.5 * (a + b), (b - a).norm() - w, w, std::atan2((b - a).y(), (b - a).x())));
+      const auto interval = insideInterval(trajs[static_cast<std::size_t>(i)], street);
+      if (!interval) continue;
+      KeepOutZone koz = makeKoz(street, "access_denial");
+      koz.window.net = std::floor(interval->first * 1000.0) / 1000.0;
+      koz.window.nlt = std::ceil(interval->second * 1000.0) / 1000.0;
+      koz.alt_min = 0.0;
+      koz.alt_max = std::round(uav_.altitude_max + 20.0);
+      m.kozs.push_back(koz);
+    }
+
+    for (int i = 0; i < n_targets; ++i) {
+      add(targets[static_cast<std::size_t>(i)], "target", trajs[static_cast<std::size_t>(i)]);
+    }
+    for (int i = 0; i < n_targets; ++i) {
+      movingTargetRelations(targets[static_cast<std::size_t>(i)], trajs[static_cast<std::size_t>(i)], {});
+      addConfusers(targets[static_cast<std::size_t>(i)], {}, {}, &route.band, 40.0);
+    }
+  }
+
+  void movingTargetRelations(const Entity& target, const Trajectory& traj,
+                             const std::vector<Subject>& extra) {
+    const std::vector<Group> groups = currentGroups();
+    std::vector<const Group*> mine = groupsOf(target.id, groups);
+    std::vector<Subject> others = parkedSubjects(target.id);
+    others.insert(others.end(), extra.begin(), extra.end());
+    const auto at_start = eval_.allRelations(subjectOf(target), others, mine);
+    std::vector<SceneRelation> rels = selectRelations(at_start);
+    const int n_ev = std::max(1, cfg_.relations.max_relations / 3);
+    if (static_cast<int>(rels.size()) > cfg_.relations.max_relations - n_ev) rels.resize(static_cast<std::size_t>(cfg_.relations.max_relations - n_ev));
+    for (auto& r : eventuallyRelations(target, traj, at_start, n_ev)) rels.push_back(r);
+    for (auto& r : rels) sc_.mission.relations.push_back(r);
+  }
+
+  void buildPursuit() {
+    Mission& m = sc_.mission;
+    m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_pursuit));
+    const catalog::CarModel* model;
+    std::string color;
+    drawTargetLook(&model, &color);
+    // The target waits at the kerb, the pedestrians run at it, and it drives off.
+    const int slot = pickSlot([](const ParkingSlot& s) { return s.block >= 0; }, true);
+    if (slot < 0) throw GenerationError("no free kerb slot for the pursuit target");
+    const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
+    slot_taken_[static_cast<std::size_t>(slot)] = 1;
+    const auto& edge = world_.edges()[static_cast<std::size_t>(sl.edge)];
+    // Drive in the direction the car faces, then on through a random walk.
+    const Vec2 fwd(std::cos(sl.yaw), std::sin(sl.yaw));
+    const Vec2 pa = world_.nodes()[edge.a].position, pb = world_.nodes()[edge.b].position;
+    const int first = (pb - pa).dot(fwd) > 0 ? edge.a : edge.b;
+    const int second = first == edge.a ? edge.b : edge.a;
+    std::vector<int> nodes{first};
+    for (int n : randomWalk(second, static_cast<int>(rng_.uniformInt(6, 12)))) {
+      if (n != first) nodes.push_back(n);
+    }
+    const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
+    DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
+    spec.start_time = 0.0;
+    spec.depart_delay = depart;
+    spec.from_kerb = Vec3(sl.position.x(), sl.position.y(), sl.ground_z);
+    spec.from_kerb_yaw = sl.yaw;
+    const std::vector<Vec2> path = nodePositions(nodes);
+    spec.start_offset = (sl.position - path[0]).dot((path[1] - path[0]).normalized());
+    Trajectory traj = planDrive(path, spec);
+    Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
+    m.objective.type = "track";
+    m.objective.targets.push_back(describe(target));
+    m.objective.text = "Track the " + lookText(m.objective.targets.back()) +
+                       " that pedestrians chase, and keep it in view after it drives off.";
+
+    // Vignette: two or three pedestrians run along the sidewalk at the car, then after it.
+    Group vignette;
+    vignette.id = "vignette_1";
+    vignette.kind = "vignette";
+    const Block& block = world_.blocks()[static_cast<std::size_t>(sl.block)];
+    const int n_ped = static_cast<int>(rng_.uniformInt(2, 3));
+    std::vector<Subject> runners;
+    const double ring = geometry::polylineLength(block.sidewalk);
+    double s_car = 0;  // arc length of the sidewalk point nearest the car
+    {
+      double best = 1e18, acc = 0;
+      for (std::size_t i = 0; i + 1 < block.sidewalk.size(); ++i) {
+        const Vec2 a = block.sidewalk[i], b = block.sidewalk[i + 1];
+        const Vec2 q = geometry::closestPointOnSegment(sl.position, a, b);
+        const double d = (q - sl.position).norm();
+        if (d < best) best = d, s_car = acc + (q - a).norm();
+        acc += (b - a).norm();
+      }
+    }
+    for (int i = 0; i < n_ped; ++i) {
+      const double speed = rangeDraw(rng_, cfg_.runner_speed);
+      const double lead = rng_.uniform(25.0, 45.0);
+      const double dir = (block.sidewalk.size() > 1 &&
+                          (geometry::polylinePointAt(block.sidewalk, std::fmod(s_car + 1.0, ring)) -
+                           geometry::polylinePointAt(block.sidewalk, s_car)).dot(fwd) > 0) ? 1.0 : -1.0;
+      // Start behind the car (against its heading) and run past it in its direction.
+      const double s0 = s_car - dir * lead;
+      const double s1 = s_car + dir * rng_.uniform(8.0, 20.0);
+      const double t_arrive = depart - rng_.uniform(0.0, 3.0);
+      const double t0 = std::max(1.0, t_arrive - lead / speed);
+      Trajectory pt = walkRing(block.sidewalk, s0, s1, speed, t0);
+      Entity p;
+      p.id = nextPedId();
+      p.cls = EntityClass::kPedestrian;
+      p.attributes.set("clothing_color", catalog::pick(rng_, catalog::clothingColors()));
+      p.attributes.set("activity", std::string("running"));
+      p.box = boxFromPose(Vec3(pt[0].x, pt[0].y, 0.0), pt[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.6, 1.9))));
+      p.block = -1;
+      vignette.members.push_back(p.id);
+      add(p, "vignette", pt);
+    }
+    vignette.members.push_back(target.id);
+    extra_groups_.push_back(vignette);
+
+    // AOI around where the car waits, valid until it departs.
+    const double len = rangeDraw(rng_, cfg_.aoi_length), wid = rangeDraw(rng_, cfg_.aoi_width);
+    AreaOfInterest aoi = makeAoi("aoi_1", target.box.center2(), rng_.uniform(-0.3, 0.3), len, wid, nullptr);
+    aoi.window.nlt = depart;
+    m.aois.push_back(aoi);
+    const Vec2 tp = target.box.center2();
+    m.priors.push_back(makePrior(aoi, &tp));
+    add(target, "target", traj);
+
+    // Pedestrian subjects at the moment they are nearest the car, for EVENTUALLY_NEXT_TO.
+    movingTargetRelations(target, traj, {});
+    // The runners reach the car: EVENTUALLY_NEXT_TO with the first runner, at the first
+    // grid time they are next to it.
+    for (const auto& se : sc_.sim.entities) {
+      if (se.role != "vignette") continue;
+      const double dt = cfg_.relations.eventually_dt;
+      for (int k = 1; k * dt <= depart + 10.0; ++k) {
+        const double t = k * dt;
+        Subject ts = subjectOf(target);
+        ts.box = poseBox(target.box, sampleTrajectory(traj, t));
+        Subject ps = subjectOf(se.entity);
+        ps.box = poseBox(se.entity.box, sampleTrajectory(se.trajectory, t));
+        const RelationFacts f = eval_.measure(ts, ps);
+        if (eval_.holds(RelationOp::kNextTo, f, EntityClass::kPedestrian)) {
+          SceneRelation r;
+          r.related_id = se.entity.id;
+          r.related_class = "pedestrian";
+          r.related_attributes = se.entity.attributes;
+          r.op = RelationOp::kNextTo;
+          r.eventually = true;
+          r.target_id = target.id;
+          r.distance = f.distance;
+          r.bearing_deg = f.bearing_deg;
+          r.dz = f.dz;
+          r.line_of_sight = f.line_of_sight;
+          r.time = t;
+          m.relations.push_back(r);
+          break;
+        }
+      }
+      break;
+    }
+    std::vector<const AreaOfInterest*> aois{&m.aois.front()};
+    std::vector<SceneRelation> rels;
+    for (const auto& r : m.relations) rels.push_back(r);
+    addConfusers(target, rels, aois, nullptr, 60.0);
+  }
+
+  // ------------------------------------------------------------------ everything else
+  void drawUav() {
+    uav_.altitude_min = std::round(rangeDraw(rng_, cfg_.uav_altitude_min));
+    uav_.altitude_max = std::round(std::max(uav_.altitude_min + 15.0, rangeDraw(rng_, cfg_.uav_altitude_max)));
+    uav_.max_speed = cfg_.uav_max_speed;
+    CameraSpec front;
+    front.name = "front";
+    front.mount_xyz = Vec3(0.12, 0.0, -0.03);
+    front.mount_rpy = Vec3(0.0, roundMilli(rangeDraw(rng_, cfg_.front_pitch)), 0.0);
+    front.width = cfg_.camera_width;
+    front.height = cfg_.camera_height;
+    front.hfov_deg = roundMilli(rangeDraw(rng_, cfg_.front_hfov));
+    front.rate_hz = cfg_.camera_rate_hz;
+    front.modalities = {"rgb", "depth", "segmentation", "instances"};
+    CameraSpec down = front;
+    down.name = "down";
+    down.mount_xyz = Vec3(0.0, 0.0, -0.06);
+    down.mount_rpy = Vec3(0.0, 90.0, 0.0);
+    down.hfov_deg = roundMilli(rangeDraw(rng_, cfg_.down_hfov));
+    uav_.cameras = {front, down};
+  }
+
+  // The UAV starts on the ground at an intersection away from the targets and outside every
+  // keep-out zone.
+  void placeUavStart() {
+    Vec2 first_target(0, 0);
+    for (const auto& se : sc_.sim.entities) {
+      if (se.role == "target") {
+        first_target = se.entity.box.center2();
+        break;
+      }
+    }
+    for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
+      const Vec2 p = world_.nodes()[static_cast<std::size_t>(randomNode())].position;
+      const double d = (p - first_target).norm();
+      if (d < 120.0 || d > 600.0) continue;
+      bool in_koz = false;
+      for (const auto& k : sc_.mission.kozs) in_koz = in_koz || k.polygon.distance(p) < 5.0;
+      if (in_koz) continue;
+      uav_.start = {0.0, p.x(), p.y(), 0.0, roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
+      sc_.sim.uav = uav_;
+      return;
+    }
+    throw GenerationError("no UAV start position outside the keep-out zones");
+  }
+
+  // Ambient traffic (cars driving a few blocks, then stopping) and strolling pedestrians.
+  void addTraffic() {
+    const int cars = static_cast<int>(rng_.uniformInt(cfg_.traffic_count_min, cfg_.traffic_count_max));
+    for (int i = 0; i < cars; ++i) {
+      std::vector<int> nodes = randomWalk(randomNode(), static_cast<int>(rng_.uniformInt(2, 5)));
+      if (nodes.size() < 2) continue;
+      DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
+      const std::vector<Vec2> path = nodePositions(nodes);
+      spec.start_offset = rng_.uniform(0.0, 0.5) * (path[1] - path[0]).norm();
+      spec.depart_delay = rng_.uniform(0.0, 20.0);
+      Trajectory traj = planDrive(path, spec);
+      const auto& model = catalog::pickModel(rng_);
+      Entity e = makeCar(model, catalog::pick(rng_, catalog::carColors()), Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
+      add(std::move(e), "traffic", std::move(traj));
+    }
+    const int peds = static_cast<int>(rng_.uniformInt(cfg_.pedestrian_count_min, cfg_.pedestrian_count_max));
+    for (int i = 0; i < peds; ++i) {
+      const Block& b = world_.blocks()[static_cast<std::size_t>(rng_.uniformInt(0, static_cast<long>(world_.blocks().size()) - 1))];
+      const double ring = geometry::polylineLength(b.sidewalk);
+      const double s0 = rng_.uniform(0.0, ring);
+      const double dist = rng_.uniform(60.0, 300.0) * (rng_.bernoulli(0.5) ? 1.0 : -1.0);
+      Trajectory traj = walkRing(b.sidewalk, s0, s0 + dist, rangeDraw(rng_, cfg_.pedestrian_speed), rng_.uniform(0.0, 30.0));
+      Entity p;
+      p.id = nextPedId();
+      p.cls = EntityClass::kPedestrian;
+      p.attributes.set("clothing_color", catalog::pick(rng_, catalog::clothingColors()));
+      p.attributes.set("activity", std::string("walking"));
+      p.box = boxFromPose(Vec3(traj[0].x, traj[0].y, 0.0), traj[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.55, 1.9))));
+      add(std::move(p), "pedestrian", std::move(traj));
+    }
+  }
+
+  void drawEnvironment() {
+    Environment& env = sc_.sim.environment;
+    env.time_of_day = roundMilli(rangeDraw(rng_, cfg_.time_of_day));
+    const double wp = cfg_.weather_probability;
+    if (rng_.bernoulli(wp)) {
+      (rng_.bernoulli(0.5) ? env.snow : env.rain) = roundMilli(rng_.uniform(0.05, 1.0));
+    }
+    if (rng_.bernoulli(wp * 0.5)) env.dust = roundMilli(rng_.uniform(0.05, 1.0));
+    if (rng_.bernoulli(wp)) env.fog = roundMilli(rng_.uniform(0.05, 1.0));
+    env.foliage = roundMilli(rangeDraw(rng_, cfg_.foliage));
+    const double ws = rangeDraw(rng_, cfg_.wind_speed), wd = rng_.uniform(0, 2 * geometry::kPi);
+    env.wind_mean = Vec3(roundMilli(ws * std::cos(wd)), roundMilli(ws * std::sin(wd)), 0.0);
+    env.gust_intensity = roundMilli(rangeDraw(rng_, cfg_.gust_intensity));
+    Perturbations& p = sc_.sim.perturbations;
+    p.gaussian_noise_std = roundMilli(rangeDraw(rng_, cfg_.noise_std) * 1000.0) / 1000.0;
+    p.salt_pepper_probability = std::round(rangeDraw(rng_, cfg_.salt_pepper) * 1e5) / 1e5;
+    p.motion_blur_px = roundMilli(rangeDraw(rng_, cfg_.motion_blur_px));
+  }
+
+  void finishGroups() { sc_.sim.groups = currentGroups(); }
+
+  const World& world_;
+  const GeneratorConfig& cfg_;
+  ScenarioClass cls_;
+  std::uint64_t seed_;
+  Rng rng_;
+  RelationEvaluator eval_;
+  Scenario sc_;
+  UavSpec uav_;
+  std::vector<char> slot_taken_;
+  std::vector<int> car_ids_, ped_ids_;
+  std::vector<Group> extra_groups_;
+};
+
+}  // namespace
+
+Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
+                          std::uint64_t seed) {
+  try {
+    return ScenarioBuilder(world, config, cls, seed).build();
+  } catch (const GenerationError& e) {
+    throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " + e.what());
+  }
+}
+
+}  // namespace hameritt::scenario

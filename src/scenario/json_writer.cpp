@@ -1,0 +1,152 @@
+#include "hameritt/scenario/json_writer.h"
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace hameritt::scenario {
+
+void JsonWriter::newline() {
+  if (!pretty_ || inline_depth_ > 0) return;
+  out_ += '\n';
+  out_.append(2 * has_items_.size(), ' ');
+}
+
+void JsonWriter::separate() {
+  if (after_key_) {
+    after_key_ = false;
+    return;
+  }
+  if (!has_items_.empty()) {
+    if (has_items_.back()) {
+      out_ += ',';
+      if (inline_depth_ > 0 && pretty_) out_ += ' ';
+    }
+    has_items_.back() = true;
+    newline();
+  }
+}
+
+JsonWriter& JsonWriter::beginObject() {
+  separate();
+  out_ += '{';
+  has_items_.push_back(false);
+  return *this;
+}
+
+JsonWriter& JsonWriter::endObject() {
+  const bool had = has_items_.back();
+  has_items_.pop_back();
+  if (had) newline();
+  out_ += '}';
+  return *this;
+}
+
+JsonWriter& JsonWriter::beginArray() {
+  separate();
+  out_ += '[';
+  has_items_.push_back(false);
+  return *this;
+}
+
+JsonWriter& JsonWriter::endArray() {
+  const bool had = has_items_.back();
+  has_items_.pop_back();
+  if (had) newline();
+  out_ += ']';
+  return *this;
+}
+
+JsonWriter& JsonWriter::key(std::string_view k) {
+  separate();
+  escape(k);
+  out_ += pretty_ ? ": " : ":";
+  after_key_ = true;
+  return *this;
+}
+
+void JsonWriter::escape(std::string_view s) {
+  out_ += '"';
+  for (char c : s) {
+    switch (c) {
+      case '"':
+        out_ += "\\\"";
+        break;
+      case '\\':
+        out_ += "\\\\";
+        break;
+      case '\n':
+        out_ += "\\n";
+        break;
+      case '\t':
+        out_ += "\\t";
+        break;
+      case '\r':
+        out_ += "\\r";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof(buf), "\\u%04x", c);
+          out_ += buf;
+        } else {
+          out_ += c;
+        }
+    }
+  }
+  out_ += '"';
+}
+
+JsonWriter& JsonWriter::value(std::string_view s) {
+  separate();
+  escape(s);
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(double d) {
+  if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
+  separate();
+  if (d == 0.0) d = 0.0;  // no "-0"
+  char buf[32];
+  // An integral value keeps a ".0"-free integer form only through to_chars' shortest output,
+  // e.g. 12 -> "12"; readers treat it as a number either way.
+  const auto res = std::to_chars(buf, buf + sizeof(buf), d);
+  out_.append(buf, res.ptr);
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(std::int64_t i) {
+  separate();
+  out_ += std::to_string(i);
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(std::uint64_t u) {
+  separate();
+  out_ += std::to_string(u);
+  return *this;
+}
+
+JsonWriter& JsonWriter::value(bool b) {
+  separate();
+  out_ += b ? "true" : "false";
+  return *this;
+}
+
+JsonWriter& JsonWriter::null() {
+  separate();
+  out_ += "null";
+  return *this;
+}
+
+JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
+  beginArray();
+  ++inline_depth_;
+  for (double d : v) value(d);
+  --inline_depth_;
+  has_items_.pop_back();
+  out_ += ']';
+  return *this;
+}
+
+}  // namespace hameritt::scenario

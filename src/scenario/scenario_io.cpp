@@ -1,0 +1,395 @@
+#include "hameritt/scenario/scenario_io.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/json_writer.h"
+#include "hameritt/scenario/params_table.h"
+
+namespace hameritt::scenario {
+
+namespace fs = std::filesystem;
+using geometry::Polygon;
+using geometry::Vec2;
+
+std::string hex64(std::uint64_t v) {
+  char buf[24];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+namespace {
+
+void writePoints(JsonWriter& w, const std::vector<Vec2>& pts) {
+  w.beginArray();
+  for (const auto& p : pts) w.numbers({p.x(), p.y()});
+  w.endArray();
+}
+
+void writePolygon(JsonWriter& w, const Polygon& p) { writePoints(w, p.vertices()); }
+
+void writeWindow(JsonWriter& w, const geometry::TimeWindow& tw) {
+  w.key("time_window").beginObject();
+  if (tw.net) w.key("net").value(*tw.net);
+  if (tw.nlt) w.key("nlt").value(*tw.nlt);
+  w.endObject();
+}
+
+void writeAttributes(JsonWriter& w, const Attributes& a) {
+  w.beginObject();
+  for (const auto& [k, v] : a.items) {
+    w.key(k);
+    if (const auto* s = std::get_if<std::string>(&v)) w.value(*s);
+    else w.value(std::get<std::int64_t>(v));
+  }
+  w.endObject();
+}
+
+void writePose(JsonWriter& w, const Entity& e) {
+  const auto p = e.position();
+  w.key("pose").beginObject();
+  w.key("x").value(p.x()).key("y").value(p.y()).key("z").value(p.z()).key("yaw").value(e.yaw());
+  w.endObject();
+  w.key("size").numbers({e.box.size.x(), e.box.size.y(), e.box.size.z()});
+}
+
+void writeHeader(JsonWriter& w, const char* kind, const std::string& id, ScenarioClass cls,
+                 std::uint64_t seed) {
+  w.key("schema").value(kind);
+  w.key("schema_version").value(kSchemaVersion);
+  w.key("scenario_id").value(id);
+  w.key("class").value(toString(cls));
+  w.key("seed").value(seed);
+}
+
+}  // namespace
+
+std::string relationText(const SceneRelation& r) {
+  std::string s = "[" + r.related_class + "] [" + toString(r.op, r.eventually) + "] [" + r.target_id + "]";
+  if (!r.related_attributes.items.empty()) {
+    s += " [";
+    bool first = true;
+    for (const auto& [k, v] : r.related_attributes.items) {
+      if (!first) s += ", ";
+      first = false;
+      s += k + ": ";
+      if (const auto* str = std::get_if<std::string>(&v)) s += *str;
+      else s += std::to_string(std::get<std::int64_t>(v));
+    }
+    s += "]";
+  }
+  return s;
+}
+
+std::string missionJson(const Mission& m) {
+  JsonWriter w;
+  w.beginObject();
+  writeHeader(w, "hameritt/mission", m.scenario_id, m.cls, m.seed);
+  w.key("frame").beginObject();
+  w.key("type").value("ENU").key("units").value("m");
+  w.key("origin").beginObject();
+  w.key("latitude").value(m.origin.latitude).key("longitude").value(m.origin.longitude);
+  w.key("altitude").value(m.origin.altitude);
+  w.endObject().endObject();
+  w.key("time_limit").value(m.time_limit);
+
+  w.key("objective").beginObject();
+  w.key("type").value(m.objective.type).key("text").value(m.objective.text);
+  w.key("targets").beginArray();
+  for (const auto& t : m.objective.targets) {
+    w.beginObject();
+    w.key("id").value(t.id).key("class").value(t.cls).key("vehicle_class").value(t.vehicle_class);
+    w.key("make").value(t.make).key("model").value(t.model).key("color").value(t.color);
+    w.endObject();
+  }
+  w.endArray().endObject();
+
+  w.key("areas_of_interest").beginArray();
+  for (const auto& a : m.aois) {
+    w.beginObject();
+    w.key("id").value(a.id);
+    w.key("polygon");
+    writePolygon(w, a.polygon);
+    writeWindow(w, a.window);
+    w.endObject();
+  }
+  w.endArray();
+
+  w.key("keep_out_zones").beginArray();
+  for (const auto& k : m.kozs) {
+    w.beginObject();
+    w.key("id").value(k.id).key("purpose").value(k.purpose);
+    w.key("polygon");
+    writePolygon(w, k.polygon);
+    w.key("altitude").beginObject();
+    if (k.alt_min) w.key("min").value(*k.alt_min);
+    if (k.alt_max) w.key("max").value(*k.alt_max);
+    w.endObject();
+    writeWindow(w, k.window);
+    w.endObject();
+  }
+  w.endArray();
+
+  w.key("area_priors").beginArray();
+  for (const auto& p : m.priors) {
+    w.beginObject();
+    w.key("aoi_id").value(p.aoi_id).key("depth").value(p.depth);
+    w.key("cells").beginArray();
+    for (const auto& c : p.cells) {
+      w.beginObject();
+      w.key("id").value(c.id).key("row").value(c.row).key("col").value(c.col);
+      w.key("polygon");
+      writePolygon(w, c.polygon);
+      w.key("probability").value(c.probability);
+      w.endObject();
+    }
+    w.endArray().endObject();
+  }
+  w.endArray();
+
+  w.key("routes").beginArray();
+  for (const auto& r : m.routes) {
+    w.beginObject();
+    w.key("id").value(r.id);
+    w.key("polyline");
+    writePoints(w, r.polyline);
+    w.key("streets").beginArray();
+    for (const auto& s : r.streets) w.value(s);
+    w.endArray();
+    w.key("band_width").value(r.band_width);
+    w.key("band_polygon");
+    writePolygon(w, r.band);
+    w.endObject();
+  }
+  w.endArray();
+
+  w.key("scene_relations").beginArray();
+  for (const auto& r : m.relations) {
+    w.beginObject();
+    w.key("related").beginObject();
+    w.key("id").value(r.related_id).key("class").value(r.related_class);
+    w.key("attributes");
+    writeAttributes(w, r.related_attributes);
+    w.endObject();
+    w.key("operator").value(toString(r.op, r.eventually));
+    w.key("target").value(r.target_id);
+    w.key("evidence").beginObject();
+    if (r.op != RelationOp::kPartOf) {
+      w.key("distance").value(roundMilli(r.distance));
+      w.key("bearing_deg").value(roundMilli(r.bearing_deg));
+      w.key("dz").value(roundMilli(r.dz));
+      w.key("line_of_sight").value(r.line_of_sight);
+    }
+    if (r.time) w.key("time").value(*r.time);
+    w.endObject();
+    w.key("text").value(relationText(r));
+    w.endObject();
+  }
+  w.endArray();
+  w.endObject();
+  return w.str();
+}
+
+std::string simConfigJson(const SimConfig& s) {
+  JsonWriter w;
+  w.beginObject();
+  writeHeader(w, "hameritt/sim_config", s.scenario_id, s.cls, s.seed);
+  w.key("duration").value(s.duration);
+  w.key("world").beginObject();
+  w.key("generator").value("hameritt_suburb");
+  w.key("fingerprint").value(hex64(s.world_fingerprint));
+  w.key("params");
+  writeWorldParams(w, s.world);
+  w.endObject();
+
+  w.key("entities").beginArray();
+  for (const auto& se : s.entities) {
+    const Entity& e = se.entity;
+    w.beginObject();
+    w.key("id").value(e.id).key("class").value(toString(e.cls)).key("role").value(se.role);
+    w.key("attributes");
+    writeAttributes(w, e.attributes);
+    writePose(w, e);
+    w.key("trajectory").beginArray();
+    for (const auto& p : se.trajectory) w.numbers({p.t, p.x, p.y, p.z, p.yaw});
+    w.endArray();
+    w.endObject();
+  }
+  w.endArray();
+
+  w.key("groups").beginArray();
+  for (const auto& g : s.groups) {
+    w.beginObject();
+    w.key("id").value(g.id).key("kind").value(g.kind);
+    w.key("members").beginArray();
+    for (const auto& m : g.members) w.value(m);
+    w.endArray().endObject();
+  }
+  w.endArray();
+
+  const Environment& env = s.environment;
+  w.key("environment").beginObject();
+  w.key("time_of_day").value(env.time_of_day);
+  w.key("snow").value(env.snow).key("rain").value(env.rain).key("dust").value(env.dust);
+  w.key("fog").value(env.fog).key("foliage").value(env.foliage);
+  w.key("wind").beginObject();
+  w.key("mean").numbers({env.wind_mean.x(), env.wind_mean.y(), env.wind_mean.z()});
+  w.key("gust_intensity").value(env.gust_intensity);
+  w.endObject().endObject();
+
+  const UavSpec& u = s.uav;
+  w.key("uav").beginObject();
+  w.key("model").value(u.model);
+  w.key("start").beginObject();
+  w.key("x").value(u.start.x).key("y").value(u.start.y).key("z").value(u.start.z);
+  w.key("yaw").value(u.start.yaw);
+  w.endObject();
+  w.key("altitude").beginObject().key("min").value(u.altitude_min).key("max").value(u.altitude_max).endObject();
+  w.key("max_speed").value(u.max_speed);
+  w.key("payload").beginObject().key("cameras").beginArray();
+  for (const auto& c : u.cameras) {
+    w.beginObject();
+    w.key("name").value(c.name);
+    w.key("mount").beginObject();
+    w.key("xyz").numbers({c.mount_xyz.x(), c.mount_xyz.y(), c.mount_xyz.z()});
+    w.key("rpy_deg").numbers({c.mount_rpy.x(), c.mount_rpy.y(), c.mount_rpy.z()});
+    w.endObject();
+    w.key("width").value(c.width).key("height").value(c.height);
+    w.key("hfov_deg").value(c.hfov_deg).key("rate_hz").value(c.rate_hz);
+    w.key("modalities").beginArray();
+    for (const auto& m : c.modalities) w.value(m);
+    w.endArray().endObject();
+  }
+  w.endArray().endObject().endObject();
+
+  w.key("perturbations").beginObject().key("camera_noise").beginObject();
+  w.key("gaussian_std").value(s.perturbations.gaussian_noise_std);
+  w.key("salt_pepper_probability").value(s.perturbations.salt_pepper_probability);
+  w.key("motion_blur_px").value(s.perturbations.motion_blur_px);
+  w.endObject().endObject();
+  w.endObject();
+  return w.str();
+}
+
+std::string worldParamsJson(const WorldParams& p) {
+  JsonWriter w;
+  writeWorldParams(w, p);
+  return w.str();
+}
+
+std::string worldJson(const World& world) {
+  JsonWriter w;
+  w.beginObject();
+  w.key("schema").value("hameritt/world");
+  w.key("schema_version").value(kSchemaVersion);
+  w.key("fingerprint").value(hex64(world.fingerprint()));
+  w.key("params");
+  writeWorldParams(w, world.params());
+  const auto b = world.bounds();
+  w.key("bounds").beginObject();
+  w.key("min").numbers({b.min.x(), b.min.y()}).key("max").numbers({b.max.x(), b.max.y()});
+  w.endObject();
+  w.key("streets").beginObject().key("nodes").beginArray();
+  for (const auto& n : world.nodes()) w.numbers({n.position.x(), n.position.y()});
+  w.endArray().key("edges").beginArray();
+  for (const auto& e : world.edges()) {
+    w.beginObject();
+    w.key("a").value(e.a).key("b").value(e.b).key("width").value(e.width).key("name").value(e.name);
+    w.key("entity").value(world.entities()[static_cast<std::size_t>(e.entity)].id);
+    w.endObject();
+  }
+  w.endArray().endObject();
+  w.key("blocks").beginArray();
+  for (const auto& bl : world.blocks()) {
+    w.beginObject();
+    w.key("name").value(bl.name);
+    w.key("outline");
+    writePolygon(w, bl.outline);
+    w.key("sidewalk");
+    writePoints(w, bl.sidewalk);
+    w.endObject();
+  }
+  w.endArray();
+  w.key("parking_slots").beginArray();
+  for (const auto& s : world.slots()) {
+    w.beginObject();
+    w.key("position").numbers({s.position.x(), s.position.y(), s.ground_z});
+    w.key("yaw").value(s.yaw).key("driveway").value(s.driveway);
+    if (s.occupant >= 0) w.key("occupant").value(world.entities()[static_cast<std::size_t>(s.occupant)].id);
+    w.endObject();
+  }
+  w.endArray();
+  w.key("entities").beginArray();
+  for (const auto& e : world.entities()) {
+    w.beginObject();
+    w.key("id").value(e.id).key("class").value(toString(e.cls));
+    w.key("attributes");
+    writeAttributes(w, e.attributes);
+    writePose(w, e);
+    w.key("block").value(e.block);
+    w.endObject();
+  }
+  w.endArray();
+  w.endObject();
+  return w.str();
+}
+
+void writeFileAtomic(const std::string& path, const std::string& content) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw OutputError(path + ": cannot write: " + std::strerror(errno));
+  const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw OutputError(path + ": write failed: " + std::strerror(err));
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    std::remove(tmp.c_str());
+    throw OutputError(path + ": cannot rename into place: " + std::strerror(err));
+  }
+}
+
+std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
+  const std::string final_dir = dir + "/" + s.mission.scenario_id;
+  const std::string tmp = dir + "/.tmp-" + s.mission.scenario_id + "-" + std::to_string(::getpid());
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  if (::mkdir(tmp.c_str(), 0755) != 0) {
+    throw OutputError(tmp + ": cannot create directory: " + std::strerror(errno));
+  }
+  try {
+    auto put = [&](const char* name, const std::string& content) {
+      const std::string p = tmp + "/" + name;
+      FILE* f = std::fopen(p.c_str(), "wb");
+      if (!f) throw OutputError(p + ": cannot write: " + std::strerror(errno));
+      const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+      if (std::fclose(f) != 0 || !ok) throw OutputError(p + ": write failed: " + std::strerror(errno));
+    };
+    put("mission.json", missionJson(s.mission));
+    put("sim_config.json", simConfigJson(s.sim));
+    if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) {
+      // An older scenario of the same id: move it aside, then replace it.
+      const std::string old = final_dir + ".old-" + std::to_string(::getpid());
+      if (std::rename(final_dir.c_str(), old.c_str()) != 0 ||
+          std::rename(tmp.c_str(), final_dir.c_str()) != 0) {
+        throw OutputError(final_dir + ": cannot move scenario into place: " + std::strerror(errno));
+      }
+      fs::remove_all(old, ec);
+    }
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  return final_dir;
+}
+
+}  // namespace hameritt::scenario
