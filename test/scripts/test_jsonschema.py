@@ -1,0 +1,229 @@
+#!/usr/bin/python3
+"""Outside-judge check of the scenario JSON schemas with python3-jsonschema (Draft 7).
+
+Runs $HAMERITT_BIN_DIR/hameritt_generate for a batch of every class, then checks that
+  * every schema in $HAMERITT_SOURCE_DIR/config/schema is itself a valid draft-07 schema,
+  * every mission.json, sim_config.json, world.json and manifest.json of the batch validates,
+  * hand-broken documents are rejected at the expected place,
+  * $HAMERITT_BIN_DIR/hameritt_validate accepts the batch and rejects a bow-tie AOI polygon
+    (a rule beyond the schema) with a "FILE: PATH: RULE: MESSAGE" line.
+Prints one line per failure and a "N passed, N failed" summary; exits 1 on any failure.
+"""
+
+import copy
+import glob
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+try:
+    from jsonschema import Draft7Validator
+except ImportError:  # Debian: apt-get install python3-jsonschema
+    print("test_jsonschema: python3-jsonschema is not installed", file=sys.stderr)
+    sys.exit(1)
+
+KINDS = ("mission", "sim_config", "world", "manifest")
+
+passed = 0
+failed = 0
+
+
+def ok(name):
+    global passed
+    passed += 1
+
+
+def fail(name, why):
+    global failed
+    failed += 1
+    print("FAIL %s: %s" % (name, why))
+
+
+def env_dir(var):
+    value = os.environ.get(var)
+    if not value or not os.path.isdir(value):
+        print("test_jsonschema: $%s must name a directory (got %r)" % (var, value), file=sys.stderr)
+        sys.exit(1)
+    return value
+
+
+def load_validators(schema_dir):
+    validators = {}
+    for kind in KINDS:
+        name = "%s.schema.json" % kind
+        path = os.path.join(schema_dir, name)
+        try:
+            with open(path) as f:
+                schema = json.load(f)
+            Draft7Validator.check_schema(schema)
+        except Exception as e:  # missing file, malformed JSON or an invalid schema
+            fail("schema " + name, e)
+            continue
+        if schema.get("properties", {}).get("schema", {}).get("const") != "hameritt/" + kind:
+            fail("schema " + name, 'properties.schema.const is not "hameritt/%s"' % kind)
+            continue
+        ok("schema " + name)
+        validators["hameritt/" + kind] = Draft7Validator(schema)
+    return validators
+
+
+def errors_of(validators, doc):
+    """Error messages of doc against the schema its "schema" field names."""
+    v = validators.get(doc.get("schema")) if isinstance(doc, dict) else None
+    if v is None:
+        kind = doc.get("schema") if isinstance(doc, dict) else doc
+        return ["no schema for document kind %r" % (kind,)]
+    return ["/%s: %s" % ("/".join(str(p) for p in e.absolute_path), e.message)
+            for e in v.iter_errors(doc)]
+
+
+def expect_rejected(validators, name, doc, where):
+    """doc must fail, with an error located at JSON path `where` (a list of keys/indices)."""
+    v = validators.get(doc["schema"])
+    if v is None:
+        fail(name, "no validator for %s" % doc["schema"])
+        return
+    errs = list(v.iter_errors(doc))
+    if not errs:
+        fail(name, "broken document was accepted")
+    elif not any(list(e.absolute_path) == where for e in errs):
+        fail(name, "rejected, but not at /%s: %s" % ("/".join(map(str, where)),
+                                                      [e.message for e in errs]))
+    else:
+        ok(name)
+
+
+def main():
+    bin_dir = env_dir("HAMERITT_BIN_DIR")
+    source_dir = env_dir("HAMERITT_SOURCE_DIR")
+    schema_dir = os.path.join(source_dir, "config", "schema")
+    generate = os.path.join(bin_dir, "hameritt_generate")
+
+    validators = load_validators(schema_dir)
+    if len(validators) != len(KINDS):
+        print("%d passed, %d failed" % (passed, failed))
+        return 1
+
+    out = tempfile.mkdtemp(prefix="hameritt_jsonschema_")
+    try:
+        cmd = [generate, "--class", "all", "--count", "60", "--seed", "7", "--out", out, "--quiet"]
+        run = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             universal_newlines=True, timeout=540)
+        if run.returncode != 0:
+            fail("hameritt_generate", "exit %d: %s" % (run.returncode, run.stderr.strip()))
+            print("%d passed, %d failed" % (passed, failed))
+            return 1
+        ok("hameritt_generate")
+
+        files = sorted(glob.glob(os.path.join(out, "*", "mission.json")) +
+                       glob.glob(os.path.join(out, "*", "sim_config.json")))
+        files += [os.path.join(out, "world.json"), os.path.join(out, "manifest.json")]
+        counts = {}
+        docs = {}
+        for path in files:
+            rel = os.path.relpath(path, out)
+            try:
+                with open(path) as f:
+                    doc = json.load(f)
+            except Exception as e:
+                fail(rel, "cannot read JSON: %s" % e)
+                continue
+            errs = errors_of(validators, doc)
+            if errs:
+                more = " (+%d more)" % (len(errs) - 5) if len(errs) > 5 else ""
+                fail(rel, "; ".join(errs[:5]) + more)
+            else:
+                ok(rel)
+            counts[doc.get("schema")] = counts.get(doc.get("schema"), 0) + 1
+            docs.setdefault(doc.get("schema"), doc)
+        for kind, want in (("hameritt/mission", 60), ("hameritt/sim_config", 60),
+                           ("hameritt/world", 1), ("hameritt/manifest", 1)):
+            if counts.get(kind, 0) != want:
+                fail("batch", "expected %d %s documents, found %d"
+                     % (want, kind, counts.get(kind, 0)))
+            else:
+                ok("batch " + kind)
+
+        # Hand-broken documents, each derived from a valid one.
+        mission = docs.get("hameritt/mission")
+        sim = docs.get("hameritt/sim_config")
+        if mission is None or sim is None:
+            fail("broken documents", "no valid mission/sim_config to derive them from")
+        else:
+            m = copy.deepcopy(mission)
+            m["frame"]["origin"]["datum"] = "WGS84"
+            expect_rejected(validators, "unknown key", m, ["frame", "origin"])
+
+            m = copy.deepcopy(mission)
+            m["scene_relations"] = [{
+                "related": {"id": "group_1", "class": "group", "attributes": {"kind": "block"}},
+                "operator": "EVENTUALLY_PART_OF", "target": m["objective"]["targets"][0]["id"],
+                "evidence": {"time": 3.0}, "text": "x"}]
+            expect_rejected(validators, "EVENTUALLY_PART_OF operator", m,
+                            ["scene_relations", 0, "operator"])
+
+            m = copy.deepcopy(mission)
+            m["keep_out_zones"] = [{"id": "koz_1", "purpose": "restricted",
+                                    "polygon": [[0, 0], [10, 0]], "altitude": {},
+                                    "time_window": {}}]
+            expect_rejected(validators, "two-point polygon", m, ["keep_out_zones", 0, "polygon"])
+
+            s = copy.deepcopy(sim)
+            s["entities"][0]["trajectory"] = [[0, 1, 2, 0]]
+            expect_rejected(validators, "4-number trajectory sample", s,
+                            ["entities", 0, "trajectory", 0])
+
+            s = copy.deepcopy(sim)
+            s["seed"] = -1
+            expect_rejected(validators, "negative seed", s, ["seed"])
+
+            s = copy.deepcopy(sim)
+            del s["world"]["params"]["lot_depth"]
+            expect_rejected(validators, "world params missing a key", s, ["world", "params"])
+
+        # The C++ validator agrees on the batch and also catches what a schema cannot express.
+        validate = os.path.join(bin_dir, "hameritt_validate")
+        run = subprocess.run([validate, "--schema-dir", schema_dir] + files, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+        ok_lines = [l for l in run.stdout.splitlines() if l.endswith(": ok")]
+        if run.returncode != 0 or len(ok_lines) != len(files):
+            fail("hameritt_validate batch", "exit %d, %d of %d ok: %s" % (
+                run.returncode, len(ok_lines), len(files), run.stderr.strip()[:500]))
+        else:
+            ok("hameritt_validate batch")
+        area = [p for p in files if os.path.basename(os.path.dirname(p)).startswith("area_search")
+                and p.endswith("mission.json")]
+        if not area:
+            fail("bow-tie AOI", "the batch has no area_search mission")
+        else:
+            with open(area[0]) as f:
+                m = json.load(f)
+            poly = m["areas_of_interest"][0]["polygon"]
+            poly[1], poly[2] = poly[2], poly[1]  # edges 0-1 and 2-3 now cross
+            broken = os.path.join(out, "bowtie_mission.json")
+            with open(broken, "w") as f:
+                json.dump(m, f)
+            # Schemas cannot express geometry: jsonschema accepts it, hameritt_validate does not.
+            run = subprocess.run([validate, "--schema-dir", schema_dir, broken],
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 universal_newlines=True, timeout=60)
+            want = broken + ": /areas_of_interest/0/polygon: polygon_simple: "
+            if errors_of(validators, m):
+                fail("bow-tie AOI", "jsonschema rejected it: %s" % errors_of(validators, m))
+            elif run.returncode != 2 or not run.stderr.startswith(want):
+                fail("bow-tie AOI", "hameritt_validate exit %d, stderr %r"
+                     % (run.returncode, run.stderr))
+            else:
+                ok("bow-tie AOI")
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+    print("%d passed, %d failed" % (passed, failed))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
