@@ -78,6 +78,9 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
   if (req.count < 1) throw ConfigError("--count: expected a positive number of scenarios, got " + std::to_string(req.count));
   if (req.jobs < 1) throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
   if (req.out_dir.empty()) throw ConfigError("--out: an output directory is required");
+  if (req.exact_seed && req.count != 1) {
+    throw ConfigError("--scenario-seed: generates exactly one scenario; --count must be 1");
+  }
   std::error_code ec;
   fs::create_directories(req.out_dir, ec);
   if (ec || !fs::is_directory(req.out_dir)) {
@@ -103,7 +106,7 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
         ManifestEntry& e = entries[static_cast<std::size_t>(i)];
         e.index = i;
         e.cls = req.classes[static_cast<std::size_t>(i) % req.classes.size()];
-        e.seed = batchSeed(req.seed, static_cast<std::uint64_t>(i));
+        e.seed = req.exact_seed ? req.seed : batchSeed(req.seed, static_cast<std::uint64_t>(i));
         const Scenario s = generateScenario(world, config, e.cls, e.seed);
         e.id = s.mission.scenario_id;
         writeScenarioDir(req.out_dir, s);

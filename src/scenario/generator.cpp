@@ -175,10 +175,11 @@ class ScenarioBuilder {
   }
 
   // ------------------------------------------------------------------ routes and motion
-  // A random walk of `n` street edges from `start` without turning back or reusing a node.
-  std::vector<int> randomWalk(int start, int n) {
+  // A random walk of `n` street edges from `start` without turning back or reusing a node
+  // (nor visiting `avoid`).
+  std::vector<int> randomWalk(int start, int n, int avoid = -1) {
     std::vector<int> nodes{start};
-    std::set<int> seen{start};
+    std::set<int> seen{start, avoid};
     while (static_cast<int>(nodes.size()) <= n) {
       std::vector<int> next;
       for (int ei : world_.adjacency()[static_cast<std::size_t>(nodes.back())]) {
@@ -192,6 +193,13 @@ class ScenarioBuilder {
       seen.insert(pick);
     }
     return nodes;
+  }
+
+  // True for points at least 20 m inside the neighborhood, where an AOI around them fits.
+  bool wellInside(const Vec2& p) const {
+    const auto b = world_.bounds();
+    return p.x() > b.min.x() + 20 && p.x() < b.max.x() - 20 && p.y() > b.min.y() + 20 &&
+           p.y() < b.max.y() - 20;
   }
 
   int randomNode() {
@@ -232,7 +240,10 @@ class ScenarioBuilder {
       a.polygon = roundPolygon(geometry::orientedRectangle(c, len, wid, yaw));
       if (a.polygon.contains(contains) && a.polygon.boundaryDistance(contains) > 5.0) return a;
     }
-    a.polygon = roundPolygon(geometry::orientedRectangle(contains, len, wid, yaw));
+    // Near the edge of the neighborhood: keep the off-centre placement (so the point does not
+    // fall on a prior-cell corner) and let the AOI reach past the edge.
+    const double ox = rng_.uniform(0.1, 0.35) * len, oy = rng_.uniform(0.1, 0.35) * wid;
+    a.polygon = roundPolygon(geometry::orientedRectangle(contains - ox * ax - oy * ay, len, wid, yaw));
     return a;
   }
 
@@ -606,7 +617,7 @@ class ScenarioBuilder {
     const catalog::CarModel* model;
     std::string color;
     drawTargetLook(&model, &color);
-    const int slot = pickSlot([](const ParkingSlot&) { return true; });
+    const int slot = pickSlot([this](const ParkingSlot& s) { return wellInside(s.position); });
     if (slot < 0) throw GenerationError("no free parking slot for the target");
     Entity target = parkCar(slot, *model, color);
     const Vec2 tp = target.box.center2();
@@ -735,7 +746,9 @@ class ScenarioBuilder {
     convoy.id = "convoy_1";
     convoy.kind = "convoy";
     const double speed = rangeDraw(rng_, cfg_.car_speed);
-    const double start_s = rng_.uniform(0.0, 0.3) * (route.polyline[1] - route.polyline[0]).norm();
+    // The lead car starts some way along the first street so that a trailing car, 12 m behind,
+    // still starts well inside the band (not on its end cap).
+    const double start_s = 20.0 + rng_.uniform(0.0, 0.2) * (route.polyline[1] - route.polyline[0]).norm();
     std::vector<Entity> targets;
     std::vector<Trajectory> trajs;
     for (int i = 0; i < n_targets; ++i) {
@@ -743,7 +756,7 @@ class ScenarioBuilder {
       std::string color;
       drawTargetLook(&model, &color);
       DriveSpec spec = driveSpec(speed);
-      spec.start_offset = std::max(0.0, start_s - 12.0 * i);
+      spec.start_offset = start_s - 12.0 * i;
       spec.start_time = 0.0;
       spec.depart_delay = 2.5 * i;
       Trajectory traj = planDrive(route.polyline, spec);
@@ -759,21 +772,31 @@ class ScenarioBuilder {
                        " travelling along route_1.";
     if (n_targets == 2) extra_groups_.push_back(convoy);
 
-    // Access denial: the street the car is on, for exactly the time it is there.
-    for (int i = 0; i < n_targets; ++i) {
-      std::vector<int> edge_choices;
-      for (int k = 1; k + 1 < static_cast<int>(nodes.size()); ++k) edge_choices.push_back(k);
-      if (edge_choices.empty()) edge_choices.push_back(0);
-      const int k = rng_.pick(edge_choices);
-      const Vec2 a = route.polyline[static_cast<std::size_t>(k)], b = route.polyline[static_cast<std::size_t>(k) + 1];
+    // Access denial: a street of the route, closed for exactly the time the target cars are on
+    // it (from the first car's entry to the last car's exit).
+    std::vector<int> edge_choices;
+    for (int k = 1; k + 1 < static_cast<int>(nodes.size()); ++k) edge_choices.push_back(k);
+    if (edge_choices.empty()) edge_choices.push_back(0);
+    rng_.shuffle(edge_choices);
+    const int n_denied = std::min<int>(n_targets, static_cast<int>(edge_choices.size()));
+    std::sort(edge_choices.begin(), edge_choices.begin() + n_denied);
+    for (int d = 0; d < n_denied; ++d) {
+      const auto k = static_cast<std::size_t>(edge_choices[static_cast<std::size_t>(d)]);
+      const Vec2 a = route.polyline[k], b = route.polyline[k + 1];
       const double w = world_.params().street_width;
       const Polygon street = roundPolygon(geometry::orientedRectangle(
           0.5 * (a + b), (b - a).norm() - w, w, std::atan2((b - a).y(), (b - a).x())));
-      const auto interval = insideInterval(trajs[static_cast<std::size_t>(i)], street);
-      if (!interval) continue;
+      std::optional<double> enter, exit;
+      for (const auto& traj : trajs) {
+        const auto interval = insideInterval(traj, street);
+        if (!interval) continue;
+        enter = enter ? std::min(*enter, interval->first) : interval->first;
+        exit = exit ? std::max(*exit, interval->second) : interval->second;
+      }
+      if (!enter) continue;
       KeepOutZone koz = makeKoz(street, "access_denial");
-      koz.window.net = std::floor(interval->first * 1000.0) / 1000.0;
-      koz.window.nlt = std::ceil(interval->second * 1000.0) / 1000.0;
+      koz.window.net = std::floor(*enter * 1000.0) / 1000.0;
+      koz.window.nlt = std::ceil(*exit * 1000.0) / 1000.0;
       koz.alt_min = 0.0;
       koz.alt_max = std::round(uav_.altitude_max + 20.0);
       m.kozs.push_back(koz);
@@ -809,7 +832,7 @@ class ScenarioBuilder {
     std::string color;
     drawTargetLook(&model, &color);
     // The target waits at the kerb, the pedestrians run at it, and it drives off.
-    const int slot = pickSlot([](const ParkingSlot& s) { return s.block >= 0; }, true);
+    const int slot = pickSlot([this](const ParkingSlot& s) { return s.block >= 0 && wellInside(s.position); }, true);
     if (slot < 0) throw GenerationError("no free kerb slot for the pursuit target");
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
     slot_taken_[static_cast<std::size_t>(slot)] = 1;
@@ -820,9 +843,7 @@ class ScenarioBuilder {
     const int first = (pb - pa).dot(fwd) > 0 ? edge.a : edge.b;
     const int second = first == edge.a ? edge.b : edge.a;
     std::vector<int> nodes{first};
-    for (int n : randomWalk(second, static_cast<int>(rng_.uniformInt(6, 12)))) {
-      if (n != first) nodes.push_back(n);
-    }
+    for (int n : randomWalk(second, static_cast<int>(rng_.uniformInt(6, 12)), first)) nodes.push_back(n);
     const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
     DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
     spec.start_time = 0.0;

@@ -1,6 +1,7 @@
 // hameritt_generate: random scenarios as mission.json + sim_config.json, with a manifest.
 //   hameritt_generate --class area_search|route_search|pursuit|all --count N --seed S --out DIR
 //                     [--jobs J] [--world-config FILE] [--generator-config FILE]
+//   hameritt_generate --class CLASS --scenario-seed S --out DIR   (regenerates one scenario)
 // Exit codes: 0 success, 2 bad input or unwritable output, 1 generation failure.
 
 #include <chrono>
@@ -20,7 +21,9 @@ namespace {
 const char* kUsage =
     "usage: hameritt_generate --class CLASS --count N --seed S --out DIR [--jobs J]\n"
     "                         [--world-config FILE] [--generator-config FILE] [--quiet]\n"
-    "  CLASS: area_search, route_search, pursuit, all, or a comma-separated list\n";
+    "       hameritt_generate --class CLASS --scenario-seed S --out DIR   (one scenario, seed S)\n"
+    "  CLASS: area_search, route_search, pursuit, all, or a comma-separated list\n"
+    "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n";
 
 std::uint64_t parseUnsigned(const std::string& flag, const std::string& v) {
   if (v.empty() || v[0] == '-' || v.find_first_not_of("0123456789") != std::string::npos) {
@@ -49,7 +52,7 @@ int main(int argc, char** argv) {
   std::string gen_cfg = defaultConfigDir() + "/generator.json";
   long count = -1;
   std::uint64_t seed = 0;
-  bool have_seed = false, quiet = false;
+  bool have_seed = false, quiet = false, exact = false;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   try {
     for (int i = 1; i < argc; ++i) {
@@ -61,6 +64,7 @@ int main(int argc, char** argv) {
       if (a == "--class") cls = next();
       else if (a == "--count") count = parseCount(a, next());
       else if (a == "--seed") seed = parseUnsigned(a, next()), have_seed = true;
+      else if (a == "--scenario-seed") seed = parseUnsigned(a, next()), have_seed = exact = true;
       else if (a == "--out") out = next();
       else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
       else if (a == "--world-config") world_cfg = next();
@@ -74,8 +78,9 @@ int main(int argc, char** argv) {
       }
     }
     if (cls.empty()) throw ConfigError("--class is required");
+    if (count < 0 && exact) count = 1;
     if (count < 0) throw ConfigError("--count is required");
-    if (!have_seed) throw ConfigError("--seed is required");
+    if (!have_seed) throw ConfigError("--seed (or --scenario-seed) is required");
     if (out.empty()) throw ConfigError("--out is required");
 
     BatchRequest req;
@@ -84,6 +89,7 @@ int main(int argc, char** argv) {
     req.seed = seed;
     req.out_dir = out;
     req.jobs = jobs;
+    req.exact_seed = exact;
     const WorldParams wp = loadWorldParams(world_cfg);
     const GeneratorConfig gc = loadGeneratorConfig(gen_cfg);
     const auto t0 = std::chrono::steady_clock::now();

@@ -17,6 +17,9 @@ struct BatchRequest {
   std::string out_dir;
   int jobs = 1;
   bool write_world = true;  // also write DIR/world.json
+  // Use `seed` itself as the scenario seed (count must be 1): regenerates a scenario from the
+  // class and seed written in its files.
+  bool exact_seed = false;
 };
 
 struct ManifestEntry {
