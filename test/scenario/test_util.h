@@ -1,0 +1,33 @@
+#pragma once
+// Shared fixtures of the scenario tests: the shipped configuration and its world, built once.
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "hameritt/scenario/generator.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::scenario::testing {
+
+inline const GeneratorConfig& shippedConfig() {
+  static const GeneratorConfig c = loadGeneratorConfig(defaultConfigDir() + "/generator.json");
+  return c;
+}
+
+inline const World& shippedWorld() {
+  static const World w = generateWorld(loadWorldParams(defaultConfigDir() + "/world.json"));
+  return w;
+}
+
+// A fresh, empty temporary directory unique to this process and tag.
+inline std::string freshTempDir(const std::string& tag) {
+  const std::string d = std::filesystem::temp_directory_path().string() + "/hameritt_test_" + tag +
+                        "_" + std::to_string(::getpid());
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+}  // namespace hameritt::scenario::testing
