@@ -71,7 +71,9 @@ void writeHeader(JsonWriter& w, const char* kind, const std::string& id, Scenari
 }  // namespace
 
 std::string relationText(const SceneRelation& r) {
-  std::string s = "[" + r.related_class + "] [" + toString(r.op, r.eventually) + "] [" + r.target_id + "]";
+  // Groups are abstract: they are named by id; entities by class, as in the paper.
+  const std::string related = r.op == RelationOp::kPartOf ? r.related_id : r.related_class;
+  std::string s = "[" + related + "] [" + toString(r.op, r.eventually) + "] [" + r.target_id + "]";
   if (!r.related_attributes.items.empty()) {
     s += " [";
     bool first = true;
