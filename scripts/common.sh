@@ -40,9 +40,11 @@ install_deps() {
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# Configures (always with testing on, so that switching between the two commands never
+# reconfigures; test programs are only built by the "tests" target) and builds.
 build() {
   cmake -S "$HAMERITT_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release \
-    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING="${1:-ON}" >/dev/null
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON >/dev/null
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }
 

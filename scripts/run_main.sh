@@ -3,7 +3,7 @@
 # validate it, summarize it, draw its map, and generate a fresh batch of all three classes.
 source "$(dirname "$0")/common.sh"
 install_deps
-build OFF
+build
 source_devel
 
 SCENARIO="${1:-$HAMERITT_ROOT/scenarios/default}"

@@ -3,7 +3,7 @@
 # validators, rostest) through ctest. Ends with "N passed, N failed".
 source "$(dirname "$0")/common.sh"
 install_deps
-build ON
+build
 cmake --build "$BUILD_DIR" --target tests -j "$JOBS"
 source_devel
 

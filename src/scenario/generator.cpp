@@ -321,12 +321,27 @@ class ScenarioBuilder {
     std::stable_partition(all.begin(), all.end(), [](const SceneRelation& r) {
       return r.op == RelationOp::kPartOf || r.op == RelationOp::kOnTopOf;
     });
+    // A relation and its negation about look-alike related entities (same class and
+    // attributes) would read as a contradiction to a client: keep only the first.
+    auto contradicts = [&](const SceneRelation& r) {
+      for (const auto& o : out) {
+        const bool negation = (o.op == RelationOp::kNextTo && r.op == RelationOp::kNotNextTo) ||
+                              (o.op == RelationOp::kNotNextTo && r.op == RelationOp::kNextTo) ||
+                              (o.op == RelationOp::kOnTopOf && r.op == RelationOp::kNotOnTopOf) ||
+                              (o.op == RelationOp::kNotOnTopOf && r.op == RelationOp::kOnTopOf);
+        if (negation && o.related_class == r.related_class &&
+            o.related_attributes == r.related_attributes) {
+          return true;
+        }
+      }
+      return false;
+    };
     for (auto& r : all) {
       if (static_cast<int>(out.size()) >= cfg_.relations.max_relations) break;
       const std::string name = toString(r.op, r.eventually);
       auto it = caps.find(name);
       if (it == caps.end() || it->second <= 0) continue;
-      if (used.count(r.related_id + name)) continue;
+      if (used.count(r.related_id + name) || contradicts(r)) continue;
       --it->second;
       used.insert(r.related_id + name);
       out.push_back(std::move(r));

@@ -107,9 +107,30 @@ JsonWriter& JsonWriter::value(double d) {
   if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   separate();
   if (d == 0.0) d = 0.0;  // no "-0"
-  char buf[32];
-  // An integral value keeps a ".0"-free integer form only through to_chars' shortest output,
-  // e.g. 12 -> "12"; readers treat it as a number either way.
+  char buf[40];
+  // Most values are millimetre-rounded (k / 1000): print k's digits with the decimal point
+  // moved, which is the shortest form that reads back to the same double and much faster
+  // than the general algorithm. Anything else takes std::to_chars' shortest round-trip form.
+  if (std::abs(d) < 1e12) {
+    const long long k = std::llround(d * 1000.0);
+    if (static_cast<double>(k) / 1000.0 == d) {
+      char* p = buf;
+      unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
+      if (k < 0) *p++ = '-';
+      const unsigned long long whole = a / 1000, frac = a % 1000;
+      p = std::to_chars(p, buf + sizeof(buf), whole).ptr;
+      if (frac != 0) {
+        *p++ = '.';
+        char digits[3] = {static_cast<char>('0' + frac / 100), static_cast<char>('0' + frac / 10 % 10),
+                          static_cast<char>('0' + frac % 10)};
+        int n = 3;
+        while (digits[n - 1] == '0') --n;
+        for (int i = 0; i < n; ++i) *p++ = digits[i];
+      }
+      out_.append(buf, p);
+      return *this;
+    }
+  }
   const auto res = std::to_chars(buf, buf + sizeof(buf), d);
   out_.append(buf, res.ptr);
   return *this;

@@ -1,5 +1,6 @@
 #include "hameritt/scenario/scenario_io.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -364,17 +365,30 @@ std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
   const std::string final_dir = dir + "/" + s.mission.scenario_id;
   const std::string tmp = dir + "/.tmp-" + s.mission.scenario_id + "-" + std::to_string(::getpid());
   std::error_code ec;
-  fs::remove_all(tmp, ec);
   if (::mkdir(tmp.c_str(), 0755) != 0) {
-    throw OutputError(tmp + ": cannot create directory: " + std::strerror(errno));
+    // A leftover of an interrupted run with the same pid: clear it once and retry.
+    if (errno == EEXIST) fs::remove_all(tmp, ec);
+    if (errno != EEXIST || ::mkdir(tmp.c_str(), 0755) != 0) {
+      throw OutputError(tmp + ": cannot create directory: " + std::strerror(errno));
+    }
   }
   try {
     auto put = [&](const char* name, const std::string& content) {
       const std::string p = tmp + "/" + name;
-      FILE* f = std::fopen(p.c_str(), "wb");
-      if (!f) throw OutputError(p + ": cannot write: " + std::strerror(errno));
-      const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
-      if (std::fclose(f) != 0 || !ok) throw OutputError(p + ": write failed: " + std::strerror(errno));
+      const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+      if (fd < 0) throw OutputError(p + ": cannot write: " + std::strerror(errno));
+      std::size_t done = 0;
+      while (done < content.size()) {
+        const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+          const int err = errno;
+          ::close(fd);
+          throw OutputError(p + ": write failed: " + std::strerror(err));
+        }
+        done += static_cast<std::size_t>(n);
+      }
+      if (::close(fd) != 0) throw OutputError(p + ": write failed: " + std::strerror(errno));
     };
     put("mission.json", missionJson(s.mission));
     put("sim_config.json", simConfigJson(s.sim));

@@ -95,7 +95,7 @@ Trajectory planDrive(const std::vector<Vec2>& path, const DriveSpec& spec) {
     const Vec3 a = fine.back().p, b = vs[i].p;
     const double len = (b - a).norm();
     if (len < 1e-6) continue;
-    const int pieces = std::max(1, static_cast<int>(std::ceil(len / 8.0)));
+    const int pieces = std::max(1, static_cast<int>(std::ceil(len / 12.0)));
     for (int k = 1; k < pieces; ++k) fine.push_back({a + (b - a) * (double(k) / pieces), spec.cruise_speed});
     fine.push_back(vs[i]);
   }

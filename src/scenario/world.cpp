@@ -139,7 +139,8 @@ class WorldBuilder {
     bounds->min = Vec2(xs_.front(), ys_.front());
     bounds->max = Vec2(xs_.back(), ys_.back());
     // North-south streets are named from kStreetNamesNS, east-west from kStreetNamesEW.
-    auto addEdge = [&](int a, int b, const std::string& name) {
+    auto addEdge = [&](int a, int b, const std::string& name, const std::string& from,
+                       const std::string& to) {
       StreetEdge e;
       e.a = a;
       e.b = b;
@@ -150,19 +151,27 @@ class WorldBuilder {
       const Vec2 d = pb - pa;
       Attributes attrs;
       attrs.set("name", name);
+      attrs.set("between", from + " and " + to);
       // Street surface: a slab whose top is the ground plane z = 0.
       e.entity = addEntity(EntityClass::kStreet, "street", Vec3(mid.x(), mid.y(), -0.1),
                            std::atan2(d.y(), d.x()), Vec3(d.norm() + p_.street_width, p_.street_width, 0.1),
                            attrs, -1);
       edges->push_back(e);
     };
+    // Each segment is also named by the cross streets at its ends.
     for (int j = 0; j < ny_; ++j) {
       const std::string name = catalog::streetName(false, j);
-      for (int i = 0; i + 1 < nx_; ++i) addEdge(j * nx_ + i, j * nx_ + i + 1, name);
+      for (int i = 0; i + 1 < nx_; ++i) {
+        addEdge(j * nx_ + i, j * nx_ + i + 1, name, catalog::streetName(true, i),
+                catalog::streetName(true, i + 1));
+      }
     }
     for (int i = 0; i < nx_; ++i) {
       const std::string name = catalog::streetName(true, i);
-      for (int j = 0; j + 1 < ny_; ++j) addEdge(j * nx_ + i, (j + 1) * nx_ + i, name);
+      for (int j = 0; j + 1 < ny_; ++j) {
+        addEdge(j * nx_ + i, (j + 1) * nx_ + i, name, catalog::streetName(false, j),
+                catalog::streetName(false, j + 1));
+      }
     }
   }
 

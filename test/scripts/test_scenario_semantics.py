@@ -479,7 +479,9 @@ def split_op(op):
 
 
 def relation_text(r):
-    s = "[%s] [%s] [%s]" % (r["related"]["class"], r["operator"], r["target"])
+    # Entities are named by class (as in the paper), abstract groups by their id.
+    related = r["related"]["id"] if r["operator"] == "PART_OF" else r["related"]["class"]
+    s = "[%s] [%s] [%s]" % (related, r["operator"], r["target"])
     attrs = r["related"].get("attributes", {})
     if attrs:
         s += " [" + ", ".join("%s: %s" % (k, v) for k, v in attrs.items()) + "]"

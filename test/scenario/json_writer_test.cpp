@@ -1,0 +1,59 @@
+// The streaming JSON writer: valid JSON, and numbers that read back to the same double.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "hameritt/scenario/entity.h"
+#include "hameritt/scenario/json_writer.h"
+
+using hameritt::scenario::JsonWriter;
+using hameritt::scenario::roundMilli;
+
+TEST(JsonWriterTest, NumbersRoundTripExactly) {
+  std::mt19937_64 gen(99);
+  std::vector<double> values = {0.0, -0.0, 1.0, -1.0, 0.001, -0.001, 12.5, 1e-7, 123456789.123,
+                                0.1 + 0.2, 1e300, -2.5e-300, 4.0000000000000001, 999.999};
+  for (int i = 0; i < 20000; ++i) {
+    const double raw = std::ldexp(static_cast<double>(gen() >> 11) * 0x1.0p-53 - 0.5, static_cast<int>(gen() % 40) - 10);
+    values.push_back(raw);
+    values.push_back(roundMilli(raw));
+  }
+  JsonWriter w(false);
+  w.beginArray();
+  for (double v : values) w.value(v);
+  w.endArray();
+  const auto j = nlohmann::json::parse(w.str());
+  ASSERT_EQ(j.size(), values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    EXPECT_EQ(j[i].get<double>(), values[i] == 0.0 ? 0.0 : values[i]) << i;
+  }
+}
+
+TEST(JsonWriterTest, MillimetreValuesPrintShort) {
+  JsonWriter w(false);
+  w.beginArray();
+  for (double v : {roundMilli(12.3456), roundMilli(-0.0004), 3.0, roundMilli(-7.25), 0.5})
+    w.value(v);
+  w.endArray();
+  EXPECT_EQ(w.str(), "[12.346,0,3,-7.25,0.5]\n");
+}
+
+TEST(JsonWriterTest, StructureAndEscaping) {
+  JsonWriter w;
+  w.beginObject();
+  w.key("text").value("quote \" backslash \\ newline \n tab \t bell \x07");
+  w.key("point").numbers({1.5, -2.0});
+  w.key("empty").beginArray().endArray();
+  w.key("nested").beginObject().key("flag").value(true).key("n").value(std::int64_t{-3}).endObject();
+  w.key("none").null();
+  w.endObject();
+  const auto j = nlohmann::json::parse(w.str());
+  EXPECT_EQ(j["text"], "quote \" backslash \\ newline \n tab \t bell \x07");
+  EXPECT_EQ(j["point"][1], -2.0);
+  EXPECT_TRUE(j["empty"].empty());
+  EXPECT_EQ(j["nested"]["n"], -3);
+  EXPECT_TRUE(j["none"].is_null());
+  EXPECT_THROW(JsonWriter().value(std::nan("")), std::invalid_argument);
+}
