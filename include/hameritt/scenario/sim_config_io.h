@@ -1,0 +1,25 @@
+#pragma once
+// Reading sim_config.json: the strict inverse of simConfigJson() (scenario_io.h), so that the
+// simulator can load a scenario written by the generator. simConfigJson(loadSimConfig(f)) is
+// byte-identical to the file f for files the generator wrote.
+
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+
+#include "hameritt/scenario/scenario.h"
+
+namespace hameritt::scenario {
+
+// Builds a SimConfig from a parsed sim_config document. Unknown keys, missing keys, wrong types
+// and out-of-range values are ConfigErrors whose message names `file`, the JSON path
+// ("entities[3].trajectory[2]") and what was expected. Entity attributes keep the document's
+// key order, so parse with nlohmann::ordered_json for a byte-exact round trip (nlohmann::json
+// sorts keys; its overload gives attributes in sorted order).
+SimConfig simConfigFromJson(const nlohmann::ordered_json& j, const std::string& file);
+SimConfig simConfigFromJson(const nlohmann::json& j, const std::string& file);
+
+// Reads and parses a sim_config.json file (ConfigError on I/O or syntax errors, with the file),
+// keeping key order.
+SimConfig loadSimConfig(const std::string& path);
+
+}  // namespace hameritt::scenario

@@ -1,0 +1,393 @@
+#include "hameritt/scenario/sim_config_io.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/params_table.h"
+
+namespace hameritt::scenario {
+
+using json = nlohmann::ordered_json;
+
+namespace {
+
+const char* typeName(const json& j) { return j.type_name(); }
+
+// A JSON object being read strictly: every key must be consumed exactly once (finish()).
+class Obj {
+ public:
+  Obj(const json& j, std::string path, const std::string& file)
+      : j_(j), path_(std::move(path)), file_(file) {
+    if (!j_.is_object()) fail(path_, "expected an object", j_);
+  }
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what, const json& got) const {
+    throw ConfigError(file_ + ": " + path + ": " + what + ", got " + typeName(got) +
+                      (got.is_primitive() ? " " + got.dump() : std::string()));
+  }
+
+  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  const json& get(const std::string& key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) throw ConfigError(file_ + ": " + at(key) + ": missing required key");
+    used_.insert(key);
+    return *it;
+  }
+
+  double number(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_number()) fail(at(key), "expected a number", v);
+    return v.get<double>();
+  }
+  double numberIn(const std::string& key, double lo, double hi) {
+    const double v = number(key);
+    if (!(v >= lo && v <= hi)) {
+      throw ConfigError(file_ + ": " + at(key) + ": expected a number in [" + fmt(lo) + ", " +
+                        fmt(hi) + "], got " + fmt(v));
+    }
+    return v;
+  }
+  std::int64_t integer(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_number_integer()) fail(at(key), "expected an integer", v);
+    return v.get<std::int64_t>();
+  }
+  std::uint64_t unsignedInteger(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_number_unsigned()) fail(at(key), "expected a non-negative integer", v);
+    return v.get<std::uint64_t>();
+  }
+  std::string string(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_string()) fail(at(key), "expected a string", v);
+    return v.get<std::string>();
+  }
+  const json& array(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_array()) fail(at(key), "expected an array", v);
+    return v;
+  }
+  Obj object(const std::string& key) { return Obj(get(key), at(key), file_); }
+
+  // Unknown keys are errors.
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (!used_.count(it.key())) throw ConfigError(file_ + ": " + at(it.key()) + ": unknown key");
+    }
+  }
+
+  const std::string& path() const { return path_; }
+  const std::string& file() const { return file_; }
+
+  static std::string fmt(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof(buf), "%.17g", v);
+    return buf;
+  }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const std::string& file_;
+  std::set<std::string> used_;
+};
+
+std::string idx(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+// A fixed-length array of numbers.
+template <std::size_t N>
+std::array<double, N> numbers(const json& v, const std::string& path, const std::string& file) {
+  if (!v.is_array() || v.size() != N) {
+    throw ConfigError(
+        file + ": " + path + ": expected an array of " + std::to_string(N) + " numbers, got " +
+        (v.is_array() ? "an array of " + std::to_string(v.size()) : std::string(v.type_name())));
+  }
+  std::array<double, N> out{};
+  for (std::size_t i = 0; i < N; ++i) {
+    if (!v[i].is_number()) {
+      throw ConfigError(file + ": " + idx(path, i) + ": expected a number, got " +
+                        v[i].type_name());
+    }
+    out[i] = v[i].get<double>();
+  }
+  return out;
+}
+
+std::vector<std::string> strings(const json& v, const std::string& path, const std::string& file) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_string()) {
+      throw ConfigError(file + ": " + idx(path, i) + ": expected a string, got " +
+                        v[i].type_name());
+    }
+    out.push_back(v[i].get<std::string>());
+  }
+  return out;
+}
+
+geometry::Vec3 vec3(const json& v, const std::string& path, const std::string& file) {
+  const auto a = numbers<3>(v, path, file);
+  return {a[0], a[1], a[2]};
+}
+
+// The entity box whose minZ() is exactly `z` (the writer prints minZ(); centre + half height
+// - half height need not give z back in floating point, so the centre is nudged if needed).
+geometry::OrientedBox entityBox(double x, double y, double z, double yaw,
+                                const geometry::Vec3& size) {
+  geometry::OrientedBox b = boxFromPose({x, y, z}, yaw, size);
+  double c = b.center.z();
+  for (int i = 0; i < 8 && b.minZ() != z; ++i) {
+    c = std::nextafter(c, b.minZ() < z ? INFINITY : -INFINITY);
+    b.center.z() = c;
+  }
+  if (b.minZ() != z) b = boxFromPose({x, y, z}, yaw, size);
+  return b;
+}
+
+ScenarioEntity readEntity(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  ScenarioEntity se;
+  Entity& e = se.entity;
+  e.id = o.string("id");
+  if (e.id.empty()) throw ConfigError(file + ": " + o.at("id") + ": expected a non-empty id");
+  const std::string cls = o.string("class");
+  if (!parseEntityClass(cls, &e.cls)) {
+    throw ConfigError(file + ": " + o.at("class") + ": expected an entity class, got \"" + cls +
+                      "\"");
+  }
+  se.role = o.string("role");
+  {
+    const json& a = o.get("attributes");
+    if (!a.is_object()) o.fail(o.at("attributes"), "expected an object", a);
+    for (auto it = a.begin(); it != a.end(); ++it) {
+      if (it->is_string()) {
+        e.attributes.set(it.key(), it->get<std::string>());
+      } else if (it->is_number_integer()) {
+        e.attributes.set(it.key(), it->get<std::int64_t>());
+      } else {
+        o.fail(o.at("attributes." + it.key()), "expected a string or an integer", *it);
+      }
+    }
+  }
+  Obj pose = o.object("pose");
+  const double x = pose.number("x"), y = pose.number("y"), z = pose.number("z");
+  const double yaw = pose.number("yaw");
+  pose.finish();
+  const geometry::Vec3 size = vec3(o.get("size"), o.at("size"), file);
+  if (!(size.minCoeff() > 0)) {
+    throw ConfigError(file + ": " + o.at("size") + ": expected positive sizes");
+  }
+  e.box = entityBox(x, y, z, yaw, size);
+  const json& traj = o.array("trajectory");
+  se.trajectory.reserve(traj.size());
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const std::string p = idx(o.at("trajectory"), i);
+    const auto a = numbers<5>(traj[i], p, file);
+    // Strictly increasing, as hameritt_validate requires: two samples at one time would be
+    // a teleport.
+    if (!(a[0] >= 0)) {
+      throw ConfigError(file + ": " + p + ": expected a time >= 0, got " + Obj::fmt(a[0]));
+    }
+    if (!se.trajectory.empty() && !(a[0] > se.trajectory.back().t)) {
+      throw ConfigError(file + ": " + p + ": expected strictly increasing times, got t = " +
+                        Obj::fmt(a[0]) + " after " + Obj::fmt(se.trajectory.back().t));
+    }
+    se.trajectory.push_back({a[0], a[1], a[2], a[3], a[4]});
+  }
+  o.finish();
+  return se;
+}
+
+CameraSpec readCamera(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  CameraSpec c;
+  c.name = o.string("name");
+  Obj mount = o.object("mount");
+  c.mount_xyz = vec3(mount.get("xyz"), mount.at("xyz"), file);
+  c.mount_rpy = vec3(mount.get("rpy_deg"), mount.at("rpy_deg"), file);
+  mount.finish();
+  const std::int64_t w = o.integer("width"), h = o.integer("height");
+  if (w <= 0 || h <= 0 || w > 16384 || h > 16384) {
+    throw ConfigError(file + ": " + o.at("width") + "/height: expected 1..16384 pixels");
+  }
+  c.width = static_cast<int>(w);
+  c.height = static_cast<int>(h);
+  c.hfov_deg = o.number("hfov_deg");
+  if (!(c.hfov_deg > 0 && c.hfov_deg < 180)) {
+    throw ConfigError(file + ": " + o.at("hfov_deg") + ": expected degrees in (0, 180), got " +
+                      Obj::fmt(c.hfov_deg));
+  }
+  c.rate_hz = o.number("rate_hz");
+  if (!(c.rate_hz > 0)) {
+    throw ConfigError(file + ": " + o.at("rate_hz") + ": expected a positive rate, got " +
+                      Obj::fmt(c.rate_hz));
+  }
+  c.modalities = strings(o.array("modalities"), o.at("modalities"), file);
+  o.finish();
+  return c;
+}
+
+}  // namespace
+
+SimConfig simConfigFromJson(const nlohmann::json& j, const std::string& file) {
+  return simConfigFromJson(nlohmann::ordered_json(j), file);
+}
+
+SimConfig simConfigFromJson(const json& j, const std::string& file) {
+  Obj root(j, "", file);
+  SimConfig s;
+  const std::string schema = root.string("schema");
+  if (schema != "hameritt/sim_config") {
+    throw ConfigError(file + ": schema: expected \"hameritt/sim_config\", got \"" + schema + "\"");
+  }
+  const std::int64_t version = root.integer("schema_version");
+  if (version != kSchemaVersion) {
+    throw ConfigError(file + ": schema_version: expected " + std::to_string(kSchemaVersion) +
+                      ", got " + std::to_string(version));
+  }
+  s.scenario_id = root.string("scenario_id");
+  const std::string cls = root.string("class");
+  if (!parseScenarioClass(cls, &s.cls)) {
+    throw ConfigError(file + ": class: expected area_search, route_search or pursuit, got \"" +
+                      cls + "\"");
+  }
+  s.seed = root.unsignedInteger("seed");
+  s.duration = root.number("duration");
+  if (!(s.duration >= 0)) throw ConfigError(file + ": duration: expected a non-negative number");
+
+  {
+    Obj w = root.object("world");
+    const std::string gen = w.string("generator");
+    if (gen != "hameritt_suburb") {
+      throw ConfigError(file + ": world.generator: expected \"hameritt_suburb\", got \"" + gen +
+                        "\"");
+    }
+    const std::string fp = w.string("fingerprint");
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(fp.c_str(), &end, 16);
+    if (fp.size() != 16 || end != fp.c_str() + fp.size()) {
+      throw ConfigError(file + ": world.fingerprint: expected 16 hex digits, got \"" + fp + "\"");
+    }
+    s.world_fingerprint = v;
+    try {
+      s.world = worldParamsFromJson(nlohmann::json(w.get("params")), file);
+    } catch (const ConfigError& e) {
+      // worldParamsFromJson names paths "world.<key>"; here they live under world.params.
+      std::string msg = e.what();
+      const std::string prefix = file + ": world";
+      if (msg.compare(0, prefix.size(), prefix) == 0) {
+        msg = prefix + ".params" + msg.substr(prefix.size());
+      }
+      throw ConfigError(msg);
+    }
+    w.finish();
+  }
+
+  const json& ents = root.array("entities");
+  s.entities.reserve(ents.size());
+  std::set<std::string> ids;
+  for (std::size_t i = 0; i < ents.size(); ++i) {
+    s.entities.push_back(readEntity(ents[i], idx("entities", i), file));
+    if (!ids.insert(s.entities.back().entity.id).second) {
+      throw ConfigError(file + ": " + idx("entities", i) + ".id: duplicate id \"" +
+                        s.entities.back().entity.id + "\"");
+    }
+  }
+
+  const json& groups = root.array("groups");
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    Obj g(groups[i], idx("groups", i), file);
+    Group grp;
+    grp.id = g.string("id");
+    grp.kind = g.string("kind");
+    grp.members = strings(g.array("members"), g.at("members"), file);
+    g.finish();
+    s.groups.push_back(std::move(grp));
+  }
+
+  {
+    Obj env = root.object("environment");
+    Environment& e = s.environment;
+    e.time_of_day = env.numberIn("time_of_day", 0, 24);
+    e.snow = env.numberIn("snow", 0, 1);
+    e.rain = env.numberIn("rain", 0, 1);
+    e.dust = env.numberIn("dust", 0, 1);
+    e.fog = env.numberIn("fog", 0, 1);
+    e.foliage = env.numberIn("foliage", 0, 1);
+    Obj wind = env.object("wind");
+    e.wind_mean = vec3(wind.get("mean"), wind.at("mean"), file);
+    e.gust_intensity = wind.numberIn("gust_intensity", 0, 1);
+    wind.finish();
+    env.finish();
+  }
+
+  {
+    Obj u = root.object("uav");
+    UavSpec& spec = s.uav;
+    spec.model = u.string("model");
+    Obj start = u.object("start");
+    spec.start.t = 0.0;
+    spec.start.x = start.number("x");
+    spec.start.y = start.number("y");
+    spec.start.z = start.number("z");
+    spec.start.yaw = start.number("yaw");
+    start.finish();
+    Obj alt = u.object("altitude");
+    spec.altitude_min = alt.number("min");
+    spec.altitude_max = alt.number("max");
+    if (!(spec.altitude_min <= spec.altitude_max)) {
+      throw ConfigError(file + ": uav.altitude: expected min <= max, got " +
+                        Obj::fmt(spec.altitude_min) + " > " + Obj::fmt(spec.altitude_max));
+    }
+    alt.finish();
+    spec.max_speed = u.number("max_speed");
+    if (!(spec.max_speed > 0)) {
+      throw ConfigError(file + ": uav.max_speed: expected a positive speed, got " +
+                        Obj::fmt(spec.max_speed));
+    }
+    Obj payload = u.object("payload");
+    const json& cams = payload.array("cameras");
+    for (std::size_t i = 0; i < cams.size(); ++i) {
+      spec.cameras.push_back(readCamera(cams[i], idx("uav.payload.cameras", i), file));
+    }
+    payload.finish();
+    u.finish();
+  }
+
+  {
+    Obj p = root.object("perturbations");
+    Obj n = p.object("camera_noise");
+    s.perturbations.gaussian_noise_std = n.numberIn("gaussian_std", 0, 1);
+    s.perturbations.salt_pepper_probability = n.numberIn("salt_pepper_probability", 0, 1);
+    s.perturbations.motion_blur_px = n.numberIn("motion_blur_px", 0, 1000);
+    n.finish();
+    p.finish();
+  }
+  root.finish();
+  return s;
+}
+
+SimConfig loadSimConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw ConfigError(path + ": malformed JSON: " + e.what());
+  }
+  return simConfigFromJson(j, path);
+}
+
+}  // namespace hameritt::scenario
