@@ -17,8 +17,11 @@ HAMERITT_PACKAGES=(
   libroscpp-dev libstd-msgs-dev libgeometry-msgs-dev librostest-dev
   rosbash python3-roslaunch python3-rostest python3-rosbag ros-environment
   libgtest-dev googletest
+  libnav-msgs-dev libsensor-msgs-dev libros-rosgraph-msgs-dev libtf2-dev libtf2-ros-dev
   libeigen3-dev nlohmann-json3-dev libopencv-dev
-  python3-jsonschema
+  libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev
+  python3-jsonschema python3-rospy python3-nav-msgs python3-rosgraph-msgs
+  python3-geometry-msgs python3-std-msgs python3-actionlib-msgs
 )
 
 install_deps() {

@@ -1,0 +1,31 @@
+#pragma once
+// Conversions between the simulator core's types and ROS messages, in one place.
+
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/Imu.h>
+
+#include "hameritt/EntityState.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/sim/simulator.h"
+
+namespace hameritt::ros_wrappers {
+
+// Frame names.
+constexpr const char* kMapFrame = "map";
+constexpr const char* kBaseFrame = "uav/base_link";
+
+// Odometry of the UAV: pose in map, twist in the body frame (REP 105 / nav_msgs convention).
+nav_msgs::Odometry toOdometryMsg(const sim::UavState& s, const ros::Time& stamp);
+// IMU reading: orientation, body rates and specific force in the body frame.
+sensor_msgs::Imu toImuMsg(const sim::UavState& s, const ros::Time& stamp);
+// map -> uav/base_link.
+geometry_msgs::TransformStamped toBaseTransform(const sim::UavState& s, const ros::Time& stamp);
+// uav/base_link -> uav/<camera>_link from a payload camera's mount (FLU, rpy in degrees).
+geometry_msgs::TransformStamped toCameraTransform(const scenario::CameraSpec& c, const ros::Time& stamp);
+// Ground truth of one entity.
+hameritt::EntityState toMsg(const sim::EntityState& e, const ros::Time& stamp);
+// map -> <entity id>.
+geometry_msgs::TransformStamped toEntityTransform(const sim::EntityState& e, const ros::Time& stamp);
+
+}  // namespace hameritt::ros_wrappers

@@ -1,0 +1,64 @@
+#pragma once
+// ROS wrapper of the simulator core: sim time on /clock, UAV odometry/IMU/tf, ground truth,
+// velocity and pose setpoints, pause/resume, lock-step stepping and reset.
+
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/Twist.h>
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <memory>
+#include <string>
+
+#include "hameritt/ResetSimulation.h"
+#include "hameritt/SetPaused.h"
+#include "hameritt/StepSimulation.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+#include "hameritt/sim/simulator.h"
+
+namespace hameritt::ros_wrappers {
+
+// Parameters (private namespace):
+//   ~sim_config (path, required), ~urdf (default: the package's models/sentinel.urdf),
+//   ~physics_rate_hz (500), ~real_time_factor (0 = as fast as possible), ~start_paused (false),
+//   ~publish_rate_hz (250: /clock, odometry, IMU, UAV tf), ~ground_truth_rate_hz (20),
+//   ~duration (0 = the scenario's; free running stops there and the node stays up).
+class SimulatorRos {
+ public:
+  // Throws scenario::ConfigError (bad parameters or sim_config): the node exits with ROS_FATAL.
+  SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+  // Runs until shutdown: steps (unless paused), publishes, serves callbacks.
+  void spin();
+
+ private:
+  void advance(int steps);
+  void publishState(bool force_ground_truth);
+  void publishStaticFrames();
+  void onVelocity(const geometry_msgs::Twist::ConstPtr& msg);
+  void onPose(const geometry_msgs::PoseStamped::ConstPtr& msg);
+  bool onStep(hameritt::StepSimulation::Request& req, hameritt::StepSimulation::Response& res);
+  bool onPause(hameritt::SetPaused::Request& req, hameritt::SetPaused::Response& res);
+  bool onReset(hameritt::ResetSimulation::Request& req, hameritt::ResetSimulation::Response& res);
+
+  scenario::SimConfig config_;
+  std::unique_ptr<scenario::World> world_;
+  std::unique_ptr<sim::Simulator> sim_;
+  double real_time_factor_ = 0.0;
+  double duration_ = 0.0;
+  bool paused_ = false;
+  bool crash_reported_ = false;
+  int steps_per_publish_ = 1;
+  int steps_per_ground_truth_ = 1;
+  long long step_count_ = 0;
+
+  ros::Publisher clock_pub_, odom_pub_, imu_pub_, truth_pub_, crash_pub_;
+  ros::Subscriber vel_sub_, pose_sub_;
+  ros::ServiceServer step_srv_, pause_srv_, reset_srv_;
+  tf2_ros::TransformBroadcaster tf_;
+  tf2_ros::StaticTransformBroadcaster static_tf_;
+};
+
+}  // namespace hameritt::ros_wrappers

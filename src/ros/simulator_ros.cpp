@@ -1,0 +1,225 @@
+#include "hameritt/ros/simulator_ros.h"
+
+#include <ros/callback_queue.h>
+#include <rosgraph_msgs/Clock.h>
+#include <tf2/LinearMath/Matrix3x3.h>
+#include <tf2/LinearMath/Quaternion.h>
+
+#include <cmath>
+
+#include "hameritt/CrashEvent.h"
+#include "hameritt/EntityStateArray.h"
+#include "hameritt/ros/conversions.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/generator.h"
+#include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/sim_config_io.h"
+#include "hameritt/sim/quadrotor.h"
+
+namespace hameritt::ros_wrappers {
+
+namespace {
+
+int ratio(double physics_hz, double rate_hz, const char* name) {
+  if (!(rate_hz > 0 && rate_hz <= physics_hz)) {
+    throw scenario::ConfigError(std::string("~") + name + ": expected a rate in (0, physics_rate_hz], got " +
+                                std::to_string(rate_hz));
+  }
+  const double steps = physics_hz / rate_hz;
+  if (std::abs(steps - std::round(steps)) > 1e-9) {
+    throw scenario::ConfigError(std::string("~") + name + ": expected a rate that divides physics_rate_hz (" +
+                                std::to_string(physics_hz) + ") into whole steps, got " +
+                                std::to_string(rate_hz));
+  }
+  return static_cast<int>(std::round(steps));
+}
+
+}  // namespace
+
+SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string sim_config, urdf;
+  if (!pnh.getParam("sim_config", sim_config)) {
+    throw scenario::ConfigError("~sim_config: required parameter (path of a sim_config.json)");
+  }
+  pnh.param<std::string>("urdf", urdf, std::string(HAMERITT_SOURCE_DIR) + "/models/sentinel.urdf");
+  sim::SimSettings settings;
+  pnh.param("physics_rate_hz", settings.physics_rate_hz, settings.physics_rate_hz);
+  pnh.param("real_time_factor", real_time_factor_, 0.0);
+  pnh.param("start_paused", paused_, false);
+  pnh.param("duration", duration_, 0.0);
+  double publish_hz = 250.0, truth_hz = 20.0;
+  pnh.param("publish_rate_hz", publish_hz, publish_hz);
+  pnh.param("ground_truth_rate_hz", truth_hz, truth_hz);
+  settings.validate();
+  if (!(real_time_factor_ >= 0)) {
+    throw scenario::ConfigError("~real_time_factor: expected >= 0 (0 = unpaced), got " +
+                                std::to_string(real_time_factor_));
+  }
+  steps_per_publish_ = ratio(settings.physics_rate_hz, publish_hz, "publish_rate_hz");
+  steps_per_ground_truth_ = ratio(settings.physics_rate_hz, truth_hz, "ground_truth_rate_hz");
+
+  config_ = scenario::loadSimConfig(sim_config);
+  if (duration_ <= 0) duration_ = config_.duration;
+  world_ = std::make_unique<scenario::World>(scenario::generateWorld(config_.world));
+  if (world_->fingerprint() != config_.world_fingerprint) {
+    throw scenario::ConfigError(sim_config + ": world.fingerprint: expected " +
+                                scenario::hex64(world_->fingerprint()) +
+                                " for these world parameters, got " +
+                                scenario::hex64(config_.world_fingerprint));
+  }
+  sim_ = std::make_unique<sim::Simulator>(*world_, config_, sim::loadQuadrotorUrdf(urdf), settings);
+
+  clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  odom_pub_ = nh.advertise<nav_msgs::Odometry>("uav/odom", 50);
+  imu_pub_ = nh.advertise<sensor_msgs::Imu>("uav/imu", 50);
+  truth_pub_ = nh.advertise<hameritt::EntityStateArray>("ground_truth/entities", 10);
+  crash_pub_ = nh.advertise<hameritt::CrashEvent>("uav/crash", 1, true);
+  vel_sub_ = nh.subscribe("uav/cmd_vel", 10, &SimulatorRos::onVelocity, this);
+  pose_sub_ = nh.subscribe("uav/cmd_pose", 10, &SimulatorRos::onPose, this);
+  step_srv_ = pnh.advertiseService("step", &SimulatorRos::onStep, this);
+  pause_srv_ = pnh.advertiseService("set_paused", &SimulatorRos::onPause, this);
+  reset_srv_ = pnh.advertiseService("reset", &SimulatorRos::onReset, this);
+  publishStaticFrames();
+  publishState(true);
+  ROS_INFO("simulator: %s, %zu world entities, %zu scenario entities, %.0f Hz physics, %s",
+           config_.scenario_id.c_str(), world_->entities().size(), config_.entities.size(),
+           settings.physics_rate_hz, paused_ ? "paused" : "running");
+}
+
+void SimulatorRos::publishStaticFrames() {
+  std::vector<geometry_msgs::TransformStamped> frames;
+  for (const auto& c : config_.uav.cameras) frames.push_back(toCameraTransform(c, ros::Time(0)));
+  static_tf_.sendTransform(frames);
+}
+
+void SimulatorRos::publishState(bool force_ground_truth) {
+  const sim::UavState& s = sim_->uav();
+  ros::Time stamp;
+  stamp.fromSec(s.t);
+  rosgraph_msgs::Clock clock;
+  clock.clock = stamp;
+  clock_pub_.publish(clock);
+  odom_pub_.publish(toOdometryMsg(s, stamp));
+  imu_pub_.publish(toImuMsg(s, stamp));
+  std::vector<geometry_msgs::TransformStamped> tfs{toBaseTransform(s, stamp)};
+  if (force_ground_truth || step_count_ % steps_per_ground_truth_ == 0) {
+    hameritt::EntityStateArray truth;
+    truth.header.stamp = stamp;
+    truth.header.frame_id = kMapFrame;
+    for (const auto& e : sim_->scenarioEntities()) {
+      truth.entities.push_back(toMsg(e, stamp));
+      if (e.role != "static") tfs.push_back(toEntityTransform(e, stamp));
+    }
+    truth_pub_.publish(truth);
+  }
+  tf_.sendTransform(tfs);
+  if (s.crashed && !crash_reported_) {
+    crash_reported_ = true;
+    hameritt::CrashEvent ev;
+    ev.header.stamp = stamp;
+    ev.header.frame_id = kMapFrame;
+    ev.entity_id = s.crashed_into;
+    ev.position.x = s.position.x();
+    ev.position.y = s.position.y();
+    ev.position.z = s.position.z();
+    ev.speed = s.velocity.norm();
+    crash_pub_.publish(ev);
+    ROS_WARN("simulator: UAV crashed into %s at t=%.3f s", s.crashed_into.c_str(), s.crash_time);
+  }
+}
+
+void SimulatorRos::advance(int steps) {
+  for (int i = 0; i < steps; ++i) {
+    sim_->step();
+    ++step_count_;
+    if (step_count_ % steps_per_publish_ == 0) publishState(false);
+  }
+}
+
+void SimulatorRos::spin() {
+  ros::WallTime wall_start = ros::WallTime::now();
+  double sim_start = sim_->time();
+  bool was_paused = paused_;
+  while (ros::ok()) {
+    const bool running = !paused_ && sim_->time() < duration_;
+    if (!running) {
+      ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
+      was_paused = true;
+      continue;
+    }
+    if (was_paused) {
+      // Pacing restarts from where the pause left off.
+      sim_start = sim_->time();
+      wall_start = ros::WallTime::now();
+      was_paused = false;
+    }
+    advance(steps_per_publish_);
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0));
+    if (real_time_factor_ > 0) {
+      const double due = (sim_->time() - sim_start) / real_time_factor_;
+      const double ahead = due - (ros::WallTime::now() - wall_start).toSec();
+      if (ahead > 0) ros::WallDuration(ahead).sleep();
+    }
+  }
+}
+
+void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
+  sim_->setVelocitySetpoint(sim::Vec3(msg->linear.x, msg->linear.y, msg->linear.z), msg->angular.z);
+}
+
+void SimulatorRos::onPose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
+  if (!msg->header.frame_id.empty() && msg->header.frame_id != kMapFrame) {
+    ROS_WARN_THROTTLE(5.0, "simulator: pose setpoints must be in frame '%s', got '%s'; ignored",
+                      kMapFrame, msg->header.frame_id.c_str());
+    return;
+  }
+  const auto& q = msg->pose.orientation;
+  double roll, pitch, yaw;
+  tf2::Matrix3x3(tf2::Quaternion(q.x, q.y, q.z, q.w)).getRPY(roll, pitch, yaw);
+  if (!std::isfinite(yaw)) yaw = 0.0;
+  sim_->setPositionSetpoint(sim::Vec3(msg->pose.position.x, msg->pose.position.y, msg->pose.position.z), yaw);
+}
+
+bool SimulatorRos::onStep(hameritt::StepSimulation::Request& req,
+                          hameritt::StepSimulation::Response& res) {
+  if (!paused_) {
+    res.success = false;
+    res.code = 2;
+    res.message = "pause the simulator (~set_paused) before stepping it";
+  } else if (req.steps > 1000000) {
+    res.success = false;
+    res.code = 2;
+    res.message = "steps: at most 1000000 per call";
+  } else {
+    advance(static_cast<int>(req.steps));
+    publishState(true);
+    res.success = true;
+    res.code = 0;
+    res.message = "stepped " + std::to_string(req.steps);
+  }
+  res.sim_time = sim_->time();
+  return true;
+}
+
+bool SimulatorRos::onPause(hameritt::SetPaused::Request& req, hameritt::SetPaused::Response& res) {
+  paused_ = req.paused;
+  res.success = true;
+  res.code = 0;
+  res.message = paused_ ? "paused" : "running";
+  res.sim_time = sim_->time();
+  return true;
+}
+
+bool SimulatorRos::onReset(hameritt::ResetSimulation::Request&,
+                           hameritt::ResetSimulation::Response& res) {
+  sim_->reset();
+  step_count_ = 0;
+  crash_reported_ = false;
+  publishState(true);
+  res.success = true;
+  res.code = 0;
+  res.message = "reset to t = 0";
+  return true;
+}
+
+}  // namespace hameritt::ros_wrappers
