@@ -90,6 +90,9 @@ TEST(Simulator, TakesOffAndHoldsAPositionSetpoint) {
   EXPECT_NEAR(sim.uav().rotor_speeds.mean(), sentinel().hoverSpeed(),
               0.02 * sentinel().hoverSpeed());
   EXPECT_GT((sim.uav().orientation * Vec3::UnitZ()).z(), 0.999);
+  // An accelerometer at hover reads the thrust per unit mass: +g along body z.
+  EXPECT_NEAR(sim.uav().specific_force.z(), 9.80665, 0.1);
+  EXPECT_LT(sim.uav().specific_force.head<2>().norm(), 0.1);
 }
 
 TEST(Simulator, FliesASquareOfWaypoints) {
