@@ -372,17 +372,8 @@ class ScenarioBuilder {
           if (seen.count(key) || !eval_.holds(op, f, rel.cls)) continue;
           seen.insert(key);
           if (rel.cls == EntityClass::kStreet || rel.cls == EntityClass::kFence) continue;
-          SceneRelation r;
-          r.related_id = rel.id;
-          r.related_class = toString(rel.cls);
-          if (rel.attributes) r.related_attributes = *rel.attributes;
-          r.op = op;
+          SceneRelation r = makeRelation(s, rel, op, f);
           r.eventually = true;
-          r.target_id = target.id;
-          r.distance = f.distance;
-          r.bearing_deg = f.bearing_deg;
-          r.dz = f.dz;
-          r.line_of_sight = f.line_of_sight;
           r.time = t;
           out.push_back(r);
         }
@@ -942,17 +933,8 @@ class ScenarioBuilder {
         ps.box = poseBox(se.entity.box, sampleTrajectory(se.trajectory, t));
         const RelationFacts f = eval_.measure(ts, ps);
         if (eval_.holds(RelationOp::kNextTo, f, EntityClass::kPedestrian)) {
-          SceneRelation r;
-          r.related_id = se.entity.id;
-          r.related_class = "pedestrian";
-          r.related_attributes = se.entity.attributes;
-          r.op = RelationOp::kNextTo;
+          SceneRelation r = makeRelation(ts, ps, RelationOp::kNextTo, f);
           r.eventually = true;
-          r.target_id = target.id;
-          r.distance = f.distance;
-          r.bearing_deg = f.bearing_deg;
-          r.dz = f.dz;
-          r.line_of_sight = f.line_of_sight;
           r.time = t;
           m.relations.push_back(r);
           break;

@@ -165,6 +165,8 @@ constexpr RelationOp kSpatialOps[] = {
     RelationOp::kNotOnTopOf, RelationOp::kOrthogonalTo, RelationOp::kInFrontOf,
     RelationOp::kRightOf, RelationOp::kLeftOf};
 
+}  // namespace
+
 SceneRelation makeRelation(const Subject& target, const Subject& related, RelationOp op,
                            const RelationFacts& f) {
   SceneRelation r;
@@ -179,7 +181,6 @@ SceneRelation makeRelation(const Subject& target, const Subject& related, Relati
   r.line_of_sight = f.line_of_sight;
   return r;
 }
-}  // namespace
 
 std::vector<SceneRelation> RelationEvaluator::allRelations(
     const Subject& target, const std::vector<Subject>& extra,

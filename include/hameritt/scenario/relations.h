@@ -89,6 +89,10 @@ class RelationEvaluator {
 // The classes that each operator considers as related entities.
 bool operatorApplies(RelationOp op, EntityClass related_cls);
 
+// The relation `op` between two subjects with its evidence (not EVENTUALLY, no time).
+SceneRelation makeRelation(const Subject& target, const Subject& related, RelationOp op,
+                           const RelationFacts& facts);
+
 // A subject for world entity i.
 Subject worldSubject(const World& world, int i);
 
