@@ -1,0 +1,397 @@
+#include "hameritt/scenario/mission_io.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/scenario_io.h"
+
+namespace hameritt::scenario {
+
+using json = nlohmann::ordered_json;
+
+namespace {
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.17g", v);
+  return buf;
+}
+
+std::string idx(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+// A JSON object being read strictly: every key must be consumed (finish()), the same rules and
+// messages as sim_config_io.cpp.
+class Obj {
+ public:
+  Obj(const json& j, std::string path, const std::string& file)
+      : j_(j), path_(std::move(path)), file_(file) {
+    if (!j_.is_object()) fail(path_.empty() ? std::string("(root)") : path_, "expected an object", j_);
+  }
+
+  [[noreturn]] void fail(const std::string& path, const std::string& what, const json& got) const {
+    throw ConfigError(file_ + ": " + path + ": " + what + ", got " + got.type_name() +
+                      (got.is_primitive() ? " " + got.dump() : std::string()));
+  }
+  [[noreturn]] void error(const std::string& key, const std::string& what) const {
+    throw ConfigError(file_ + ": " + at(key) + ": " + what);
+  }
+
+  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  bool has(const std::string& key) const { return j_.find(key) != j_.end(); }
+
+  const json& get(const std::string& key) {
+    const auto it = j_.find(key);
+    if (it == j_.end()) throw ConfigError(file_ + ": " + at(key) + ": missing required key");
+    used_.insert(key);
+    return *it;
+  }
+  double number(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_number()) fail(at(key), "expected a number", v);
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(at(key), "expected a finite number", v);
+    return d;
+  }
+  std::int64_t integer(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_number_integer()) fail(at(key), "expected an integer", v);
+    return v.get<std::int64_t>();
+  }
+  std::uint64_t unsignedInteger(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_number_unsigned()) fail(at(key), "expected a non-negative integer", v);
+    return v.get<std::uint64_t>();
+  }
+  std::string string(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_string()) fail(at(key), "expected a string", v);
+    return v.get<std::string>();
+  }
+  bool boolean(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_boolean()) fail(at(key), "expected a boolean", v);
+    return v.get<bool>();
+  }
+  const json& array(const std::string& key) {
+    const json& v = get(key);
+    if (!v.is_array()) fail(at(key), "expected an array", v);
+    return v;
+  }
+  Obj object(const std::string& key) { return Obj(get(key), at(key), file_); }
+
+  void finish() const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (!used_.count(it.key())) throw ConfigError(file_ + ": " + at(it.key()) + ": unknown key");
+    }
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  const json& j_;
+  std::string path_;
+  const std::string& file_;
+  std::set<std::string> used_;
+};
+
+std::vector<geometry::Vec2> points(const json& v, const std::string& path, const std::string& file,
+                                   std::size_t min_count) {
+  if (!v.is_array()) {
+    throw ConfigError(file + ": " + path + ": expected an array of [x, y] points, got " +
+                      v.type_name());
+  }
+  if (v.size() < min_count) {
+    throw ConfigError(file + ": " + path + ": expected at least " + std::to_string(min_count) +
+                      " points, got " + std::to_string(v.size()));
+  }
+  std::vector<geometry::Vec2> out;
+  out.reserve(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const json& p = v[i];
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
+      throw ConfigError(file + ": " + idx(path, i) + ": expected a point [x, y] of 2 numbers, got " +
+                        (p.is_primitive() ? p.dump() : std::string(p.type_name())));
+    }
+    out.emplace_back(p[0].get<double>(), p[1].get<double>());
+    if (!out.back().allFinite()) {
+      throw ConfigError(file + ": " + idx(path, i) + ": expected finite coordinates");
+    }
+  }
+  return out;
+}
+
+geometry::Polygon polygon(Obj& o, const std::string& key) {
+  return geometry::Polygon(points(o.get(key), o.at(key), o.file(), 3));
+}
+
+geometry::TimeWindow window(Obj& o) {
+  Obj w = o.object("time_window");
+  geometry::TimeWindow tw;
+  if (w.has("net")) tw.net = w.number("net");
+  if (w.has("nlt")) tw.nlt = w.number("nlt");
+  w.finish();
+  if (!tw.valid()) {
+    throw ConfigError(o.file() + ": " + o.at("time_window") + ": expected net <= nlt, got " +
+                      fmt(*tw.net) + " > " + fmt(*tw.nlt));
+  }
+  return tw;
+}
+
+Attributes attributes(Obj& o, const std::string& key) {
+  const json& a = o.get(key);
+  if (!a.is_object()) o.fail(o.at(key), "expected an object", a);
+  Attributes out;
+  for (auto it = a.begin(); it != a.end(); ++it) {
+    if (it->is_string()) {
+      out.set(it.key(), it->get<std::string>());
+    } else if (it->is_number_integer()) {
+      out.set(it.key(), it->get<std::int64_t>());
+    } else {
+      o.fail(o.at(key + "." + it.key()), "expected a string or an integer", *it);
+    }
+  }
+  return out;
+}
+
+TargetDescription readTarget(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  TargetDescription t;
+  t.id = o.string("id");
+  t.cls = o.string("class");
+  t.vehicle_class = o.string("vehicle_class");
+  t.make = o.string("make");
+  t.model = o.string("model");
+  t.color = o.string("color");
+  o.finish();
+  return t;
+}
+
+KeepOutZone readKoz(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  KeepOutZone k;
+  k.id = o.string("id");
+  k.purpose = o.string("purpose");
+  if (k.purpose != "vantage_denial" && k.purpose != "access_denial" && k.purpose != "restricted") {
+    o.error("purpose", "expected vantage_denial, access_denial or restricted, got \"" +
+                           k.purpose + "\"");
+  }
+  k.polygon = polygon(o, "polygon");
+  {
+    Obj alt = o.object("altitude");
+    if (alt.has("min")) k.alt_min = alt.number("min");
+    if (alt.has("max")) k.alt_max = alt.number("max");
+    alt.finish();
+    if (k.alt_min && k.alt_max && !(*k.alt_min <= *k.alt_max)) {
+      o.error("altitude", "expected min <= max, got " + fmt(*k.alt_min) + " > " + fmt(*k.alt_max));
+    }
+  }
+  k.window = window(o);
+  o.finish();
+  return k;
+}
+
+AreaPrior readPrior(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  AreaPrior p;
+  p.aoi_id = o.string("aoi_id");
+  const std::int64_t depth = o.integer("depth");
+  if (depth < 0 || depth > 16) o.error("depth", "expected an integer in [0, 16], got " +
+                                                    std::to_string(depth));
+  p.depth = static_cast<int>(depth);
+  const json& cells = o.array("cells");
+  const std::string cpath = o.at("cells");
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    Obj c(cells[i], idx(cpath, i), file);
+    PriorCell cell;
+    cell.id = c.string("id");
+    const std::int64_t row = c.integer("row"), col = c.integer("col");
+    const std::int64_t n = std::int64_t{1} << depth;
+    if (row < 0 || row >= n) c.error("row", "expected an integer in [0, " + std::to_string(n - 1) +
+                                                "], got " + std::to_string(row));
+    if (col < 0 || col >= n) c.error("col", "expected an integer in [0, " + std::to_string(n - 1) +
+                                                "], got " + std::to_string(col));
+    cell.row = static_cast<int>(row);
+    cell.col = static_cast<int>(col);
+    cell.polygon = polygon(c, "polygon");
+    cell.probability = c.number("probability");
+    if (!(cell.probability >= 0 && cell.probability <= 1)) {
+      c.error("probability", "expected a number in [0, 1], got " + fmt(cell.probability));
+    }
+    c.finish();
+    p.cells.push_back(std::move(cell));
+  }
+  o.finish();
+  return p;
+}
+
+RouteOfInterest readRoute(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  RouteOfInterest r;
+  r.id = o.string("id");
+  r.polyline = points(o.get("polyline"), o.at("polyline"), file, 2);
+  const json& streets = o.array("streets");
+  for (std::size_t i = 0; i < streets.size(); ++i) {
+    if (!streets[i].is_string()) {
+      throw ConfigError(file + ": " + idx(o.at("streets"), i) + ": expected a string, got " +
+                        streets[i].type_name());
+    }
+    r.streets.push_back(streets[i].get<std::string>());
+  }
+  r.band_width = o.number("band_width");
+  if (!(r.band_width > 0)) o.error("band_width", "expected a positive width, got " +
+                                                     fmt(r.band_width));
+  r.band = polygon(o, "band_polygon");
+  o.finish();
+  return r;
+}
+
+SceneRelation readRelation(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  SceneRelation r;
+  {
+    Obj rel = o.object("related");
+    r.related_id = rel.string("id");
+    r.related_class = rel.string("class");
+    r.related_attributes = attributes(rel, "attributes");
+    rel.finish();
+  }
+  const std::string op = o.string("operator");
+  if (!parseRelationOp(op, &r.op, &r.eventually)) {
+    o.error("operator", "expected a relation operator (NEXT_TO, ..., PART_OF, EVENTUALLY_*), got \"" +
+                            op + "\"");
+  }
+  r.target_id = o.string("target");
+  {
+    Obj ev = o.object("evidence");
+    if (r.op != RelationOp::kPartOf) {
+      r.distance = ev.number("distance");
+      r.bearing_deg = ev.number("bearing_deg");
+      if (!(r.bearing_deg >= 0 && r.bearing_deg < 360)) {
+        ev.error("bearing_deg", "expected degrees in [0, 360), got " + fmt(r.bearing_deg));
+      }
+      r.dz = ev.number("dz");
+      r.line_of_sight = ev.boolean("line_of_sight");
+    }
+    if (r.eventually) {
+      r.time = ev.number("time");
+    } else if (ev.has("time")) {
+      ev.error("time", "unexpected for an operator without EVENTUALLY_");
+    }
+    ev.finish();
+  }
+  const std::string text = o.string("text");
+  const std::string expected = relationText(r);
+  if (text != expected) o.error("text", "expected \"" + expected + "\", got \"" + text + "\"");
+  o.finish();
+  return r;
+}
+
+}  // namespace
+
+Mission missionFromJson(const json& j, const std::string& file) {
+  Obj root(j, "", file);
+  Mission m;
+  const std::string schema = root.string("schema");
+  if (schema != "hameritt/mission") {
+    throw ConfigError(file + ": schema: expected \"hameritt/mission\", got \"" + schema + "\"");
+  }
+  const std::int64_t version = root.integer("schema_version");
+  if (version != kSchemaVersion) {
+    throw ConfigError(file + ": schema_version: expected " + std::to_string(kSchemaVersion) +
+                      ", got " + std::to_string(version));
+  }
+  m.scenario_id = root.string("scenario_id");
+  const std::string cls = root.string("class");
+  if (!parseScenarioClass(cls, &m.cls)) {
+    throw ConfigError(file + ": class: expected area_search, route_search or pursuit, got \"" +
+                      cls + "\"");
+  }
+  m.seed = root.unsignedInteger("seed");
+  {
+    Obj frame = root.object("frame");
+    const std::string type = frame.string("type");
+    if (type != "ENU") frame.error("type", "expected \"ENU\", got \"" + type + "\"");
+    const std::string units = frame.string("units");
+    if (units != "m") frame.error("units", "expected \"m\", got \"" + units + "\"");
+    Obj origin = frame.object("origin");
+    m.origin.latitude = origin.number("latitude");
+    if (!(m.origin.latitude >= -90 && m.origin.latitude <= 90)) {
+      origin.error("latitude", "expected degrees in [-90, 90], got " + fmt(m.origin.latitude));
+    }
+    m.origin.longitude = origin.number("longitude");
+    if (!(m.origin.longitude >= -180 && m.origin.longitude <= 180)) {
+      origin.error("longitude", "expected degrees in [-180, 180], got " + fmt(m.origin.longitude));
+    }
+    m.origin.altitude = origin.number("altitude");
+    origin.finish();
+    frame.finish();
+  }
+  m.time_limit = root.number("time_limit");
+  if (!(m.time_limit > 0)) root.error("time_limit", "expected a positive number, got " +
+                                                        fmt(m.time_limit));
+  {
+    Obj obj = root.object("objective");
+    m.objective.type = obj.string("type");
+    if (m.objective.type != "find" && m.objective.type != "track") {
+      obj.error("type", "expected \"find\" or \"track\", got \"" + m.objective.type + "\"");
+    }
+    m.objective.text = obj.string("text");
+    const json& targets = obj.array("targets");
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      m.objective.targets.push_back(readTarget(targets[i], idx("objective.targets", i), file));
+    }
+    obj.finish();
+  }
+  const json& aois = root.array("areas_of_interest");
+  for (std::size_t i = 0; i < aois.size(); ++i) {
+    Obj o(aois[i], idx("areas_of_interest", i), file);
+    AreaOfInterest a;
+    a.id = o.string("id");
+    a.polygon = polygon(o, "polygon");
+    a.window = window(o);
+    o.finish();
+    m.aois.push_back(std::move(a));
+  }
+  const json& kozs = root.array("keep_out_zones");
+  for (std::size_t i = 0; i < kozs.size(); ++i) {
+    m.kozs.push_back(readKoz(kozs[i], idx("keep_out_zones", i), file));
+  }
+  const json& priors = root.array("area_priors");
+  for (std::size_t i = 0; i < priors.size(); ++i) {
+    m.priors.push_back(readPrior(priors[i], idx("area_priors", i), file));
+  }
+  const json& routes = root.array("routes");
+  for (std::size_t i = 0; i < routes.size(); ++i) {
+    m.routes.push_back(readRoute(routes[i], idx("routes", i), file));
+  }
+  const json& rels = root.array("scene_relations");
+  for (std::size_t i = 0; i < rels.size(); ++i) {
+    m.relations.push_back(readRelation(rels[i], idx("scene_relations", i), file));
+  }
+  root.finish();
+  return m;
+}
+
+Mission loadMission(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open file");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw ConfigError(path + ": malformed JSON: " + e.what());
+  }
+  return missionFromJson(j, path);
+}
+
+}  // namespace hameritt::scenario
