@@ -1,0 +1,234 @@
+#include "hameritt/planning/validity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "hameritt/geometry/segment.h"
+#include "hameritt/scenario/error.h"
+
+namespace hameritt::planning {
+
+using geometry::Vec2;
+using geometry::Vec3;
+
+namespace {
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.17g", v);
+  return buf;
+}
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Distance in the plane from the segment [a, b] to the polygon region (0 when they touch).
+double segmentPolygonDistance(const geometry::Polygon& poly, const Vec2& a, const Vec2& b) {
+  if (poly.intersectsSegment(a, b)) return 0.0;
+  const auto& v = poly.vertices();
+  double d = kInf;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    d = std::min(d, geometry::segmentSegmentDistance(a, b, v[i], v[(i + 1) % v.size()]));
+  }
+  return d;
+}
+
+geometry::OrientedBox inflate(const geometry::OrientedBox& b, double m) {
+  geometry::OrientedBox o = b;
+  o.size += Vec3(2 * m, 2 * m, 2 * m);
+  return o;
+}
+
+// Intersects [*lo, *hi] with the parameters u in [0, 1] where f(u) = fa + (fb - fa) u lies in
+// [flo, fhi].
+void clip(double fa, double fb, double flo, double fhi, double* lo, double* hi) {
+  const double d = fb - fa;
+  if (std::abs(d) < 1e-12) {
+    if (fa < flo || fa > fhi) *hi = -1.0;  // empty
+    return;
+  }
+  double u0 = (flo - fa) / d, u1 = (fhi - fa) / d;
+  if (u0 > u1) std::swap(u0, u1);
+  *lo = std::max(*lo, u0);
+  *hi = std::min(*hi, u1);
+}
+
+}  // namespace
+
+void ValiditySettings::validate() const {
+  if (!(margin >= 0.1 && margin <= 20.0)) {
+    throw scenario::ConfigError("planning.margin: expected metres in [0.1, 20], got " +
+                                fmt(margin));
+  }
+  if (!(altitude_min >= 0.0 && std::isfinite(altitude_min))) {
+    throw scenario::ConfigError("planning.altitude_min: expected a finite number >= 0, got " +
+                                fmt(altitude_min));
+  }
+  if (!(altitude_max > altitude_min && std::isfinite(altitude_max))) {
+    throw scenario::ConfigError("planning.altitude_max: expected a finite number > altitude_min (" +
+                                fmt(altitude_min) + "), got " + fmt(altitude_max));
+  }
+}
+
+ValiditySettings validitySettingsFor(const scenario::UavSpec& uav, double margin) {
+  ValiditySettings s;
+  s.margin = margin;
+  s.altitude_min = uav.altitude_min;
+  s.altitude_max = uav.altitude_max;
+  return s;
+}
+
+WorldValidity::WorldValidity(const scenario::World& world, const scenario::Mission& mission,
+                             const ValiditySettings& settings)
+    : WorldValidity(world, mission.kozs, settings) {}
+
+WorldValidity::WorldValidity(const scenario::World& world, std::vector<scenario::KeepOutZone> kozs,
+                             const ValiditySettings& settings)
+    : world_(world), kozs_(std::move(kozs)), settings_(settings), bounds_(world.bounds()) {
+  settings_.validate();
+  const auto& occ = world.occluders();
+  for (std::size_t i = 0; i < occ.size(); ++i) {
+    inflated_.add(inflate(occ.box(static_cast<int>(i)), settings_.margin));
+  }
+  inflated_.build();
+  for (std::size_t i = 0; i < kozs_.size(); ++i) {
+    if (kozs_[i].polygon.size() < 3) {
+      throw scenario::ConfigError("planning.keep_out_zones[" + std::to_string(i) +
+                                  "].polygon: expected at least 3 vertices");
+    }
+    geometry::Aabb2 b = kozs_[i].polygon.bounds();
+    b.min -= Vec2(settings_.margin, settings_.margin);
+    b.max += Vec2(settings_.margin, settings_.margin);
+    koz_bounds_.push_back(b);
+  }
+}
+
+bool WorldValidity::hasTimedKozs() const {
+  for (const auto& k : kozs_) {
+    if (!k.window.unbounded()) return true;
+  }
+  return false;
+}
+
+bool WorldValidity::staticValid(const Vec3& p, double slack) const {
+  if (!p.allFinite()) return false;
+  if (p.z() < settings_.altitude_min || p.z() > settings_.altitude_max) return false;
+  if (!bounds_.contains(p.head<2>())) return false;
+  const Vec2 q = p.head<2>();
+  for (int i : inflated_.candidates(geometry::Aabb2{q, q})) {
+    geometry::OrientedBox b = inflated_.box(i);
+    if (slack > 0) b.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
+    if (b.contains(p)) return false;
+  }
+  return true;
+}
+
+bool WorldValidity::staticSegmentValid(const Vec3& a, const Vec3& b, double slack) const {
+  // The band and the bounds are convex: the endpoints decide.
+  if (!staticValid(a, slack) || !staticValid(b, slack)) return false;
+  if (slack <= 0) return inflated_.clear(a, b);
+  geometry::Aabb2 box{a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())};
+  for (int i : inflated_.candidates(box)) {
+    geometry::OrientedBox o = inflated_.box(i);
+    o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
+    if (o.intersectsSegment(a, b)) return false;
+  }
+  return true;
+}
+
+bool WorldValidity::kozSegmentHit(const scenario::KeepOutZone& k, std::size_t i, const Vec3& a,
+                                  const Vec3& b, double u0, double u1, double slack) const {
+  const double m = std::max(0.0, settings_.margin - slack);
+  const double zlo = k.alt_min ? *k.alt_min - m : -kInf;
+  const double zhi = k.alt_max ? *k.alt_max + m : kInf;
+  clip(a.z(), b.z(), zlo, zhi, &u0, &u1);
+  if (u0 > u1) return false;
+  const Vec3 pa = a + (b - a) * u0, pb = a + (b - a) * u1;
+  const Vec2 qa = pa.head<2>(), qb = pb.head<2>();
+  const geometry::Aabb2 sb{qa.cwiseMin(qb), qa.cwiseMax(qb)};
+  if (!sb.overlaps(koz_bounds_[i])) return false;
+  return segmentPolygonDistance(k.polygon, qa, qb) <= m;
+}
+
+bool WorldValidity::kozClear(const Vec3& p, double t0, double t1, double slack) const {
+  return kozSegmentClearDuring(p, p, t0, t1, slack);
+}
+
+bool WorldValidity::kozSegmentClear(const Vec3& a, const Vec3& b, double ta, double tb,
+                                    double slack) const {
+  for (std::size_t i = 0; i < kozs_.size(); ++i) {
+    const auto& k = kozs_[i];
+    double u0 = 0.0, u1 = 1.0;
+    clip(ta, tb, k.window.net ? *k.window.net : -kInf, k.window.nlt ? *k.window.nlt : kInf, &u0,
+         &u1);
+    if (u0 > u1) continue;
+    if (kozSegmentHit(k, i, a, b, u0, u1, slack)) return false;
+  }
+  return true;
+}
+
+bool WorldValidity::kozSegmentClearDuring(const Vec3& a, const Vec3& b, double t0, double t1,
+                                          double slack) const {
+  for (std::size_t i = 0; i < kozs_.size(); ++i) {
+    const auto& k = kozs_[i];
+    if (!k.window.overlaps(t0, t1)) continue;
+    if (kozSegmentHit(k, i, a, b, 0.0, 1.0, slack)) return false;
+  }
+  return true;
+}
+
+std::string WorldValidity::explain(const Vec3& p, double t) const {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "(%.3f, %.3f, %.3f) at t = %.3f s", p.x(), p.y(), p.z(), t);
+  const std::string where = buf;
+  if (!p.allFinite()) return where + ": not finite";
+  if (p.z() < settings_.altitude_min || p.z() > settings_.altitude_max) {
+    return where + ": outside the altitude band [" + fmt(settings_.altitude_min) + ", " +
+           fmt(settings_.altitude_max) + "]";
+  }
+  if (!bounds_.contains(p.head<2>())) return where + ": outside the neighborhood bounds";
+  const Vec2 q = p.head<2>();
+  for (int i : inflated_.candidates(geometry::Aabb2{q, q})) {
+    if (inflated_.box(i).contains(p)) {
+      return where + ": inside the box of " + world_.entities()[static_cast<std::size_t>(
+                                                  world_.occluderOwner(i))].id +
+             " inflated by " + fmt(settings_.margin) + " m";
+    }
+  }
+  for (std::size_t i = 0; i < kozs_.size(); ++i) {
+    if (kozs_[i].window.active(t) && kozSegmentHit(kozs_[i], i, p, p, 0.0, 1.0, 0.0)) {
+      return where + ": inside keep-out zone " + kozs_[i].id + " (active)";
+    }
+  }
+  return "";
+}
+
+std::string WorldValidity::checkTrajectory(const scenario::Trajectory& traj, double max_step,
+                                           double slack) const {
+  if (traj.empty()) return "empty trajectory";
+  auto pos = [](const scenario::TrajectoryPoint& p) { return Vec3(p.x, p.y, p.z); };
+  if (!staticValid(pos(traj[0]), slack) || !kozClear(pos(traj[0]), traj[0].t, traj[0].t, slack)) {
+    return "sample 0: " + explain(pos(traj[0]), traj[0].t);
+  }
+  for (std::size_t i = 1; i < traj.size(); ++i) {
+    const Vec3 a = pos(traj[i - 1]), b = pos(traj[i]);
+    const double ta = traj[i - 1].t, tb = traj[i].t;
+    if (!(tb > ta)) return "sample " + std::to_string(i) + ": time not increasing";
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / max_step)));
+    for (int k = 0; k < n; ++k) {
+      const double u0 = static_cast<double>(k) / n, u1 = static_cast<double>(k + 1) / n;
+      const Vec3 p0 = a + (b - a) * u0, p1 = a + (b - a) * u1;
+      const double t0 = ta + (tb - ta) * u0, t1 = ta + (tb - ta) * u1;
+      if (!staticSegmentValid(p0, p1, slack) || !kozSegmentClear(p0, p1, t0, t1, slack)) {
+        std::string why = explain(p1, t1);
+        if (why.empty()) why = explain(p0, t0);
+        if (why.empty()) why = "segment crosses an obstacle or an active keep-out zone";
+        return "segment " + std::to_string(i - 1) + "-" + std::to_string(i) + ": " + why;
+      }
+    }
+  }
+  return "";
+}
+
+}  // namespace hameritt::planning

@@ -1,0 +1,364 @@
+#include "hameritt/planning/vehicle_routes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <queue>
+
+#include <ompl/base/ScopedState.h>
+#include <ompl/base/spaces/DubinsStateSpace.h>
+
+#include "hameritt/geometry/oriented_box.h"
+#include "hameritt/geometry/segment.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/rng.h"
+#include "ompl_glue.h"
+
+namespace hameritt::planning {
+
+namespace ob = ompl::base;
+using geometry::Vec2;
+using scenario::World;
+
+namespace {
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.17g", v);
+  return buf;
+}
+
+struct Pose {
+  Vec2 p;
+  double yaw;
+};
+
+// The edge nearest p and whether a car heading `yaw` drives it from a to b.
+int nearestEdge(const World& w, const Vec2& p, double* dist) {
+  int best = -1;
+  *dist = std::numeric_limits<double>::infinity();
+  for (std::size_t e = 0; e < w.edges().size(); ++e) {
+    const auto& ed = w.edges()[e];
+    const double d = geometry::pointSegmentDistance(p, w.nodes()[ed.a].position,
+                                                    w.nodes()[ed.b].position);
+    if (d < *dist) {
+      *dist = d;
+      best = static_cast<int>(e);
+    }
+  }
+  return best;
+}
+
+// Directed traversal of an edge: from node u to node v.
+struct Leg {
+  int edge, u, v;
+};
+
+Leg directed(const World& w, int e, double yaw) {
+  const auto& ed = w.edges()[static_cast<std::size_t>(e)];
+  const Vec2 d = w.nodes()[ed.b].position - w.nodes()[ed.a].position;
+  const bool forward = std::cos(yaw - std::atan2(d.y(), d.x())) >= 0;
+  return forward ? Leg{e, ed.a, ed.b} : Leg{e, ed.b, ed.a};
+}
+
+// Lane start and end poses of a directed edge.
+std::pair<Pose, Pose> lane(const World& w, const Leg& l, const RouteSettings& s) {
+  const Vec2 a = w.nodes()[l.u].position, b = w.nodes()[l.v].position;
+  const double len = (b - a).norm();
+  const Vec2 d = (b - a) / len, n(d.y(), -d.x());
+  const double c = std::min(s.corner_clearance, 0.45 * len);
+  const double yaw = std::atan2(d.y(), d.x());
+  return {Pose{a + d * c + n * s.lane_offset, yaw}, Pose{b - d * c + n * s.lane_offset, yaw}};
+}
+
+// Arc length along the directed edge of the projection of p.
+double along(const World& w, const Leg& l, const Vec2& p) {
+  const Vec2 a = w.nodes()[l.u].position, b = w.nodes()[l.v].position;
+  return (p - a).dot((b - a).normalized());
+}
+
+// Dijkstra over the street graph from `from` (arriving over edge `in_edge`, no U-turn onto it)
+// to `to` (not arriving over `out_edge`, the edge it leaves by), with seeded noisy costs. Returns the node sequence, empty when unreachable.
+std::vector<int> search(const World& w, int from, int in_edge, int to, std::uint64_t seed,
+                        double noise, int out_edge) {
+  scenario::Rng rng(seed);
+  std::vector<double> cost(w.edges().size());
+  for (std::size_t e = 0; e < cost.size(); ++e) {
+    const auto& ed = w.edges()[e];
+    cost[e] = (w.nodes()[ed.b].position - w.nodes()[ed.a].position).norm() * (1 + noise * rng.unit());
+  }
+  // State: (node, edge it was entered by) so that U-turns can be excluded.
+  const std::size_t ne = w.edges().size();
+  auto key = [&](int node, int edge) {
+    return static_cast<std::size_t>(node) * (ne + 1) + static_cast<std::size_t>(edge + 1);
+  };
+  std::vector<double> dist(w.nodes().size() * (ne + 1), std::numeric_limits<double>::infinity());
+  std::vector<std::pair<int, int>> prev(dist.size(), {-1, -1});
+  using Item = std::tuple<double, int, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
+  dist[key(from, in_edge)] = 0;
+  pq.emplace(0.0, from, in_edge);
+  int found_edge = -2;
+  while (!pq.empty()) {
+    const auto [d, u, ein] = pq.top();
+    pq.pop();
+    if (d > dist[key(u, ein)]) continue;
+    if (u == to && (ein != out_edge || ein < 0)) {
+      found_edge = ein;
+      break;
+    }
+    for (int e : w.adjacency()[static_cast<std::size_t>(u)]) {
+      if (e == ein) continue;  // no U-turns
+      const auto& ed = w.edges()[static_cast<std::size_t>(e)];
+      const int v = ed.a == u ? ed.b : ed.a;
+      const double nd = d + cost[static_cast<std::size_t>(e)];
+      if (nd < dist[key(v, e)]) {
+        dist[key(v, e)] = nd;
+        prev[key(v, e)] = {u, ein};
+        pq.emplace(nd, v, e);
+      }
+    }
+  }
+  if (found_edge == -2) return {};
+  std::vector<int> nodes;
+  int n = to, e = found_edge;
+  while (n != -1) {
+    nodes.push_back(n);
+    const auto p = prev[key(n, e)];
+    n = p.first;
+    e = p.second;
+  }
+  std::reverse(nodes.begin(), nodes.end());
+  return nodes;
+}
+
+int edgeBetween(const World& w, int u, int v) {
+  for (int e : w.adjacency()[static_cast<std::size_t>(u)]) {
+    const auto& ed = w.edges()[static_cast<std::size_t>(e)];
+    if ((ed.a == u && ed.b == v) || (ed.a == v && ed.b == u)) return e;
+  }
+  return -1;
+}
+
+// The car's footprint at a pose is on the street and clear of parked cars.
+bool carValid(const World& w, const Pose& q, const RouteSettings& s) {
+  const Vec2 fwd(std::cos(q.yaw), std::sin(q.yaw)), left(-fwd.y(), fwd.x());
+  for (double a : {-0.5, 0.5}) {
+    for (double b : {-0.5, 0.5}) {
+      const Vec2 c = q.p + fwd * (a * s.vehicle_length) + left * (b * s.vehicle_width);
+      if (!onStreet(w, c)) return false;
+    }
+  }
+  if (!onStreet(w, q.p)) return false;
+  geometry::OrientedBox car;
+  car.center = geometry::Vec3(q.p.x(), q.p.y(), 0.8);
+  car.size = geometry::Vec3(s.vehicle_length, s.vehicle_width, 1.6);
+  car.yaw = q.yaw;
+  const auto& occ = w.occluders();
+  for (int i : occ.near(q.p, 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1)) {
+    if (geometry::footprintsOverlap(car, occ.box(i))) return false;
+  }
+  return true;
+}
+
+// Dense Dubins samples (every <= 0.25 m) from a to b, or empty when some sample is invalid.
+std::vector<Pose> dubins(const World& w, const Pose& a, const Pose& b, double radius,
+                         const RouteSettings& s) {
+  auto space = std::make_shared<ob::DubinsStateSpace>(radius);
+  ob::ScopedState<ob::DubinsStateSpace> sa(space), sb(space), x(space);
+  sa->setXY(a.p.x(), a.p.y());
+  sa->setYaw(a.yaw);
+  sb->setXY(b.p.x(), b.p.y());
+  sb->setYaw(b.yaw);
+  const double len = space->distance(sa.get(), sb.get());
+  const int n = std::max(1, static_cast<int>(std::ceil(len / 0.25)));
+  std::vector<Pose> out;
+  out.reserve(static_cast<std::size_t>(n) + 1);
+  for (int k = 0; k <= n; ++k) {
+    space->interpolate(sa.get(), sb.get(), static_cast<double>(k) / n, x.get());
+    const Pose q{Vec2(x->getX(), x->getY()), x->getYaw()};
+    if (!carValid(w, q, s)) return {};
+    out.push_back(q);
+  }
+  return out;
+}
+
+}  // namespace
+
+void SpeedProfile::validate() const {
+  auto need = [](double v, const char* f) {
+    if (!(v > 0 && std::isfinite(v))) {
+      throw scenario::ConfigError(std::string("route.speed.") + f +
+                                  ": expected a positive finite number, got " + fmt(v));
+    }
+  };
+  need(cruise_speed, "cruise_speed");
+  need(accel, "accel");
+  need(decel, "decel");
+  need(corner_speed, "corner_speed");
+  if (corner_speed > cruise_speed) {
+    throw scenario::ConfigError("route.speed.corner_speed: expected at most cruise_speed (" +
+                                fmt(cruise_speed) + "), got " + fmt(corner_speed));
+  }
+}
+
+void RouteSettings::validate() const {
+  auto need = [](bool ok, const char* f, const std::string& what, double v) {
+    if (!ok) throw scenario::ConfigError(std::string("route.") + f + ": expected " + what + ", got " + fmt(v));
+  };
+  need(lane_offset >= 0 && lane_offset < 10, "lane_offset", "metres in [0, 10)", lane_offset);
+  need(corner_clearance > 0 && corner_clearance < 50, "corner_clearance", "metres in (0, 50)",
+       corner_clearance);
+  need(turn_radius > 0.5 && turn_radius < 50, "turn_radius", "metres in (0.5, 50)", turn_radius);
+  need(cost_noise >= 0 && cost_noise <= 10, "cost_noise", "a number in [0, 10]", cost_noise);
+  need(vehicle_length > 0 && vehicle_length < 20, "vehicle_length", "metres in (0, 20)", vehicle_length);
+  need(vehicle_width > 0 && vehicle_width < 5, "vehicle_width", "metres in (0, 5)", vehicle_width);
+  need(sample_spacing >= 0.25 && sample_spacing <= 50, "sample_spacing", "metres in [0.25, 50]",
+       sample_spacing);
+}
+
+bool onStreet(const World& w, const Vec2& p, double shrink) {
+  for (const auto& ed : w.edges()) {
+    if (geometry::pointSegmentDistance(p, w.nodes()[ed.a].position, w.nodes()[ed.b].position) <=
+        ed.width / 2 - shrink) {
+      return true;
+    }
+  }
+  return false;
+}
+
+RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& start,
+                             const RouteGoal& goal, std::uint64_t seed, const SpeedProfile& speed,
+                             const RouteSettings& s) {
+  speed.validate();
+  s.validate();
+  detail::silenceOmplOnce();
+  RouteResult r;
+  const Pose sp{Vec2(start.x, start.y), start.yaw};
+  double d = 0;
+  const int e0 = nearestEdge(w, sp.p, &d);
+  if (e0 < 0 || !carValid(w, sp, s)) {
+    r.status = PlanStatus::kInvalidStart;
+    r.message = "start (" + fmt(start.x) + ", " + fmt(start.y) + ") is not a clear pose on a street";
+    return r;
+  }
+  const Leg first = directed(w, e0, sp.yaw);
+  int goal_node = goal.node;
+  std::optional<Pose> gp;
+  Leg last{-1, -1, -1};
+  if (goal.pose) {
+    gp = Pose{Vec2(goal.pose->x, goal.pose->y), goal.pose->yaw};
+    double gd = 0;
+    const int ge = nearestEdge(w, gp->p, &gd);
+    if (ge < 0 || !carValid(w, *gp, s)) {
+      r.status = PlanStatus::kInvalidGoal;
+      r.message = "goal pose (" + fmt(gp->p.x()) + ", " + fmt(gp->p.y()) +
+                  ") is not a clear pose on a street";
+      return r;
+    }
+    last = directed(w, ge, gp->yaw);
+    goal_node = last.u;
+  } else if (goal_node < 0 || goal_node >= static_cast<int>(w.nodes().size())) {
+    r.status = PlanStatus::kInvalidGoal;
+    r.message = "goal node " + std::to_string(goal.node) + " does not exist (" +
+                std::to_string(w.nodes().size()) + " nodes)";
+    return r;
+  }
+  // Node sequence.
+  std::vector<int> nodes;
+  const bool same_leg = gp && last.edge == first.edge && last.u == first.u &&
+                        along(w, first, gp->p) > along(w, first, sp.p) + 1.0;
+  if (same_leg) {
+    nodes = {};
+  } else {
+    nodes = search(w, first.v, first.edge, goal_node, seed, s.cost_noise, gp ? last.edge : -1);
+    if (nodes.empty()) {
+      r.status = PlanStatus::kNoSolution;
+      r.message = "goal node " + std::to_string(goal_node) + " is unreachable without a U-turn";
+      return r;
+    }
+    if (gp) {
+      // The last node must lead onto the goal's edge in its direction; and not by a U-turn.
+      const int prev_edge = nodes.size() >= 2 ? edgeBetween(w, nodes[nodes.size() - 2], nodes.back())
+                                              : first.edge;
+      if (prev_edge == last.edge) {
+        r.status = PlanStatus::kNoSolution;
+        r.message = "goal pose needs a U-turn";
+        return r;
+      }
+    }
+  }
+  // Lane waypoints.
+  std::vector<Pose> wps{sp};
+  if (same_leg) {
+    wps.push_back(*gp);
+  } else {
+    const auto l0 = lane(w, first, s);
+    if (along(w, first, l0.second.p) > along(w, first, sp.p) + 0.5) wps.push_back(l0.second);
+    for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+      const Leg l{edgeBetween(w, nodes[i], nodes[i + 1]), nodes[i], nodes[i + 1]};
+      const auto ln = lane(w, l, s);
+      wps.push_back(ln.first);
+      wps.push_back(ln.second);
+    }
+    if (gp) {
+      const auto ln = lane(w, last, s);
+      if (along(w, last, gp->p) > along(w, last, ln.first.p) + 0.5) wps.push_back(ln.first);
+      wps.push_back(*gp);
+    }
+  }
+  r.nodes = nodes;
+  // Dubins connections, validated densely.
+  std::vector<Pose> dense{wps.front()};
+  for (std::size_t i = 1; i < wps.size(); ++i) {
+    std::vector<Pose> piece;
+    for (double radius : {s.turn_radius, 0.7 * s.turn_radius, 0.5 * s.turn_radius}) {
+      piece = dubins(w, wps[i - 1], wps[i], radius, s);
+      if (!piece.empty()) break;
+    }
+    if (piece.empty()) {
+      r.status = PlanStatus::kNoSolution;
+      r.message = "no valid Dubins curve from (" + fmt(wps[i - 1].p.x()) + ", " +
+                  fmt(wps[i - 1].p.y()) + ") to (" + fmt(wps[i].p.x()) + ", " + fmt(wps[i].p.y()) +
+                  ") on the street surface";
+      return r;
+    }
+    dense.insert(dense.end(), piece.begin() + 1, piece.end());
+  }
+  // Speed profile over the dense samples: corner speed where the heading turns faster than
+  // 1 rad per 25 m, cruise elsewhere; acceleration forward, braking backward; rest at both ends.
+  const std::size_t n = dense.size();
+  std::vector<double> ds(n, 0.0), cap(n, speed.cruise_speed), v(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) ds[i] = (dense[i].p - dense[i - 1].p).norm();
+  for (std::size_t i = 1; i < n; ++i) {
+    const double turn = std::abs(geometry::wrapPi(dense[i].yaw - dense[i - 1].yaw));
+    if (ds[i] > 1e-9 && turn / ds[i] > 1.0 / 25.0) cap[i] = cap[i - 1] = speed.corner_speed;
+  }
+  for (std::size_t i = 1; i + 1 < n; ++i) v[i] = cap[i];
+  for (std::size_t i = 1; i < n; ++i) v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * speed.accel * ds[i]));
+  for (std::size_t i = n - 1; i-- > 0;) v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * speed.decel * ds[i + 1]));
+  using scenario::roundMilli;
+  double t = start.t, since = 0.0;
+  r.trajectory.push_back({roundMilli(t), roundMilli(dense[0].p.x()), roundMilli(dense[0].p.y()),
+                          0.0, roundMilli(dense[0].yaw)});
+  for (std::size_t i = 1; i < n; ++i) {
+    const double vv = v[i - 1] + v[i];
+    t += vv > 1e-9 ? 2 * ds[i] / vv : 0.0;
+    r.length += ds[i];
+    since += ds[i];
+    const bool curve = cap[i] < speed.cruise_speed;
+    if (i + 1 == n || since >= (curve ? 0.5 : s.sample_spacing) - 1e-9) {
+      scenario::TrajectoryPoint p{roundMilli(t), roundMilli(dense[i].p.x()),
+                                  roundMilli(dense[i].p.y()), 0.0, roundMilli(dense[i].yaw)};
+      if (!(p.t > r.trajectory.back().t)) p.t = roundMilli(r.trajectory.back().t + 1e-3);
+      r.trajectory.push_back(p);
+      since = 0.0;
+    }
+  }
+  r.status = PlanStatus::kExact;
+  r.message = "exact solution";
+  return r;
+}
+
+}  // namespace hameritt::planning
