@@ -19,7 +19,7 @@ HAMERITT_PACKAGES=(
   libgtest-dev googletest
   libnav-msgs-dev libsensor-msgs-dev libros-rosgraph-msgs-dev libtf2-dev libtf2-ros-dev
   libeigen3-dev nlohmann-json3-dev libopencv-dev
-  libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev
+  libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev libompl-dev
   python3-jsonschema python3-rospy python3-nav-msgs python3-rosgraph-msgs
   python3-geometry-msgs python3-std-msgs python3-actionlib-msgs
 )

@@ -116,4 +116,22 @@ geometry_msgs::TransformStamped toEntityTransform(const sim::EntityState& e, con
   return t;
 }
 
+nav_msgs::Path toPathMsg(const scenario::Trajectory& path, const ros::Time& stamp) {
+  nav_msgs::Path m;
+  m.header.stamp = stamp;
+  m.header.frame_id = kMapFrame;
+  m.poses.reserve(path.size());
+  for (const auto& p : path) {
+    geometry_msgs::PoseStamped ps;
+    ps.header.stamp.fromSec(p.t);
+    ps.header.frame_id = kMapFrame;
+    ps.pose.position.x = p.x;
+    ps.pose.position.y = p.y;
+    ps.pose.position.z = p.z;
+    ps.pose.orientation = yawQuat(p.yaw);
+    m.poses.push_back(ps);
+  }
+  return m;
+}
+
 }  // namespace hameritt::ros_wrappers

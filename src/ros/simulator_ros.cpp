@@ -60,13 +60,7 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 
   config_ = scenario::loadSimConfig(sim_config);
   if (duration_ <= 0) duration_ = config_.duration;
-  world_ = std::make_unique<scenario::World>(scenario::generateWorld(config_.world));
-  if (world_->fingerprint() != config_.world_fingerprint) {
-    throw scenario::ConfigError(sim_config + ": world.fingerprint: expected " +
-                                scenario::hex64(world_->fingerprint()) +
-                                " for these world parameters, got " +
-                                scenario::hex64(config_.world_fingerprint));
-  }
+  world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(config_, sim_config));
   sim_ = std::make_unique<sim::Simulator>(*world_, config_, sim::loadQuadrotorUrdf(urdf), settings);
 
   clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);

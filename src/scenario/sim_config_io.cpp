@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "hameritt/scenario/error.h"
+#include "hameritt/scenario/scenario_io.h"
 #include "hameritt/scenario/params_table.h"
 
 namespace hameritt::scenario {
@@ -388,6 +389,15 @@ SimConfig loadSimConfig(const std::string& path) {
     throw ConfigError(path + ": malformed JSON: " + e.what());
   }
   return simConfigFromJson(j, path);
+}
+
+World generateCheckedWorld(const SimConfig& config, const std::string& file) {
+  World world = generateWorld(config.world);
+  if (world.fingerprint() != config.world_fingerprint) {
+    throw ConfigError(file + ": world.fingerprint: expected " + hex64(world.fingerprint()) +
+                      " for these world parameters, got " + hex64(config.world_fingerprint));
+  }
+  return world;
 }
 
 }  // namespace hameritt::scenario

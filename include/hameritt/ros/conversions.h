@@ -3,6 +3,7 @@
 
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
+#include <nav_msgs/Path.h>
 #include <sensor_msgs/Imu.h>
 
 #include "hameritt/EntityState.h"
@@ -27,5 +28,8 @@ geometry_msgs::TransformStamped toCameraTransform(const scenario::CameraSpec& c,
 hameritt::EntityState toMsg(const sim::EntityState& e, const ros::Time& stamp);
 // map -> <entity id>.
 geometry_msgs::TransformStamped toEntityTransform(const sim::EntityState& e, const ros::Time& stamp);
+
+// A timed path as nav_msgs/Path in map: each pose stamped with its sim time, yaw-only.
+nav_msgs::Path toPathMsg(const scenario::Trajectory& path, const ros::Time& stamp);
 
 }  // namespace hameritt::ros_wrappers

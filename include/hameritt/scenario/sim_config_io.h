@@ -7,6 +7,7 @@
 #include <string>
 
 #include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
 
 namespace hameritt::scenario {
 
@@ -21,5 +22,9 @@ SimConfig simConfigFromJson(const nlohmann::json& j, const std::string& file);
 // Reads and parses a sim_config.json file (ConfigError on I/O or syntax errors, with the file),
 // keeping key order.
 SimConfig loadSimConfig(const std::string& path);
+
+// Regenerates the neighborhood from the sim_config's world parameters and checks it against the
+// recorded fingerprint (ConfigError naming `file` and world.fingerprint on a mismatch).
+World generateCheckedWorld(const SimConfig& config, const std::string& file);
 
 }  // namespace hameritt::scenario
