@@ -12,6 +12,8 @@
 
 #include "hameritt/CrashEvent.h"
 #include "hameritt/FollowProgress.h"
+#include "hameritt/SetPaused.h"
+#include "hameritt/StepSimulation.h"
 #include "hameritt/geometry/polygon.h"
 #include "hameritt/scenario/mission_io.h"
 
@@ -31,11 +33,20 @@ class FollowerClient {
     waypoints_pub_ = nh_.advertise<nav_msgs::Path>("/planner/waypoints", 1, true);
   }
 
-  // Waits for odometry and for the follower to listen; returns the UAV's start.
+  // The simulator starts paused (simulator.launch start_paused:=true) so that sim time does not
+  // depend on how long this process takes to start: steps once for an odometry message, waits
+  // for the follower to listen, and returns the UAV's start.
   geometry::Vec3 connect() {
+    EXPECT_TRUE(ros::service::waitForService("/simulator/step", ros::Duration(60)));
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(60);
-    while ((flight.empty() || waypoints_pub_.getNumSubscribers() == 0) &&
+    while ((odom_sub_.getNumPublishers() == 0 || waypoints_pub_.getNumSubscribers() == 0) &&
            ros::WallTime::now() < until) {
+      ros::WallDuration(0.01).sleep();
+    }
+    hameritt::StepSimulation step;
+    step.request.steps = 1;
+    EXPECT_TRUE(ros::service::call("/simulator/step", step)) << "step";
+    while (flight.empty() && ros::WallTime::now() < until) {
       ros::spinOnce();
       ros::WallDuration(0.01).sleep();
     }
@@ -43,6 +54,7 @@ class FollowerClient {
     return flight.empty() ? geometry::Vec3::Zero() : flight.back().p;
   }
 
+  // Sends the waypoints, waits until the follower has planned, then lets time run.
   void send(const std::vector<geometry::Vec3>& waypoints) {
     nav_msgs::Path path;
     path.header.frame_id = "map";
@@ -56,6 +68,15 @@ class FollowerClient {
       path.poses.push_back(p);
     }
     waypoints_pub_.publish(path);
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(60);
+    while (progress.state != "following" && progress.state != "failed" &&
+           ros::WallTime::now() < until) {
+      ros::spinOnce();
+      ros::WallDuration(0.005).sleep();
+    }
+    hameritt::SetPaused run;
+    run.request.paused = false;
+    EXPECT_TRUE(ros::service::call("/simulator/set_paused", run)) << "resume";
   }
 
   // Spins until the follower reports done or failed, or the wall-clock limit passes.
