@@ -141,16 +141,69 @@ int edgeBetween(const World& w, int u, int v) {
   return -1;
 }
 
+// Street edges bucketed on a square grid: a point within half a street width of an edge lies
+// in a cell that the edge's widened bounding box touches, so one cell's edges answer
+// onStreet() exactly as the scan over every edge does.
+class StreetIndex {
+ public:
+  explicit StreetIndex(const World& w, double cell_size = 25.0) : w_(w), cell_(cell_size) {
+    const auto b = w.bounds();
+    x0_ = b.min.x() - cell_;
+    y0_ = b.min.y() - cell_;
+    nx_ = static_cast<int>(std::ceil((b.max.x() - x0_) / cell_)) + 2;
+    ny_ = static_cast<int>(std::ceil((b.max.y() - y0_) / cell_)) + 2;
+    cells_.resize(static_cast<std::size_t>(nx_ * ny_));
+    for (std::size_t e = 0; e < w.edges().size(); ++e) {
+      const auto& ed = w.edges()[e];
+      const Vec2 a = w.nodes()[ed.a].position, c = w.nodes()[ed.b].position;
+      const double h = ed.width / 2;
+      const int i0 = cellX(std::min(a.x(), c.x()) - h), i1 = cellX(std::max(a.x(), c.x()) + h);
+      const int j0 = cellY(std::min(a.y(), c.y()) - h), j1 = cellY(std::max(a.y(), c.y()) + h);
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) cell(i, j).push_back(static_cast<int>(e));
+      }
+    }
+  }
+  // Same answer as planning::onStreet(w, p) (shrink 0); points off the grid fall back to it.
+  bool onStreet(const Vec2& p) const {
+    const double fx = (p.x() - x0_) / cell_, fy = (p.y() - y0_) / cell_;
+    if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return planning::onStreet(w_, p);
+    const std::size_t c = static_cast<std::size_t>(static_cast<int>(fy) * nx_ + static_cast<int>(fx));
+    for (int e : cells_[c]) {
+      const auto& ed = w_.edges()[static_cast<std::size_t>(e)];
+      if (geometry::pointSegmentDistance(p, w_.nodes()[ed.a].position, w_.nodes()[ed.b].position) <=
+          ed.width / 2) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  int cellX(double x) const {
+    return std::clamp(static_cast<int>(std::floor((x - x0_) / cell_)), 0, nx_ - 1);
+  }
+  int cellY(double y) const {
+    return std::clamp(static_cast<int>(std::floor((y - y0_) / cell_)), 0, ny_ - 1);
+  }
+  std::vector<int>& cell(int i, int j) { return cells_[static_cast<std::size_t>(j * nx_ + i)]; }
+
+  const World& w_;
+  double cell_, x0_ = 0, y0_ = 0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::vector<int>> cells_;
+};
+
 // The car's footprint at a pose is on the street and clear of parked cars.
-bool carValid(const World& w, const Pose& q, const RouteSettings& s) {
+bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const RouteSettings& s) {
   const Vec2 fwd(std::cos(q.yaw), std::sin(q.yaw)), left(-fwd.y(), fwd.x());
   for (double a : {-0.5, 0.5}) {
     for (double b : {-0.5, 0.5}) {
       const Vec2 c = q.p + fwd * (a * s.vehicle_length) + left * (b * s.vehicle_width);
-      if (!onStreet(w, c)) return false;
+      if (!streets.onStreet(c)) return false;
     }
   }
-  if (!onStreet(w, q.p)) return false;
+  if (!streets.onStreet(q.p)) return false;
   geometry::OrientedBox car;
   car.center = geometry::Vec3(q.p.x(), q.p.y(), 0.8);
   car.size = geometry::Vec3(s.vehicle_length, s.vehicle_width, 1.6);
@@ -163,8 +216,28 @@ bool carValid(const World& w, const Pose& q, const RouteSettings& s) {
 }
 
 // Dense Dubins samples (every <= 0.25 m) from a to b, or empty when some sample is invalid.
-std::vector<Pose> dubins(const World& w, const Pose& a, const Pose& b, double radius,
-                         const RouteSettings& s) {
+std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose& a,
+                         const Pose& b, double radius, const RouteSettings& s) {
+  // Poses on one line with one heading (the usual case for lane segments, up to the 1e-3
+  // rounding of the inputs) are joined by a straight segment: OMPL's Dubins code snaps angles
+  // within 5e-7 rad of zero and then asserts on the result, which such long near-straight
+  // connections can trip.
+  const Vec2 ab = b.p - a.p;
+  const double straight = ab.norm();
+  const double heading = std::atan2(ab.y(), ab.x());
+  if (straight > 1e-6 && std::abs(geometry::wrapPi(heading - a.yaw)) < 2e-3 &&
+      std::abs(geometry::wrapPi(b.yaw - a.yaw)) < 2e-3) {
+    const int n = std::max(1, static_cast<int>(std::ceil(straight / 0.25)));
+    std::vector<Pose> out;
+    out.reserve(static_cast<std::size_t>(n) + 1);
+    for (int k = 0; k <= n; ++k) {
+      const double u = static_cast<double>(k) / n;
+      const Pose q{a.p + ab * u, a.yaw + geometry::wrapPi(b.yaw - a.yaw) * u};
+      if (!carValid(w, streets, q, s)) return {};
+      out.push_back(q);
+    }
+    return out;
+  }
   auto space = std::make_shared<ob::DubinsStateSpace>(radius);
   ob::ScopedState<ob::DubinsStateSpace> sa(space), sb(space), x(space);
   sa->setXY(a.p.x(), a.p.y());
@@ -178,7 +251,7 @@ std::vector<Pose> dubins(const World& w, const Pose& a, const Pose& b, double ra
   for (int k = 0; k <= n; ++k) {
     space->interpolate(sa.get(), sb.get(), static_cast<double>(k) / n, x.get());
     const Pose q{Vec2(x->getX(), x->getY()), x->getYaw()};
-    if (!carValid(w, q, s)) return {};
+    if (!carValid(w, streets, q, s)) return {};
     out.push_back(q);
   }
   return out;
@@ -235,10 +308,11 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   s.validate();
   detail::silenceOmplOnce();
   RouteResult r;
+  const StreetIndex streets(w);
   const Pose sp{Vec2(start.x, start.y), start.yaw};
   double d = 0;
   const int e0 = nearestEdge(w, sp.p, &d);
-  if (e0 < 0 || !carValid(w, sp, s)) {
+  if (e0 < 0 || !carValid(w, streets, sp, s)) {
     r.status = PlanStatus::kInvalidStart;
     r.message = "start (" + fmt(start.x) + ", " + fmt(start.y) + ") is not a clear pose on a street";
     return r;
@@ -251,7 +325,7 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
     gp = Pose{Vec2(goal.pose->x, goal.pose->y), goal.pose->yaw};
     double gd = 0;
     const int ge = nearestEdge(w, gp->p, &gd);
-    if (ge < 0 || !carValid(w, *gp, s)) {
+    if (ge < 0 || !carValid(w, streets, *gp, s)) {
       r.status = PlanStatus::kInvalidGoal;
       r.message = "goal pose (" + fmt(gp->p.x()) + ", " + fmt(gp->p.y()) +
                   ") is not a clear pose on a street";
@@ -314,7 +388,7 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   for (std::size_t i = 1; i < wps.size(); ++i) {
     std::vector<Pose> piece;
     for (double radius : {s.turn_radius, 0.7 * s.turn_radius, 0.5 * s.turn_radius}) {
-      piece = dubins(w, wps[i - 1], wps[i], radius, s);
+      piece = dubins(w, streets, wps[i - 1], wps[i], radius, s);
       if (!piece.empty()) break;
     }
     if (piece.empty()) {
