@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include "hameritt/geometry/segment.h"
 #include "hameritt/scenario/error.h"
@@ -71,6 +74,31 @@ void ValiditySettings::validate() const {
   }
 }
 
+namespace {
+
+// The world's obstacles inflated by `margin`, built once per world fingerprint and margin and
+// shared (immutable) between checkers and threads; the last few are kept.
+std::shared_ptr<const geometry::OccluderIndex> inflatedObstacles(const scenario::World& world,
+                                                                 double margin) {
+  static std::mutex mutex;
+  static std::map<std::pair<std::uint64_t, double>, std::shared_ptr<const geometry::OccluderIndex>>
+      cache;
+  const auto key = std::make_pair(world.fingerprint(), margin);
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto it = cache.find(key); it != cache.end()) return it->second;
+  auto index = std::make_shared<geometry::OccluderIndex>(20.0);
+  const auto& occ = world.occluders();
+  for (std::size_t i = 0; i < occ.size(); ++i) {
+    index->add(inflate(occ.box(static_cast<int>(i)), margin));
+  }
+  index->build();
+  if (cache.size() >= 8) cache.clear();
+  cache.emplace(key, index);
+  return index;
+}
+
+}  // namespace
+
 ValiditySettings validitySettingsFor(const scenario::UavSpec& uav, double margin) {
   ValiditySettings s;
   s.margin = margin;
@@ -87,11 +115,7 @@ WorldValidity::WorldValidity(const scenario::World& world, std::vector<scenario:
                              const ValiditySettings& settings)
     : world_(world), kozs_(std::move(kozs)), settings_(settings), bounds_(world.bounds()) {
   settings_.validate();
-  const auto& occ = world.occluders();
-  for (std::size_t i = 0; i < occ.size(); ++i) {
-    inflated_.add(inflate(occ.box(static_cast<int>(i)), settings_.margin));
-  }
-  inflated_.build();
+  inflated_ = inflatedObstacles(world, settings_.margin);
   for (std::size_t i = 0; i < kozs_.size(); ++i) {
     if (kozs_[i].polygon.size() < 3) {
       throw scenario::ConfigError("planning.keep_out_zones[" + std::to_string(i) +
@@ -116,8 +140,8 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
   if (p.z() < settings_.altitude_min || p.z() > settings_.altitude_max) return false;
   if (!bounds_.contains(p.head<2>())) return false;
   const Vec2 q = p.head<2>();
-  for (int i : inflated_.candidates(geometry::Aabb2{q, q})) {
-    geometry::OrientedBox b = inflated_.box(i);
+  for (int i : inflated_->candidates(geometry::Aabb2{q, q})) {
+    geometry::OrientedBox b = inflated_->box(i);
     if (slack > 0) b.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
     if (b.contains(p)) return false;
   }
@@ -127,10 +151,10 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
 bool WorldValidity::staticSegmentValid(const Vec3& a, const Vec3& b, double slack) const {
   // The band and the bounds are convex: the endpoints decide.
   if (!staticValid(a, slack) || !staticValid(b, slack)) return false;
-  if (slack <= 0) return inflated_.clear(a, b);
+  if (slack <= 0) return inflated_->clear(a, b);
   geometry::Aabb2 box{a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())};
-  for (int i : inflated_.candidates(box)) {
-    geometry::OrientedBox o = inflated_.box(i);
+  for (int i : inflated_->candidates(box)) {
+    geometry::OrientedBox o = inflated_->box(i);
     o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
     if (o.intersectsSegment(a, b)) return false;
   }
@@ -189,8 +213,8 @@ std::string WorldValidity::explain(const Vec3& p, double t) const {
   }
   if (!bounds_.contains(p.head<2>())) return where + ": outside the neighborhood bounds";
   const Vec2 q = p.head<2>();
-  for (int i : inflated_.candidates(geometry::Aabb2{q, q})) {
-    if (inflated_.box(i).contains(p)) {
+  for (int i : inflated_->candidates(geometry::Aabb2{q, q})) {
+    if (inflated_->box(i).contains(p)) {
       return where + ": inside the box of " + world_.entities()[static_cast<std::size_t>(
                                                   world_.occluderOwner(i))].id +
              " inflated by " + fmt(settings_.margin) + " m";

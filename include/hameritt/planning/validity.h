@@ -3,6 +3,7 @@
 // zones. ROS-free and OMPL-free: the OMPL planners wrap it, and tests and clients can check any
 // path with it. Frame: ENU metres; times in seconds from mission start.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -85,7 +86,9 @@ class WorldValidity {
   std::vector<geometry::Aabb2> koz_bounds_;  // inflated by the margin
   ValiditySettings settings_;
   geometry::Aabb2 bounds_;
-  geometry::OccluderIndex inflated_{20.0};
+  // Obstacles inflated by the margin; shared by every checker of the same world and margin
+  // (the generator builds one checker per scenario).
+  std::shared_ptr<const geometry::OccluderIndex> inflated_;
 };
 
 }  // namespace hameritt::planning
