@@ -37,6 +37,9 @@ ValiditySettings validitySettingsFor(const scenario::UavSpec& uav, double margin
 // Immutable after construction; safe to share between threads.
 class WorldValidity {
  public:
+  // The obstacles inflated by the margin, with a point grid over them (validity.cpp).
+  struct Obstacles;
+
   WorldValidity(const scenario::World& world, std::vector<scenario::KeepOutZone> kozs,
                 const ValiditySettings& settings);
   WorldValidity(const scenario::World& world, const scenario::Mission& mission,
@@ -86,9 +89,9 @@ class WorldValidity {
   std::vector<geometry::Aabb2> koz_bounds_;  // inflated by the margin
   ValiditySettings settings_;
   geometry::Aabb2 bounds_;
-  // Obstacles inflated by the margin; shared by every checker of the same world and margin
-  // (the generator builds one checker per scenario).
-  std::shared_ptr<const geometry::OccluderIndex> inflated_;
+  // Shared by every checker of the same world and margin (the generator builds one per
+  // scenario).
+  std::shared_ptr<const Obstacles> obstacles_;
 };
 
 }  // namespace hameritt::planning
