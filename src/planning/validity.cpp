@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include "hameritt/geometry/segment.h"
 #include "hameritt/scenario/error.h"
@@ -71,6 +74,72 @@ void ValiditySettings::validate() const {
   }
 }
 
+// The inflated obstacles and, for point queries, a grid whose cells list every box whose
+// footprint's bounding rectangle (padded by 1 mm) meets the cell.
+struct WorldValidity::Obstacles {
+  geometry::OccluderIndex index{20.0};
+  double cell = 10.0;
+  Vec2 origin{0, 0};
+  int nx = 0, ny = 0;
+  std::vector<std::vector<int>> grid;
+
+  // The grid cell holding q, or nullptr off the grid.
+  const std::vector<int>* at(const Vec2& q) const {
+    const double fx = (q.x() - origin.x()) / cell, fy = (q.y() - origin.y()) / cell;
+    if (!(fx >= 0 && fy >= 0 && fx < nx && fy < ny)) return nullptr;
+    return &grid[static_cast<std::size_t>(static_cast<int>(fy) * nx + static_cast<int>(fx))];
+  }
+};
+
+namespace {
+
+// The world's obstacles inflated by `margin`, built once per world fingerprint and margin and
+// shared (immutable) between checkers and threads; the last few are kept.
+std::shared_ptr<const WorldValidity::Obstacles> inflatedObstacles(const scenario::World& world,
+                                                                  double margin) {
+  using Obstacles = WorldValidity::Obstacles;
+  static std::mutex mutex;
+  static std::map<std::pair<std::uint64_t, double>, std::shared_ptr<const Obstacles>> cache;
+  const auto key = std::make_pair(world.fingerprint(), margin);
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto it = cache.find(key); it != cache.end()) return it->second;
+  auto o = std::make_shared<Obstacles>();
+  const auto& occ = world.occluders();
+  for (std::size_t i = 0; i < occ.size(); ++i) {
+    o->index.add(inflate(occ.box(static_cast<int>(i)), margin));
+  }
+  o->index.build();
+  const auto b = world.bounds();
+  o->origin = b.min - Vec2(o->cell, o->cell);
+  o->nx = static_cast<int>(std::ceil((b.max.x() - o->origin.x()) / o->cell)) + 2;
+  o->ny = static_cast<int>(std::ceil((b.max.y() - o->origin.y()) / o->cell)) + 2;
+  o->grid.resize(static_cast<std::size_t>(o->nx * o->ny));
+  auto clampX = [&](double v) {
+    return std::clamp(static_cast<int>(std::floor((v - o->origin.x()) / o->cell)), 0, o->nx - 1);
+  };
+  auto clampY = [&](double v) {
+    return std::clamp(static_cast<int>(std::floor((v - o->origin.y()) / o->cell)), 0, o->ny - 1);
+  };
+  for (std::size_t i = 0; i < o->index.size(); ++i) {
+    const auto corners = o->index.box(static_cast<int>(i)).corners2();
+    Vec2 lo = corners[0], hi = corners[0];
+    for (const auto& c : corners) {
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+    }
+    for (int y = clampY(lo.y() - 1e-3); y <= clampY(hi.y() + 1e-3); ++y) {
+      for (int x = clampX(lo.x() - 1e-3); x <= clampX(hi.x() + 1e-3); ++x) {
+        o->grid[static_cast<std::size_t>(y * o->nx + x)].push_back(static_cast<int>(i));
+      }
+    }
+  }
+  if (cache.size() >= 8) cache.clear();
+  cache.emplace(key, o);
+  return o;
+}
+
+}  // namespace
+
 ValiditySettings validitySettingsFor(const scenario::UavSpec& uav, double margin) {
   ValiditySettings s;
   s.margin = margin;
@@ -87,11 +156,7 @@ WorldValidity::WorldValidity(const scenario::World& world, std::vector<scenario:
                              const ValiditySettings& settings)
     : world_(world), kozs_(std::move(kozs)), settings_(settings), bounds_(world.bounds()) {
   settings_.validate();
-  const auto& occ = world.occluders();
-  for (std::size_t i = 0; i < occ.size(); ++i) {
-    inflated_.add(inflate(occ.box(static_cast<int>(i)), settings_.margin));
-  }
-  inflated_.build();
+  obstacles_ = inflatedObstacles(world, settings_.margin);
   for (std::size_t i = 0; i < kozs_.size(); ++i) {
     if (kozs_[i].polygon.size() < 3) {
       throw scenario::ConfigError("planning.keep_out_zones[" + std::to_string(i) +
@@ -116,10 +181,20 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
   if (p.z() < settings_.altitude_min || p.z() > settings_.altitude_max) return false;
   if (!bounds_.contains(p.head<2>())) return false;
   const Vec2 q = p.head<2>();
-  for (int i : inflated_.candidates(geometry::Aabb2{q, q})) {
-    geometry::OrientedBox b = inflated_.box(i);
+  const geometry::OccluderIndex& index = obstacles_->index;
+  auto inside = [&](int i) {
+    geometry::OrientedBox b = index.box(i);
     if (slack > 0) b.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
-    if (b.contains(p)) return false;
+    return b.contains(p);
+  };
+  if (const std::vector<int>* cell = obstacles_->at(q)) {
+    for (int i : *cell) {
+      if (inside(i)) return false;
+    }
+    return true;
+  }
+  for (int i : index.candidates(geometry::Aabb2{q, q})) {
+    if (inside(i)) return false;
   }
   return true;
 }
@@ -127,10 +202,10 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
 bool WorldValidity::staticSegmentValid(const Vec3& a, const Vec3& b, double slack) const {
   // The band and the bounds are convex: the endpoints decide.
   if (!staticValid(a, slack) || !staticValid(b, slack)) return false;
-  if (slack <= 0) return inflated_.clear(a, b);
+  if (slack <= 0) return obstacles_->index.clear(a, b);
   geometry::Aabb2 box{a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())};
-  for (int i : inflated_.candidates(box)) {
-    geometry::OrientedBox o = inflated_.box(i);
+  for (int i : obstacles_->index.candidates(box)) {
+    geometry::OrientedBox o = obstacles_->index.box(i);
     o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
     if (o.intersectsSegment(a, b)) return false;
   }
@@ -189,8 +264,8 @@ std::string WorldValidity::explain(const Vec3& p, double t) const {
   }
   if (!bounds_.contains(p.head<2>())) return where + ": outside the neighborhood bounds";
   const Vec2 q = p.head<2>();
-  for (int i : inflated_.candidates(geometry::Aabb2{q, q})) {
-    if (inflated_.box(i).contains(p)) {
+  for (int i : obstacles_->index.candidates(geometry::Aabb2{q, q})) {
+    if (obstacles_->index.box(i).contains(p)) {
       return where + ": inside the box of " + world_.entities()[static_cast<std::size_t>(
                                                   world_.occluderOwner(i))].id +
              " inflated by " + fmt(settings_.margin) + " m";

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <queue>
 
 #include <ompl/base/ScopedState.h>
@@ -141,30 +144,150 @@ int edgeBetween(const World& w, int u, int v) {
   return -1;
 }
 
-// The car's footprint at a pose is on the street and clear of parked cars.
-bool carValid(const World& w, const Pose& q, const RouteSettings& s) {
+// Street edges bucketed on a square grid: a point within half a street width of an edge lies
+// in a cell that the edge's widened bounding box touches, so one cell's edges answer
+// onStreet() exactly as the scan over every edge does.
+class StreetIndex {
+ public:
+  explicit StreetIndex(const World& w, double cell_size = 8.0) : cell_(cell_size) {
+    const auto b = w.bounds();
+    x0_ = b.min.x() - cell_;
+    y0_ = b.min.y() - cell_;
+    nx_ = static_cast<int>(std::ceil((b.max.x() - x0_) / cell_)) + 2;
+    ny_ = static_cast<int>(std::ceil((b.max.y() - y0_) / cell_)) + 2;
+    cells_.resize(static_cast<std::size_t>(nx_ * ny_));
+    for (std::size_t e = 0; e < w.edges().size(); ++e) {
+      const auto& ed = w.edges()[e];
+      const Vec2 a = w.nodes()[ed.a].position, c = w.nodes()[ed.b].position;
+      const double h = ed.width / 2;
+      segs_.push_back({a, c, h});
+      const int i0 = cellX(std::min(a.x(), c.x()) - h), i1 = cellX(std::max(a.x(), c.x()) + h);
+      const int j0 = cellY(std::min(a.y(), c.y()) - h), j1 = cellY(std::max(a.y(), c.y()) + h);
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) cell(i, j).push_back(static_cast<int>(e));
+      }
+    }
+  }
+  // Same answer as planning::onStreet(w, p) (shrink 0) for the world the index was built
+  // from; points off the grid fall back to that scan.
+  bool onStreet(const World& w, const Vec2& p) const {
+    const double fx = (p.x() - x0_) / cell_, fy = (p.y() - y0_) / cell_;
+    if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return planning::onStreet(w, p);
+    const std::size_t c = static_cast<std::size_t>(static_cast<int>(fy) * nx_ + static_cast<int>(fx));
+    for (int e : cells_[c]) {
+      const Seg& s = segs_[static_cast<std::size_t>(e)];
+      if (geometry::pointSegmentDistance(p, s.a, s.b) <= s.half_width) return true;
+    }
+    return false;
+  }
+
+ private:
+  int cellX(double x) const {
+    return std::clamp(static_cast<int>(std::floor((x - x0_) / cell_)), 0, nx_ - 1);
+  }
+  int cellY(double y) const {
+    return std::clamp(static_cast<int>(std::floor((y - y0_) / cell_)), 0, ny_ - 1);
+  }
+  std::vector<int>& cell(int i, int j) { return cells_[static_cast<std::size_t>(j * nx_ + i)]; }
+
+  struct Seg {
+    Vec2 a, b;
+    double half_width;
+  };
+  std::vector<Seg> segs_;  // street edges: centreline and half width
+  double cell_, x0_ = 0, y0_ = 0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::vector<int>> cells_;
+};
+
+// One street index per world (by fingerprint), built once and shared read-only between calls
+// and threads; the last few are kept.
+std::shared_ptr<const StreetIndex> streetIndex(const World& w) {
+  static std::mutex mutex;
+  static std::map<std::uint64_t, std::shared_ptr<const StreetIndex>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto it = cache.find(w.fingerprint()); it != cache.end()) return it->second;
+  auto index = std::make_shared<const StreetIndex>(w);
+  if (cache.size() >= 8) cache.clear();
+  cache.emplace(w.fingerprint(), index);
+  return index;
+}
+
+// The car's footprint at a pose is on the street and clear of parked cars. `nearby`, when
+// given, holds every occluder that can touch the footprint (see validPoses).
+bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const RouteSettings& s,
+              const std::vector<int>* nearby = nullptr) {
   const Vec2 fwd(std::cos(q.yaw), std::sin(q.yaw)), left(-fwd.y(), fwd.x());
   for (double a : {-0.5, 0.5}) {
     for (double b : {-0.5, 0.5}) {
       const Vec2 c = q.p + fwd * (a * s.vehicle_length) + left * (b * s.vehicle_width);
-      if (!onStreet(w, c)) return false;
+      if (!streets.onStreet(w, c)) return false;
     }
   }
-  if (!onStreet(w, q.p)) return false;
+  if (!streets.onStreet(w, q.p)) return false;
   geometry::OrientedBox car;
   car.center = geometry::Vec3(q.p.x(), q.p.y(), 0.8);
   car.size = geometry::Vec3(s.vehicle_length, s.vehicle_width, 1.6);
   car.yaw = q.yaw;
   const auto& occ = w.occluders();
-  for (int i : occ.near(q.p, 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1)) {
-    if (geometry::footprintsOverlap(car, occ.box(i))) return false;
+  const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
+  if (!nearby) {
+    for (int i : occ.near(q.p, reach)) {
+      if (geometry::footprintsOverlap(car, occ.box(i))) return false;
+    }
+    return true;
+  }
+  for (int i : *nearby) {
+    const auto& o = occ.box(i);
+    // Footprints that overlap have centres within the sum of their circumradii.
+    const double r = reach + 0.5 * std::hypot(o.size.x(), o.size.y());
+    if ((o.center2() - q.p).squaredNorm() > r * r) continue;
+    if (geometry::footprintsOverlap(car, o)) return false;
   }
   return true;
 }
 
+// The poses, or empty when one of them is invalid. The occluders near the whole piece are
+// fetched once instead of once per pose.
+std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::vector<Pose> poses,
+                             const RouteSettings& s) {
+  if (poses.empty()) return poses;
+  geometry::Aabb2 box{poses.front().p, poses.front().p};
+  for (const auto& q : poses) {
+    box.min = box.min.cwiseMin(q.p);
+    box.max = box.max.cwiseMax(q.p);
+  }
+  const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
+  box.min -= Vec2(reach, reach);
+  box.max += Vec2(reach, reach);
+  const std::vector<int> nearby = w.occluders().candidates(box);
+  for (const auto& q : poses) {
+    if (!carValid(w, streets, q, s, &nearby)) return {};
+  }
+  return poses;
+}
+
 // Dense Dubins samples (every <= 0.25 m) from a to b, or empty when some sample is invalid.
-std::vector<Pose> dubins(const World& w, const Pose& a, const Pose& b, double radius,
-                         const RouteSettings& s) {
+std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose& a,
+                         const Pose& b, double radius, const RouteSettings& s) {
+  // Poses on one line with one heading (the usual case for lane segments, up to the 1e-3
+  // rounding of the inputs) are joined by a straight segment: OMPL's Dubins code snaps angles
+  // within 5e-7 rad of zero and then asserts on the result, which such long near-straight
+  // connections can trip.
+  const Vec2 ab = b.p - a.p;
+  const double straight = ab.norm();
+  const double heading = std::atan2(ab.y(), ab.x());
+  if (straight > 1e-6 && std::abs(geometry::wrapPi(heading - a.yaw)) < 2e-3 &&
+      std::abs(geometry::wrapPi(b.yaw - a.yaw)) < 2e-3) {
+    const int n = std::max(1, static_cast<int>(std::ceil(straight / 0.25)));
+    std::vector<Pose> out;
+    out.reserve(static_cast<std::size_t>(n) + 1);
+    for (int k = 0; k <= n; ++k) {
+      const double u = static_cast<double>(k) / n;
+      out.push_back({a.p + ab * u, a.yaw + geometry::wrapPi(b.yaw - a.yaw) * u});
+    }
+    return validPoses(w, streets, std::move(out), s);
+  }
   auto space = std::make_shared<ob::DubinsStateSpace>(radius);
   ob::ScopedState<ob::DubinsStateSpace> sa(space), sb(space), x(space);
   sa->setXY(a.p.x(), a.p.y());
@@ -177,11 +300,9 @@ std::vector<Pose> dubins(const World& w, const Pose& a, const Pose& b, double ra
   out.reserve(static_cast<std::size_t>(n) + 1);
   for (int k = 0; k <= n; ++k) {
     space->interpolate(sa.get(), sb.get(), static_cast<double>(k) / n, x.get());
-    const Pose q{Vec2(x->getX(), x->getY()), x->getYaw()};
-    if (!carValid(w, q, s)) return {};
-    out.push_back(q);
+    out.push_back({Vec2(x->getX(), x->getY()), x->getYaw()});
   }
-  return out;
+  return validPoses(w, streets, std::move(out), s);
 }
 
 }  // namespace
@@ -235,10 +356,12 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   s.validate();
   detail::silenceOmplOnce();
   RouteResult r;
+  const std::shared_ptr<const StreetIndex> index = streetIndex(w);
+  const StreetIndex& streets = *index;
   const Pose sp{Vec2(start.x, start.y), start.yaw};
   double d = 0;
   const int e0 = nearestEdge(w, sp.p, &d);
-  if (e0 < 0 || !carValid(w, sp, s)) {
+  if (e0 < 0 || !carValid(w, streets, sp, s)) {
     r.status = PlanStatus::kInvalidStart;
     r.message = "start (" + fmt(start.x) + ", " + fmt(start.y) + ") is not a clear pose on a street";
     return r;
@@ -251,7 +374,7 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
     gp = Pose{Vec2(goal.pose->x, goal.pose->y), goal.pose->yaw};
     double gd = 0;
     const int ge = nearestEdge(w, gp->p, &gd);
-    if (ge < 0 || !carValid(w, *gp, s)) {
+    if (ge < 0 || !carValid(w, streets, *gp, s)) {
       r.status = PlanStatus::kInvalidGoal;
       r.message = "goal pose (" + fmt(gp->p.x()) + ", " + fmt(gp->p.y()) +
                   ") is not a clear pose on a street";
@@ -314,7 +437,7 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   for (std::size_t i = 1; i < wps.size(); ++i) {
     std::vector<Pose> piece;
     for (double radius : {s.turn_radius, 0.7 * s.turn_radius, 0.5 * s.turn_radius}) {
-      piece = dubins(w, wps[i - 1], wps[i], radius, s);
+      piece = dubins(w, streets, wps[i - 1], wps[i], radius, s);
       if (!piece.empty()) break;
     }
     if (piece.empty()) {

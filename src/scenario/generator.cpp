@@ -7,6 +7,9 @@
 #include <set>
 
 #include "hameritt/geometry/segment.h"
+#include "hameritt/planning/look_at.h"
+#include "hameritt/planning/validity.h"
+#include "hameritt/planning/vehicle_routes.h"
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
@@ -95,6 +98,7 @@ class ScenarioBuilder {
     s.duration = m.time_limit;
     finalizeRelations();
     finishGroups();
+    if (cfg_.perception_paths) planPerceptionPath();
     return std::move(sc_);
   }
 
@@ -218,6 +222,54 @@ class ScenarioBuilder {
     d.corner_clearance = 0.5 * world_.params().street_width + 1.0;
     d.cruise_speed = speed;
     return d;
+  }
+
+  // Vehicle routes with the same lane and corner clearance as driveSpec().
+  planning::RouteSettings routeSettings() const {
+    planning::RouteSettings r;
+    r.lane_offset = 0.5 * world_.params().street_width - kLaneOffsetFromKerb;
+    r.corner_clearance = 0.5 * world_.params().street_width + 1.0;
+    return r;
+  }
+
+  static planning::SpeedProfile speedProfile(double cruise) {
+    planning::SpeedProfile p;
+    p.cruise_speed = cruise;
+    return p;
+  }
+
+  // A random node `hops` street edges from `from` (breadth first, never through `avoid`), or
+  // the farthest reachable ones when none is that far; -1 when nothing is reachable.
+  int nodeAtHops(int from, int avoid, int hops) {
+    std::vector<int> dist(world_.nodes().size(), -1);
+    std::vector<int> queue{from};
+    dist[static_cast<std::size_t>(from)] = 0;
+    if (avoid >= 0) dist[static_cast<std::size_t>(avoid)] = -2;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int u = queue[q];
+      for (int ei : world_.adjacency()[static_cast<std::size_t>(u)]) {
+        const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
+        const int v = e.a == u ? e.b : e.a;
+        if (dist[static_cast<std::size_t>(v)] != -1) continue;
+        dist[static_cast<std::size_t>(v)] = dist[static_cast<std::size_t>(u)] + 1;
+        queue.push_back(v);
+      }
+    }
+    const int reach = std::min(hops, dist[static_cast<std::size_t>(queue.back())]);
+    if (reach <= 0) return -1;
+    std::vector<int> at;
+    for (int v : queue) {
+      if (dist[static_cast<std::size_t>(v)] == reach) at.push_back(v);
+    }
+    return rng_.pick(at);
+  }
+
+  // The rounded pose `s` metres along a street from `a` in direction `dir`, in the lane.
+  static TrajectoryPoint lanePose(const Vec2& a, const Vec2& dir, double s, double lane_offset,
+                                  double t) {
+    const Vec2 p = a + dir * s + Vec2(dir.y(), -dir.x()) * lane_offset;
+    return {t, roundMilli(p.x()), roundMilli(p.y()), 0.0,
+            roundMilli(std::atan2(dir.y(), dir.x()))};
   }
 
   // ------------------------------------------------------------------ constraints
@@ -723,14 +775,44 @@ class ScenarioBuilder {
   void buildRouteSearch() {
     Mission& m = sc_.mission;
     m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_route_search));
-    // Route of interest: a walk of several street edges.
-    std::vector<int> nodes;
+    // The lead car plans a route (planning::planVehicleRoute) from its lane on a random street
+    // to a goal node a few edges on; the route of interest is the centreline through its nodes.
     const int want = static_cast<int>(rng_.uniformInt(cfg_.route_edges_min, cfg_.route_edges_max));
-    for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
-      nodes = randomWalk(randomNode(), want);
-      if (static_cast<int>(nodes.size()) == want + 1) break;
+    const planning::RouteSettings rs = routeSettings();
+    const planning::SpeedProfile speed = speedProfile(rangeDraw(rng_, cfg_.car_speed));
+    std::vector<int> nodes;
+    planning::RouteResult lead;
+    Vec2 lane_dir(1, 0);
+    std::uint64_t route_seed = 0;
+    int goal = -1;
+    for (int attempt = 0; attempt < kMaxAttempts && nodes.empty(); ++attempt) {
+      const int n0 = randomNode();
+      const auto& adj = world_.adjacency()[static_cast<std::size_t>(n0)];
+      if (adj.empty()) continue;
+      const auto& e = world_.edges()[static_cast<std::size_t>(rng_.pick(adj))];
+      const int n1 = e.a == n0 ? e.b : e.a;
+      const Vec2 a = world_.nodes()[static_cast<std::size_t>(n0)].position;
+      const Vec2 b = world_.nodes()[static_cast<std::size_t>(n1)].position;
+      const double len = (b - a).norm();
+      // Some way along the first street, so that a trailing car 12 m behind still starts on it
+      // and well inside the band (not on its end cap).
+      const double s0 = 20.0 + rng_.uniform(0.0, 0.2) * len;
+      route_seed = rng_.next();
+      goal = nodeAtHops(n1, n0, want - 1);
+      if (goal < 0 || s0 > len - rs.corner_clearance - 2.0) continue;
+      lane_dir = (b - a) / len;
+      const TrajectoryPoint start = lanePose(a, lane_dir, s0, rs.lane_offset, 0.0);
+      planning::RouteGoal g;
+      g.node = goal;
+      lead = planning::planVehicleRoute(world_, start, g, route_seed, speed, rs);
+      if (!lead.ok() || lead.nodes.empty() || lead.nodes.front() != n1) continue;
+      std::vector<int> candidate{n0};
+      candidate.insert(candidate.end(), lead.nodes.begin(), lead.nodes.end());
+      if (std::set<int>(candidate.begin(), candidate.end()).size() != candidate.size()) continue;
+      if (candidate.size() < 3) continue;
+      nodes = candidate;
     }
-    if (static_cast<int>(nodes.size()) < 3) throw GenerationError("no route of interest found");
+    if (nodes.empty()) throw GenerationError("no route of interest found");
     RouteOfInterest route;
     route.id = "route_1";
     route.polyline = nodePositions(nodes);
@@ -746,29 +828,43 @@ class ScenarioBuilder {
     route.band = roundPolygon(geometry::bufferPolyline(route.polyline, route.band_width));
     m.routes.push_back(route);
 
-    // One or two target cars drive the route as a convoy.
-    const int n_targets = rng_.bernoulli(0.5) ? 2 : 1;
+    // One car, or a convoy of two: the second starts 12 m behind in the same lane, departs
+    // 2.5 s later with the same seed and stops 12 m short of the lead car's stop, so it follows
+    // the same streets (checked: else the scenario keeps one target).
+    std::vector<Trajectory> trajs{lead.trajectory};
+    if (rng_.bernoulli(0.5)) {
+      const TrajectoryPoint& l0 = lead.trajectory.front();
+      TrajectoryPoint start = l0;
+      start.x = roundMilli(l0.x - 12.0 * lane_dir.x());
+      start.y = roundMilli(l0.y - 12.0 * lane_dir.y());
+      start.t = 2.5;
+      const TrajectoryPoint& le = lead.trajectory.back();
+      planning::RouteGoal g;
+      g.pose = TrajectoryPoint{0.0, roundMilli(le.x - 12.0 * std::cos(le.yaw)),
+                               roundMilli(le.y - 12.0 * std::sin(le.yaw)), 0.0, le.yaw};
+      const planning::RouteResult follow =
+          planning::planVehicleRoute(world_, start, g, route_seed, speed, rs);
+      std::vector<int> fnodes = follow.nodes;
+      fnodes.push_back(goal);
+      if (follow.ok() && fnodes == lead.nodes) {
+        Trajectory traj = follow.trajectory;
+        start.t = 0.0;
+        traj.insert(traj.begin(), start);  // waits in its lane until it departs
+        trajs.push_back(traj);
+      }
+    }
+    const int n_targets = static_cast<int>(trajs.size());
     Group convoy;
     convoy.id = "convoy_1";
     convoy.kind = "convoy";
-    const double speed = rangeDraw(rng_, cfg_.car_speed);
-    // The lead car starts some way along the first street so that a trailing car, 12 m behind,
-    // still starts well inside the band (not on its end cap).
-    const double start_s = 20.0 + rng_.uniform(0.0, 0.2) * (route.polyline[1] - route.polyline[0]).norm();
     std::vector<Entity> targets;
-    std::vector<Trajectory> trajs;
     for (int i = 0; i < n_targets; ++i) {
       const catalog::CarModel* model;
       std::string color;
       drawTargetLook(&model, &color);
-      DriveSpec spec = driveSpec(speed);
-      spec.start_offset = start_s - 12.0 * i;
-      spec.start_time = 0.0;
-      spec.depart_delay = 2.5 * i;
-      Trajectory traj = planDrive(route.polyline, spec);
+      const Trajectory& traj = trajs[static_cast<std::size_t>(i)];
       Entity e = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
       targets.push_back(e);
-      trajs.push_back(traj);
       convoy.members.push_back(e.id);
       m.objective.targets.push_back(describe(e));
     }
@@ -837,28 +933,81 @@ class ScenarioBuilder {
     const catalog::CarModel* model;
     std::string color;
     drawTargetLook(&model, &color);
-    // The target waits at the kerb, the pedestrians run at it, and it drives off.
-    const int slot = pickSlot([this](const ParkingSlot& s) { return s.block >= 0 && wellInside(s.position); }, true);
-    if (slot < 0) throw GenerationError("no free kerb slot for the pursuit target");
+    // The target waits at the kerb, the pedestrians run at it, and it drives off: it pulls out
+    // into its lane ahead of the slot, then follows a planned route (planVehicleRoute) to a
+    // node 6-12 street edges away.
+    const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
+    const planning::RouteSettings rs = routeSettings();
+    const planning::SpeedProfile speed = speedProfile(rangeDraw(rng_, cfg_.car_speed));
+    constexpr double kPullOut = 10.0;      // metres along the street to reach the lane
+    constexpr double kPullOutTime = 6.0;   // seconds, from rest to rest
+    int slot = -1;
+    Trajectory traj;
+    std::vector<int> tried;  // slots without a route, skipped on later attempts
+    for (int attempt = 0; attempt < 20 && traj.empty(); ++attempt) {
+      slot = pickSlot([&](const ParkingSlot& s) {
+        if (s.block < 0 || !wellInside(s.position)) return false;
+        const auto& e = world_.edges()[static_cast<std::size_t>(s.edge)];
+        const Vec2 a = world_.nodes()[e.a].position, b = world_.nodes()[e.b].position;
+        const Vec2 f(std::cos(s.yaw), std::sin(s.yaw));
+        const Vec2 from = (b - a).dot(f) > 0 ? a : b;
+        const double along = (s.position - from).dot(f);
+        return along + kPullOut < (b - a).norm() - rs.corner_clearance - 2.0;
+      }, true);
+      if (slot < 0) break;
+      slot_taken_[static_cast<std::size_t>(slot)] = 1;
+      const ParkingSlot& s = world_.slots()[static_cast<std::size_t>(slot)];
+      const auto& e = world_.edges()[static_cast<std::size_t>(s.edge)];
+      const Vec2 pa = world_.nodes()[e.a].position, pb = world_.nodes()[e.b].position;
+      const Vec2 fwd(std::cos(s.yaw), std::sin(s.yaw));
+      const bool ab = (pb - pa).dot(fwd) > 0;
+      const int first = ab ? e.a : e.b, second = ab ? e.b : e.a;
+      const Vec2 from = ab ? pa : pb, dir = ((ab ? pb : pa) - from).normalized();
+      const Vec2 right(dir.y(), -dir.x());
+      const double along0 = (s.position - from).dot(dir), lat0 = (s.position - from).dot(right);
+      // Waiting, then a cosine blend from the kerb into the lane, at rest at both ends
+      // (peak 2.6 m/s, 1.4 m/s^2).
+      const TrajectoryPoint kerb{0.0, roundMilli(s.position.x()), roundMilli(s.position.y()),
+                                 roundMilli(s.ground_z), roundMilli(s.yaw)};
+      Trajectory prefix{kerb, kerb};
+      prefix[1].t = depart;
+      constexpr int kSteps = 10;
+      for (int j = 1; j <= kSteps; ++j) {
+        const double u = static_cast<double>(j) / kSteps;  // fraction of the distance
+        const double w = 0.5 * (1.0 - std::cos(geometry::kPi * u));
+        const double lat = lat0 + (rs.lane_offset - lat0) * w;
+        const double dlat =
+            (rs.lane_offset - lat0) * 0.5 * geometry::kPi * std::sin(geometry::kPi * u) / kPullOut;
+        const Vec2 p = from + dir * (along0 + kPullOut * u) + right * lat;
+        const Vec2 h = dir + right * dlat;
+        const double t = depart + kPullOutTime / geometry::kPi * std::acos(1.0 - 2.0 * u);
+        prefix.push_back({roundMilli(t), roundMilli(p.x()), roundMilli(p.y()), 0.0,
+                          roundMilli(std::atan2(h.y(), h.x()))});
+      }
+      const int goal = nodeAtHops(second, first, static_cast<int>(rng_.uniformInt(6, 12)) - 1);
+      const std::uint64_t route_seed = rng_.next();
+      if (goal < 0) {
+        tried.push_back(slot);
+        continue;
+      }
+      planning::RouteGoal g;
+      g.node = goal;
+      const planning::RouteResult route =
+          planning::planVehicleRoute(world_, prefix.back(), g, route_seed, speed, rs);
+      if (!route.ok() || route.trajectory.size() < 2) {
+        tried.push_back(slot);
+        continue;
+      }
+      traj = prefix;
+      traj.insert(traj.end(), route.trajectory.begin() + 1, route.trajectory.end());
+    }
+    for (int t : tried) slot_taken_[static_cast<std::size_t>(t)] = 0;
+    if (traj.empty()) {
+      throw GenerationError("no free kerb slot with a route for the pursuit target");
+    }
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
     slot_taken_[static_cast<std::size_t>(slot)] = 1;
-    const auto& edge = world_.edges()[static_cast<std::size_t>(sl.edge)];
-    // Drive in the direction the car faces, then on through a random walk.
     const Vec2 fwd(std::cos(sl.yaw), std::sin(sl.yaw));
-    const Vec2 pa = world_.nodes()[edge.a].position, pb = world_.nodes()[edge.b].position;
-    const int first = (pb - pa).dot(fwd) > 0 ? edge.a : edge.b;
-    const int second = first == edge.a ? edge.b : edge.a;
-    std::vector<int> nodes{first};
-    for (int n : randomWalk(second, static_cast<int>(rng_.uniformInt(6, 12)), first)) nodes.push_back(n);
-    const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
-    DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
-    spec.start_time = 0.0;
-    spec.depart_delay = depart;
-    spec.from_kerb = Vec3(sl.position.x(), sl.position.y(), sl.ground_z);
-    spec.from_kerb_yaw = sl.yaw;
-    const std::vector<Vec2> path = nodePositions(nodes);
-    spec.start_offset = (sl.position - path[0]).dot((path[1] - path[0]).normalized());
-    Trajectory traj = planDrive(path, spec);
     Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
     m.objective.type = "track";
     m.objective.targets.push_back(describe(target));
@@ -1046,6 +1195,65 @@ class ScenarioBuilder {
   }
 
   void finishGroups() { sc_.sim.groups = currentGroups(); }
+
+  // The perception-only flight (planning::planLookAtPath with the down camera over the
+  // mission's validity): climb at the start to mid-band, hover there until every moving target
+  // has stopped, then visit a viewpoint of each target (parked: its box centre; moving: the
+  // centre of its box where it stops, so a view is only claimed once it is there). Seeded from
+  // the scenario seed; a planning failure is written as its status with what was planned.
+  void planPerceptionPath() {
+    const UavSpec& uav = sc_.sim.uav;
+    const planning::WorldValidity validity(world_, sc_.mission, planning::validitySettingsFor(uav));
+    planning::UavPlannerSettings settings;
+    settings.speed.max_speed = uav.max_speed;
+    settings.time_limit = 600.0;  // iteration budgets end the search: deterministic under load
+    std::vector<planning::LookAtTarget> targets;
+    double hold = 0.0;  // when the last moving target has stopped
+    for (const auto& se : sc_.sim.entities) {
+      if (se.role != "target") continue;
+      planning::LookAtTarget t;
+      t.id = se.entity.id;
+      OrientedBox box = se.entity.box;
+      if (!se.trajectory.empty()) {
+        box = poseBox(se.entity.box, se.trajectory.back());
+        hold = std::max(hold, se.trajectory.back().t);
+      }
+      t.point = box.center;
+      targets.push_back(t);
+    }
+    const Vec3 ground(uav.start.x, uav.start.y, uav.start.z);
+    const Vec3 air(uav.start.x, uav.start.y,
+                   roundMilli(0.5 * (uav.altitude_min + uav.altitude_max)));
+    const double climbed = roundMilli((air.z() - ground.z()) / settings.speed.climb_rate);
+    const double t0 = std::max(climbed + 1.0, std::ceil(hold));
+    PerceptionPath pp;
+    pp.trajectory = {{0.0, ground.x(), ground.y(), ground.z(), uav.start.yaw},
+                     {climbed, air.x(), air.y(), air.z(), uav.start.yaw},
+                     {t0, air.x(), air.y(), air.z(), uav.start.yaw}};
+    // The down camera first; the front camera when that does not see every target (a keep-out
+    // zone over a target denies the overhead view), keeping whichever sees more.
+    std::optional<planning::LookAtResult> best;
+    for (const char* name : {"down", "front"}) {
+      for (const auto& c : uav.cameras) {
+        if (c.name != name) continue;
+        planning::LookAtResult r = planning::planLookAtPath(
+            validity, c, air, t0, targets, settings, deriveSeed(seed_, 0x4C4F4F4B00000000ULL));
+        if (!best || r.viewpoints.size() > best->viewpoints.size()) {
+          best = std::move(r);
+          pp.camera = c.name;
+        }
+      }
+      if (best && best->status == planning::PlanStatus::kExact) break;
+    }
+    if (!best) return;  // no camera to plan for
+    const planning::LookAtResult& r = *best;
+    pp.status = planning::toString(r.status);
+    for (const auto& v : r.viewpoints) pp.targets_seen.push_back(v.target_id);
+    for (const auto& q : r.flight.path) {
+      if (q.t > pp.trajectory.back().t) pp.trajectory.push_back(q);
+    }
+    sc_.sim.uav.perception_path = pp;
+  }
 
   const World& world_;
   const GeneratorConfig& cfg_;

@@ -148,6 +148,14 @@ class ObjectReader {
     }
     return v.get<std::uint64_t>();
   }
+  bool boolean(const std::string& key) {
+    const json& v = at(key);
+    if (!v.is_boolean()) {
+      throw ConfigError(where_ + "." + key + ": expected true or false, got " + v.type_name() +
+                        " " + v.dump());
+    }
+    return v.get<bool>();
+  }
   Range range(const std::string& key) {
     const json& v = at(key);
     if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number()) {
@@ -228,6 +236,7 @@ GeneratorConfig generatorConfigFromJson(const json& j, const std::string& file) 
   for (const auto& f : kRangeFields) c.*(f.member) = r.range(f.key);
   for (const auto& f : kIntFields) c.*(f.member) = static_cast<int>(r.integer(f.key));
   for (const auto& f : kDoubleFields) c.*(f.member) = r.number(f.key);
+  c.perception_paths = r.boolean("perception_paths");
   r.finish();
   try {
     c.validate();

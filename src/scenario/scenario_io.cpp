@@ -269,7 +269,20 @@ std::string simConfigJson(const SimConfig& s) {
     for (const auto& m : c.modalities) w.value(m);
     w.endArray().endObject();
   }
-  w.endArray().endObject().endObject();
+  w.endArray().endObject();
+  if (u.perception_path) {
+    const PerceptionPath& pp = *u.perception_path;
+    w.key("perception_path").beginObject();
+    w.key("status").value(pp.status);
+    w.key("camera").value(pp.camera);
+    w.key("targets_seen").beginArray();
+    for (const auto& id : pp.targets_seen) w.value(id);
+    w.endArray();
+    w.key("trajectory").beginArray();
+    for (const auto& p : pp.trajectory) w.numbers({p.t, p.x, p.y, p.z, p.yaw});
+    w.endArray().endObject();
+  }
+  w.endObject();
 
   w.key("perturbations").beginObject().key("camera_noise").beginObject();
   w.key("gaussian_std").value(s.perturbations.gaussian_noise_std);

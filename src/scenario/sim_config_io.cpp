@@ -78,6 +78,7 @@ class Obj {
     return v;
   }
   Obj object(const std::string& key) { return Obj(get(key), at(key), file_); }
+  bool has(const std::string& key) const { return j_.contains(key); }
 
   // Unknown keys are errors.
   void finish() const {
@@ -104,6 +105,45 @@ class Obj {
 
 std::string idx(const std::string& path, std::size_t i) {
   return path + "[" + std::to_string(i) + "]";
+}
+
+template <std::size_t N>
+std::array<double, N> numbers(const json& v, const std::string& path, const std::string& file);
+
+// uav.perception_path: a planner status, the targets seen and a strictly increasing trajectory.
+PerceptionPath readPerceptionPath(Obj o) {
+  PerceptionPath pp;
+  pp.status = o.string("status");
+  static const std::set<std::string> kStatuses = {"exact", "approximate", "no_solution",
+                                                  "invalid_start", "invalid_goal", "timeout"};
+  if (!kStatuses.count(pp.status)) {
+    throw ConfigError(o.file() + ": " + o.at("status") + ": expected a planner status, got \"" +
+                      pp.status + "\"");
+  }
+  pp.camera = o.string("camera");
+  const json& seen = o.array("targets_seen");
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    if (!seen[i].is_string()) {
+      throw ConfigError(o.file() + ": " + idx(o.at("targets_seen"), i) +
+                        ": expected a string, got " + seen[i].type_name());
+    }
+    pp.targets_seen.push_back(seen[i].get<std::string>());
+  }
+  const json& traj = o.array("trajectory");
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    const std::string p = idx(o.at("trajectory"), i);
+    const auto a = numbers<5>(traj[i], p, o.file());
+    if (!(a[0] >= 0)) {
+      throw ConfigError(o.file() + ": " + p + ": expected a time >= 0, got " + Obj::fmt(a[0]));
+    }
+    if (!pp.trajectory.empty() && !(a[0] > pp.trajectory.back().t)) {
+      throw ConfigError(o.file() + ": " + p + ": expected strictly increasing times, got t = " +
+                        Obj::fmt(a[0]) + " after " + Obj::fmt(pp.trajectory.back().t));
+    }
+    pp.trajectory.push_back({a[0], a[1], a[2], a[3], a[4]});
+  }
+  o.finish();
+  return pp;
 }
 
 // A fixed-length array of numbers.
@@ -363,6 +403,9 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
       spec.cameras.push_back(readCamera(cams[i], idx("uav.payload.cameras", i), file));
     }
     payload.finish();
+    if (u.has("perception_path")) {
+      spec.perception_path = readPerceptionPath(u.object("perception_path"));
+    }
     u.finish();
   }
 

@@ -782,6 +782,41 @@ class Semantics {
     }
     if (exists("/uav/altitude"))
       altitude(doc_.at(json::json_pointer("/uav/altitude")), "/uav/altitude");
+    if (exists("/uav/perception_path")) perceptionPath(ents);
+  }
+
+  // The perception-only flight: strictly increasing times from t >= 0, and every target it
+  // claims to see is a target entity of this scenario.
+  void perceptionPath(const json& ents) {
+    const std::string base = "/uav/perception_path";
+    const json& pp = doc_.at(json::json_pointer(base));
+    const json& traj = arrayOrEmpty(pp, "trajectory");
+    double prev = 0.0;
+    for (std::size_t k = 0; k < traj.size(); ++k) {
+      if (!traj[k].is_array() || traj[k].empty() || !traj[k][0].is_number()) break;
+      const double t = traj[k][0].get<double>();
+      const std::string sp = jsonPointerAppend(base + "/trajectory", k);
+      if (k == 0 && t < 0) {
+        add(sp, "trajectory_order", "t = " + num(t) + " is before the mission start");
+      } else if (k > 0 && !(t > prev)) {
+        add(sp, "trajectory_order",
+            "t = " + num(t) + " does not increase on the previous sample's t = " + num(prev));
+      }
+      prev = t;
+    }
+    std::set<std::string> targets;
+    for (const auto& e : ents) {
+      if (stringAt(e, "role") == std::optional<std::string>("target")) {
+        if (auto id = stringAt(e, "id")) targets.insert(*id);
+      }
+    }
+    const json& seen = arrayOrEmpty(pp, "targets_seen");
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+      if (seen[k].is_string() && !targets.count(seen[k].get<std::string>())) {
+        add(jsonPointerAppend(base + "/targets_seen", k), "reference",
+            "'" + seen[k].get<std::string>() + "' is not a target of this scenario");
+      }
+    }
   }
 
   // ---------------------------------------------------------------- world.json

@@ -197,6 +197,13 @@ TEST_F(ScenarioMapTest, FullMapShowsTheWholeWorldAtTheRequestedScale) {
     for (const auto& r : g.mission["routes"]) {
       for (const auto& v : r["band_polygon"]) check(v[0].get<double>(), v[1].get<double>());
     }
+    // Targets (their paths too) and the UAV start belong to the map as well.
+    for (const auto& e : g.sim["entities"]) {
+      if (e["role"] != "target") continue;
+      check(e["pose"]["x"].get<double>(), e["pose"]["y"].get<double>());
+      for (const auto& q : e["trajectory"]) check(q[1].get<double>(), q[2].get<double>());
+    }
+    check(g.sim["uav"]["start"]["x"].get<double>(), g.sim["uav"]["start"]["y"].get<double>());
     const int map_w = static_cast<int>(std::ceil((f.region.max.x() - f.region.min.x()) * 0.8));
     const int map_h = static_cast<int>(std::ceil((f.region.max.y() - f.region.min.y()) * 0.8));
     EXPECT_EQ(f.map_rect.width, map_w);

@@ -381,6 +381,23 @@ TEST_F(ValidationTest, NonIncreasingTrajectoryIsReported) {
   EXPECT_ISSUE(issues, "trajectory_order", "/entities/" + std::to_string(e) + "/trajectory/2");
 }
 
+TEST_F(ValidationTest, PerceptionPathOrderTargetsAndStatusAreChecked) {
+  json s = sim(ScenarioClass::kPursuit, 12);
+  ASSERT_TRUE(s["uav"].contains("perception_path"));
+  json& pp = s["uav"]["perception_path"];
+  ASSERT_GE(pp["trajectory"].size(), 3u);
+  pp["trajectory"][2][0] = pp["trajectory"][1][0];
+  pp["targets_seen"].push_back("car_99999");
+  auto issues = check(s);
+  ASSERT_EQ(issues.size(), 2u) << describe(issues);
+  EXPECT_ISSUE(issues, "trajectory_order", "/uav/perception_path/trajectory/2");
+  const std::size_t last = pp["targets_seen"].size() - 1;
+  EXPECT_ISSUE(issues, "reference", "/uav/perception_path/targets_seen/" + std::to_string(last));
+  json bad = sim(ScenarioClass::kPursuit, 12);
+  bad["uav"]["perception_path"]["status"] = "great";
+  EXPECT_FALSE(check(bad).empty());
+}
+
 TEST_F(ValidationTest, GroupMembersAndWorldParamsAreChecked) {
   json s = find(ScenarioClass::kPursuit, false, [](const json& d) { return !d["groups"].empty(); });
   s["groups"][0]["members"][0] = "car_9999";

@@ -835,6 +835,71 @@ def check_block_groups(sc, ck, sid):
             ck.check(point_in_poly(b.x, b.y, outline, 1e-6), "group", sid, "member %s of %s outside its outline" % (mid, g["id"]))
 
 
+def project(cam, ux, uy, uz, uyaw, px, py, pz, margin=0.0):
+    """Pixel (u, v) of a world point in a payload camera of a level UAV, or None outside."""
+    mx, my, mz = cam["mount"]["xyz"]
+    roll, pitch, myaw = (math.radians(a) for a in cam["mount"]["rpy_deg"])
+    c, s = math.cos(uyaw), math.sin(uyaw)
+    cx, cy, cz = ux + c * mx - s * my, uy + s * mx + c * my, uz + mz
+    # Into the body frame (FLU), then undo the mount yaw, pitch (positive looks down), roll.
+    dx, dy, dz = px - cx, py - cy, pz - cz
+    bx, by, bz = c * dx + s * dy, -s * dx + c * dy, dz
+    cyw, syw = math.cos(myaw), math.sin(myaw)
+    bx, by = cyw * bx + syw * by, -syw * bx + cyw * by
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    bx, bz = cp * bx - sp * bz, sp * bx + cp * bz
+    cr, sr = math.cos(roll), math.sin(roll)
+    by, bz = cr * by + sr * bz, -sr * by + cr * bz
+    if bx <= 1e-6:
+        return None
+    f = 0.5 * cam["width"] / math.tan(math.radians(cam["hfov_deg"]) / 2)
+    u = 0.5 * cam["width"] + f * (-by) / bx
+    v = 0.5 * cam["height"] + f * (-bz) / bx
+    if margin <= u <= cam["width"] - margin and margin <= v <= cam["height"] - margin:
+        return u, v
+    return None
+
+
+def check_perception_path(sc, ck, sid):
+    """uav.perception_path: strictly increasing samples from the UAV start; an exact plan sees
+    every target; each target it lists projects into its camera's image at some sample, with
+    the target where its trajectory puts it at that time."""
+    uav = sc.sim["uav"]
+    pp = uav.get("perception_path")
+    if pp is None:
+        return
+    tr = pp["trajectory"]
+    ts = [q[0] for q in tr]
+    bad = [i for i in range(1, len(ts)) if not ts[i] > ts[i - 1]]
+    ck.check(not bad and (not ts or ts[0] >= 0), "perception", sid,
+             "perception_path not strictly increasing at samples %s" % bad[:5])
+    if tr:
+        st = uav["start"]
+        ck.check(abs(tr[0][1] - st["x"]) < 1e-6 and abs(tr[0][2] - st["y"]) < 1e-6, "perception", sid,
+                 "perception_path does not start at the UAV start")
+    targets = [t["id"] for t in sc.mission["objective"]["targets"]]
+    seen = pp["targets_seen"]
+    ck.check(all(t in targets for t in seen), "perception", sid, "targets_seen %s not all targets %s" % (seen, targets))
+    if pp["status"] == "exact":
+        ck.check(sorted(seen) == sorted(targets), "perception", sid,
+                 "exact perception_path sees %s, targets are %s" % (seen, targets))
+    cams = {c["name"]: c for c in uav["payload"]["cameras"]}
+    cam = cams.get(pp.get("camera"))
+    if not ck.check(cam is not None, "perception", sid, "unknown camera %s" % pp.get("camera")):
+        return
+    for tid in seen:
+        e = sc.by_id.get(tid)
+        if e is None:
+            continue
+        ok = False
+        for q in tr:
+            b = e.box(q[0])
+            if project(cam, q[1], q[2], q[3], q[4], b.x, b.y, b.zc) is not None:
+                ok = True
+                break
+        ck.check(ok, "perception", sid, "target %s never projects into the %s camera" % (tid, cam["name"]))
+
+
 def verify_scenario(wctx, fingerprint, mission, sim, ck):
     sid = mission.get("scenario_id", "?")
     sc = Scene(wctx, mission, sim)
@@ -852,6 +917,7 @@ def verify_scenario(wctx, fingerprint, mission, sim, ck):
     else:
         ck.check(False, "general", sid, "unknown class %s" % cls)
     check_confusers(sc, ck, sid, cls)
+    check_perception_path(sc, ck, sid)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -972,6 +1038,17 @@ def self_checks(wctx, fingerprint, docs, ck):
         e = next(e for e in s["entities"] if len(e["trajectory"]) > 3)
         e["trajectory"][1][0], e["trajectory"][2][0] = e["trajectory"][2][0], e["trajectory"][1][0]
         detect("trajectory order " + m["scenario_id"], m, s, "general")
+
+    # 10b. Perception path: samples out of order; an exact path that misses a target.
+    m, s = find(lambda m, s: len(s["uav"].get("perception_path", {}).get("trajectory", [])) > 3)
+    if m is not None:
+        tr = s["uav"]["perception_path"]["trajectory"]
+        tr[1][0], tr[2][0] = tr[2][0], tr[1][0]
+        detect("perception_path order " + m["scenario_id"], m, s, "perception")
+    m, s = find(lambda m, s: s["uav"].get("perception_path", {}).get("status") == "exact")
+    if m is not None:
+        s["uav"]["perception_path"]["targets_seen"] = []
+        detect("perception_path unseen " + m["scenario_id"], m, s, "perception")
 
     # 11. A PART_OF relation naming a group the target is not in.
     m, s = find(lambda m, s: any(r["operator"] == "PART_OF" for r in m["scene_relations"]))

@@ -3,6 +3,7 @@
 // zones. ROS-free and OMPL-free: the OMPL planners wrap it, and tests and clients can check any
 // path with it. Frame: ENU metres; times in seconds from mission start.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@ ValiditySettings validitySettingsFor(const scenario::UavSpec& uav, double margin
 // Immutable after construction; safe to share between threads.
 class WorldValidity {
  public:
+  // The obstacles inflated by the margin, with a point grid over them (validity.cpp).
+  struct Obstacles;
+
   WorldValidity(const scenario::World& world, std::vector<scenario::KeepOutZone> kozs,
                 const ValiditySettings& settings);
   WorldValidity(const scenario::World& world, const scenario::Mission& mission,
@@ -85,7 +89,9 @@ class WorldValidity {
   std::vector<geometry::Aabb2> koz_bounds_;  // inflated by the margin
   ValiditySettings settings_;
   geometry::Aabb2 bounds_;
-  geometry::OccluderIndex inflated_{20.0};
+  // Shared by every checker of the same world and margin (the generator builds one per
+  // scenario).
+  std::shared_ptr<const Obstacles> obstacles_;
 };
 
 }  // namespace hameritt::planning

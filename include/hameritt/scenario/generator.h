@@ -64,6 +64,9 @@ struct GeneratorConfig {
   Range noise_std{0, 0.05};
   Range salt_pepper{0, 0.01};
   Range motion_blur_px{0, 3};
+  // Plan a perception-only UAV flight over the targets (sim_config uav.perception_path); the
+  // most expensive step of generation, so it can be switched off.
+  bool perception_paths = true;
 
   // Throws ConfigError naming the field ("generator.<field>") and the bad value.
   void validate() const;

@@ -177,6 +177,16 @@ struct CameraSpec {
   std::vector<std::string> modalities;  // rgb, depth, segmentation, instances
 };
 
+// A perception-only flight over the targets, planned by the generator with
+// planning::planLookAtPath: climb at the start, hover until the moving targets have stopped,
+// then visit a viewpoint of each. Written even when planning fails (status says why).
+struct PerceptionPath {
+  std::string status;                     // exact, approximate, no_solution, invalid_start, ...
+  std::string camera;                     // payload camera the viewpoints are planned for
+  std::vector<std::string> targets_seen;  // targets verified in the camera image on the path
+  Trajectory trajectory;                  // UAV {t, x, y, z, yaw}, strictly increasing t
+};
+
 struct UavSpec {
   std::string model = "sentinel";
   TrajectoryPoint start;  // t = 0
@@ -184,6 +194,7 @@ struct UavSpec {
   double altitude_max = 60.0;
   double max_speed = 12.0;
   std::vector<CameraSpec> cameras;
+  std::optional<PerceptionPath> perception_path;  // absent when the generator skipped it
 };
 
 struct Perturbations {
