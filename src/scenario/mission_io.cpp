@@ -12,97 +12,17 @@
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/scenario_io.h"
+#include "strict_json.h"
 
 namespace hameritt::scenario {
 
-using json = nlohmann::ordered_json;
+using json = strict_json::json;
 
 namespace {
 
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
-std::string idx(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-// A JSON object being read strictly: every key must be consumed (finish()), the same rules and
-// messages as sim_config_io.cpp.
-class Obj {
- public:
-  Obj(const json& j, std::string path, const std::string& file)
-      : j_(j), path_(std::move(path)), file_(file) {
-    if (!j_.is_object()) fail(path_.empty() ? std::string("(root)") : path_, "expected an object", j_);
-  }
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what, const json& got) const {
-    throw ConfigError(file_ + ": " + path + ": " + what + ", got " + got.type_name() +
-                      (got.is_primitive() ? " " + got.dump() : std::string()));
-  }
-  [[noreturn]] void error(const std::string& key, const std::string& what) const {
-    throw ConfigError(file_ + ": " + at(key) + ": " + what);
-  }
-
-  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
-  bool has(const std::string& key) const { return j_.find(key) != j_.end(); }
-
-  const json& get(const std::string& key) {
-    const auto it = j_.find(key);
-    if (it == j_.end()) throw ConfigError(file_ + ": " + at(key) + ": missing required key");
-    used_.insert(key);
-    return *it;
-  }
-  double number(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number()) fail(at(key), "expected a number", v);
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(at(key), "expected a finite number", v);
-    return d;
-  }
-  std::int64_t integer(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number_integer()) fail(at(key), "expected an integer", v);
-    return v.get<std::int64_t>();
-  }
-  std::uint64_t unsignedInteger(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number_unsigned()) fail(at(key), "expected a non-negative integer", v);
-    return v.get<std::uint64_t>();
-  }
-  std::string string(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_string()) fail(at(key), "expected a string", v);
-    return v.get<std::string>();
-  }
-  bool boolean(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_boolean()) fail(at(key), "expected a boolean", v);
-    return v.get<bool>();
-  }
-  const json& array(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_array()) fail(at(key), "expected an array", v);
-    return v;
-  }
-  Obj object(const std::string& key) { return Obj(get(key), at(key), file_); }
-
-  void finish() const {
-    for (auto it = j_.begin(); it != j_.end(); ++it) {
-      if (!used_.count(it.key())) throw ConfigError(file_ + ": " + at(it.key()) + ": unknown key");
-    }
-  }
-  const std::string& file() const { return file_; }
-
- private:
-  const json& j_;
-  std::string path_;
-  const std::string& file_;
-  std::set<std::string> used_;
-};
+using strict_json::fmt;
+using strict_json::idx;
+using Obj = strict_json::Object;
 
 std::vector<geometry::Vec2> points(const json& v, const std::string& path, const std::string& file,
                                    std::size_t min_count) {

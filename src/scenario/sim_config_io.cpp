@@ -12,103 +12,20 @@
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/scenario_io.h"
+#include "strict_json.h"
 #include "hameritt/scenario/params_table.h"
 
 namespace hameritt::scenario {
 
-using json = nlohmann::ordered_json;
+using json = strict_json::json;
 
 namespace {
 
-const char* typeName(const json& j) { return j.type_name(); }
+using strict_json::fmt;
+using strict_json::idx;
+using strict_json::numbers;
+using Obj = strict_json::Object;
 
-// A JSON object being read strictly: every key must be consumed exactly once (finish()).
-class Obj {
- public:
-  Obj(const json& j, std::string path, const std::string& file)
-      : j_(j), path_(std::move(path)), file_(file) {
-    if (!j_.is_object()) fail(path_, "expected an object", j_);
-  }
-
-  [[noreturn]] void fail(const std::string& path, const std::string& what, const json& got) const {
-    throw ConfigError(file_ + ": " + path + ": " + what + ", got " + typeName(got) +
-                      (got.is_primitive() ? " " + got.dump() : std::string()));
-  }
-
-  std::string at(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
-  const json& get(const std::string& key) {
-    const auto it = j_.find(key);
-    if (it == j_.end()) throw ConfigError(file_ + ": " + at(key) + ": missing required key");
-    used_.insert(key);
-    return *it;
-  }
-
-  double number(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number()) fail(at(key), "expected a number", v);
-    return v.get<double>();
-  }
-  double numberIn(const std::string& key, double lo, double hi) {
-    const double v = number(key);
-    if (!(v >= lo && v <= hi)) {
-      throw ConfigError(file_ + ": " + at(key) + ": expected a number in [" + fmt(lo) + ", " +
-                        fmt(hi) + "], got " + fmt(v));
-    }
-    return v;
-  }
-  std::int64_t integer(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number_integer()) fail(at(key), "expected an integer", v);
-    return v.get<std::int64_t>();
-  }
-  std::uint64_t unsignedInteger(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_number_unsigned()) fail(at(key), "expected a non-negative integer", v);
-    return v.get<std::uint64_t>();
-  }
-  std::string string(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_string()) fail(at(key), "expected a string", v);
-    return v.get<std::string>();
-  }
-  const json& array(const std::string& key) {
-    const json& v = get(key);
-    if (!v.is_array()) fail(at(key), "expected an array", v);
-    return v;
-  }
-  Obj object(const std::string& key) { return Obj(get(key), at(key), file_); }
-  bool has(const std::string& key) const { return j_.contains(key); }
-
-  // Unknown keys are errors.
-  void finish() const {
-    for (auto it = j_.begin(); it != j_.end(); ++it) {
-      if (!used_.count(it.key())) throw ConfigError(file_ + ": " + at(it.key()) + ": unknown key");
-    }
-  }
-
-  const std::string& path() const { return path_; }
-  const std::string& file() const { return file_; }
-
-  static std::string fmt(double v) {
-    char buf[40];
-    std::snprintf(buf, sizeof(buf), "%.17g", v);
-    return buf;
-  }
-
- private:
-  const json& j_;
-  std::string path_;
-  const std::string& file_;
-  std::set<std::string> used_;
-};
-
-std::string idx(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-template <std::size_t N>
-std::array<double, N> numbers(const json& v, const std::string& path, const std::string& file);
 
 // uav.perception_path: a planner status, the targets seen and a strictly increasing trajectory.
 PerceptionPath readPerceptionPath(Obj o) {
@@ -129,41 +46,11 @@ PerceptionPath readPerceptionPath(Obj o) {
     }
     pp.targets_seen.push_back(seen[i].get<std::string>());
   }
-  const json& traj = o.array("trajectory");
-  for (std::size_t i = 0; i < traj.size(); ++i) {
-    const std::string p = idx(o.at("trajectory"), i);
-    const auto a = numbers<5>(traj[i], p, o.file());
-    if (!(a[0] >= 0)) {
-      throw ConfigError(o.file() + ": " + p + ": expected a time >= 0, got " + Obj::fmt(a[0]));
-    }
-    if (!pp.trajectory.empty() && !(a[0] > pp.trajectory.back().t)) {
-      throw ConfigError(o.file() + ": " + p + ": expected strictly increasing times, got t = " +
-                        Obj::fmt(a[0]) + " after " + Obj::fmt(pp.trajectory.back().t));
-    }
-    pp.trajectory.push_back({a[0], a[1], a[2], a[3], a[4]});
-  }
+  pp.trajectory = strict_json::trajectory(o.array("trajectory"), o.at("trajectory"), o.file());
   o.finish();
   return pp;
 }
 
-// A fixed-length array of numbers.
-template <std::size_t N>
-std::array<double, N> numbers(const json& v, const std::string& path, const std::string& file) {
-  if (!v.is_array() || v.size() != N) {
-    throw ConfigError(
-        file + ": " + path + ": expected an array of " + std::to_string(N) + " numbers, got " +
-        (v.is_array() ? "an array of " + std::to_string(v.size()) : std::string(v.type_name())));
-  }
-  std::array<double, N> out{};
-  for (std::size_t i = 0; i < N; ++i) {
-    if (!v[i].is_number()) {
-      throw ConfigError(file + ": " + idx(path, i) + ": expected a number, got " +
-                        v[i].type_name());
-    }
-    out[i] = v[i].get<double>();
-  }
-  return out;
-}
 
 std::vector<std::string> strings(const json& v, const std::string& path, const std::string& file) {
   std::vector<std::string> out;
@@ -230,22 +117,7 @@ ScenarioEntity readEntity(const json& j, const std::string& path, const std::str
     throw ConfigError(file + ": " + o.at("size") + ": expected positive sizes");
   }
   e.box = entityBox(x, y, z, yaw, size);
-  const json& traj = o.array("trajectory");
-  se.trajectory.reserve(traj.size());
-  for (std::size_t i = 0; i < traj.size(); ++i) {
-    const std::string p = idx(o.at("trajectory"), i);
-    const auto a = numbers<5>(traj[i], p, file);
-    // Strictly increasing, as hameritt_validate requires: two samples at one time would be
-    // a teleport.
-    if (!(a[0] >= 0)) {
-      throw ConfigError(file + ": " + p + ": expected a time >= 0, got " + Obj::fmt(a[0]));
-    }
-    if (!se.trajectory.empty() && !(a[0] > se.trajectory.back().t)) {
-      throw ConfigError(file + ": " + p + ": expected strictly increasing times, got t = " +
-                        Obj::fmt(a[0]) + " after " + Obj::fmt(se.trajectory.back().t));
-    }
-    se.trajectory.push_back({a[0], a[1], a[2], a[3], a[4]});
-  }
+  se.trajectory = strict_json::trajectory(o.array("trajectory"), o.at("trajectory"), file);
   o.finish();
   return se;
 }
@@ -267,12 +139,12 @@ CameraSpec readCamera(const json& j, const std::string& path, const std::string&
   c.hfov_deg = o.number("hfov_deg");
   if (!(c.hfov_deg > 0 && c.hfov_deg < 180)) {
     throw ConfigError(file + ": " + o.at("hfov_deg") + ": expected degrees in (0, 180), got " +
-                      Obj::fmt(c.hfov_deg));
+                      fmt(c.hfov_deg));
   }
   c.rate_hz = o.number("rate_hz");
   if (!(c.rate_hz > 0)) {
     throw ConfigError(file + ": " + o.at("rate_hz") + ": expected a positive rate, got " +
-                      Obj::fmt(c.rate_hz));
+                      fmt(c.rate_hz));
   }
   c.modalities = strings(o.array("modalities"), o.at("modalities"), file);
   o.finish();
@@ -389,13 +261,13 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
     spec.altitude_max = alt.number("max");
     if (!(spec.altitude_min <= spec.altitude_max)) {
       throw ConfigError(file + ": uav.altitude: expected min <= max, got " +
-                        Obj::fmt(spec.altitude_min) + " > " + Obj::fmt(spec.altitude_max));
+                        fmt(spec.altitude_min) + " > " + fmt(spec.altitude_max));
     }
     alt.finish();
     spec.max_speed = u.number("max_speed");
     if (!(spec.max_speed > 0)) {
       throw ConfigError(file + ": uav.max_speed: expected a positive speed, got " +
-                        Obj::fmt(spec.max_speed));
+                        fmt(spec.max_speed));
     }
     Obj payload = u.object("payload");
     const json& cams = payload.array("cameras");
