@@ -221,22 +221,10 @@ SceneRelation readRelation(const json& j, const std::string& path, const std::st
 Mission missionFromJson(const json& j, const std::string& file) {
   Obj root(j, "", file);
   Mission m;
-  const std::string schema = root.string("schema");
-  if (schema != "hameritt/mission") {
-    throw ConfigError(file + ": schema: expected \"hameritt/mission\", got \"" + schema + "\"");
-  }
-  const std::int64_t version = root.integer("schema_version");
-  if (version != kSchemaVersion) {
-    throw ConfigError(file + ": schema_version: expected " + std::to_string(kSchemaVersion) +
-                      ", got " + std::to_string(version));
-  }
-  m.scenario_id = root.string("scenario_id");
-  const std::string cls = root.string("class");
-  if (!parseScenarioClass(cls, &m.cls)) {
-    throw ConfigError(file + ": class: expected area_search, route_search or pursuit, got \"" +
-                      cls + "\"");
-  }
-  m.seed = root.unsignedInteger("seed");
+  const strict_json::Header h = strict_json::header(root, "hameritt/mission");
+  m.scenario_id = h.scenario_id;
+  m.cls = h.cls;
+  m.seed = h.seed;
   {
     Obj frame = root.object("frame");
     const std::string type = frame.string("type");

@@ -160,22 +160,10 @@ SimConfig simConfigFromJson(const nlohmann::json& j, const std::string& file) {
 SimConfig simConfigFromJson(const json& j, const std::string& file) {
   Obj root(j, "", file);
   SimConfig s;
-  const std::string schema = root.string("schema");
-  if (schema != "hameritt/sim_config") {
-    throw ConfigError(file + ": schema: expected \"hameritt/sim_config\", got \"" + schema + "\"");
-  }
-  const std::int64_t version = root.integer("schema_version");
-  if (version != kSchemaVersion) {
-    throw ConfigError(file + ": schema_version: expected " + std::to_string(kSchemaVersion) +
-                      ", got " + std::to_string(version));
-  }
-  s.scenario_id = root.string("scenario_id");
-  const std::string cls = root.string("class");
-  if (!parseScenarioClass(cls, &s.cls)) {
-    throw ConfigError(file + ": class: expected area_search, route_search or pursuit, got \"" +
-                      cls + "\"");
-  }
-  s.seed = root.unsignedInteger("seed");
+  const strict_json::Header h = strict_json::header(root, "hameritt/sim_config");
+  s.scenario_id = h.scenario_id;
+  s.cls = h.cls;
+  s.seed = h.seed;
   s.duration = root.number("duration");
   if (!(s.duration >= 0)) throw ConfigError(file + ": duration: expected a non-negative number");
 

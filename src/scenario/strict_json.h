@@ -154,4 +154,34 @@ inline Trajectory trajectory(const json& v, const std::string& path, const std::
   return out;
 }
 
+// The header shared by mission.json and sim_config.json (see writeHeader in scenario_io.cpp).
+struct Header {
+  std::string scenario_id;
+  ScenarioClass cls = ScenarioClass::kAreaSearch;
+  std::uint64_t seed = 0;
+};
+
+// Reads and checks "schema" (== kind), "schema_version", "scenario_id", "class" and "seed".
+inline Header header(Object& root, const std::string& kind) {
+  const std::string& file = root.file();
+  const std::string schema = root.string("schema");
+  if (schema != kind) {
+    throw ConfigError(file + ": schema: expected \"" + kind + "\", got \"" + schema + "\"");
+  }
+  const std::int64_t version = root.integer("schema_version");
+  if (version != kSchemaVersion) {
+    throw ConfigError(file + ": schema_version: expected " + std::to_string(kSchemaVersion) +
+                      ", got " + std::to_string(version));
+  }
+  Header h;
+  h.scenario_id = root.string("scenario_id");
+  const std::string cls = root.string("class");
+  if (!parseScenarioClass(cls, &h.cls)) {
+    throw ConfigError(file + ": class: expected area_search, route_search or pursuit, got \"" +
+                      cls + "\"");
+  }
+  h.seed = root.unsignedInteger("seed");
+  return h;
+}
+
 }  // namespace hameritt::scenario::strict_json
