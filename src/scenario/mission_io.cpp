@@ -291,15 +291,7 @@ Mission missionFromJson(const json& j, const std::string& file) {
 }
 
 Mission loadMission(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw ConfigError(path + ": malformed JSON: " + e.what());
-  }
-  return missionFromJson(j, path);
+  return missionFromJson(strict_json::parseFile(path), path);
 }
 
 }  // namespace hameritt::scenario

@@ -283,15 +283,7 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
 }
 
 SimConfig loadSimConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open file");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw ConfigError(path + ": malformed JSON: " + e.what());
-  }
-  return simConfigFromJson(j, path);
+  return simConfigFromJson(strict_json::parseFile(path), path);
 }
 
 World generateCheckedWorld(const SimConfig& config, const std::string& file) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -30,6 +31,17 @@ inline std::string fmt(double v) {
 // "path[i]".
 inline std::string idx(const std::string& path, std::size_t i) {
   return path + "[" + std::to_string(i) + "]";
+}
+
+// Parses a whole file, keeping key order (ConfigError on I/O or syntax errors, with the file).
+inline json parseFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open file");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw ConfigError(path + ": malformed JSON: " + e.what());
+  }
 }
 
 // A JSON object being read strictly.

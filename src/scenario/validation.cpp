@@ -749,20 +749,7 @@ class Semantics {
       const std::string p = jsonPointerAppend("/entities", i);
       ids.note(ents[i], p);
       has_target = has_target || stringAt(ents[i], "role") == std::optional<std::string>("target");
-      const json& traj = arrayOrEmpty(ents[i], "trajectory");
-      double prev = 0.0;
-      for (std::size_t k = 0; k < traj.size(); ++k) {
-        if (!traj[k].is_array() || traj[k].empty() || !traj[k][0].is_number()) break;
-        const double t = traj[k][0].get<double>();
-        const std::string sp = jsonPointerAppend(p + "/trajectory", k);
-        if (k == 0 && t < 0) {
-          add(sp, "trajectory_order", "t = " + num(t) + " is before the mission start");
-        } else if (k > 0 && !(t > prev)) {
-          add(sp, "trajectory_order",
-              "t = " + num(t) + " does not increase on the previous sample's t = " + num(prev));
-        }
-        prev = t;
-      }
+      trajectoryOrder(arrayOrEmpty(ents[i], "trajectory"), p + "/trajectory");
     }
     if (!ents.empty() && !has_target)
       add("/entities", "role_target", "no entity has role 'target'");
@@ -785,17 +772,14 @@ class Semantics {
     if (exists("/uav/perception_path")) perceptionPath(ents);
   }
 
-  // The perception-only flight: strictly increasing times from t >= 0, and every target it
-  // claims to see is a target entity of this scenario.
-  void perceptionPath(const json& ents) {
-    const std::string base = "/uav/perception_path";
-    const json& pp = doc_.at(json::json_pointer(base));
-    const json& traj = arrayOrEmpty(pp, "trajectory");
+  // Samples [t, x, y, z, yaw] of a timed path at `pointer`: t >= 0 and strictly increasing
+  // (malformed samples are the schema's to report).
+  void trajectoryOrder(const json& traj, const std::string& pointer) {
     double prev = 0.0;
     for (std::size_t k = 0; k < traj.size(); ++k) {
       if (!traj[k].is_array() || traj[k].empty() || !traj[k][0].is_number()) break;
       const double t = traj[k][0].get<double>();
-      const std::string sp = jsonPointerAppend(base + "/trajectory", k);
+      const std::string sp = jsonPointerAppend(pointer, k);
       if (k == 0 && t < 0) {
         add(sp, "trajectory_order", "t = " + num(t) + " is before the mission start");
       } else if (k > 0 && !(t > prev)) {
@@ -804,6 +788,14 @@ class Semantics {
       }
       prev = t;
     }
+  }
+
+  // The perception-only flight: strictly increasing times from t >= 0, and every target it
+  // claims to see is a target entity of this scenario.
+  void perceptionPath(const json& ents) {
+    const std::string base = "/uav/perception_path";
+    const json& pp = doc_.at(json::json_pointer(base));
+    trajectoryOrder(arrayOrEmpty(pp, "trajectory"), base + "/trajectory");
     std::set<std::string> targets;
     for (const auto& e : ents) {
       if (stringAt(e, "role") == std::optional<std::string>("target")) {
