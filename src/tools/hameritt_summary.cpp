@@ -77,6 +77,13 @@ void summarize(const std::string& dir) {
   std::printf("uav        start (%s, %s), altitude %s..%s m, %zu cameras\n", uav.at("start").at("x").dump().c_str(),
               uav.at("start").at("y").dump().c_str(), uav.at("altitude").at("min").dump().c_str(),
               uav.at("altitude").at("max").dump().c_str(), uav.at("payload").at("cameras").size());
+  if (uav.contains("perception_path")) {
+    const auto& pp = uav.at("perception_path");
+    const auto& traj = pp.at("trajectory");
+    std::printf("perception %s path, %zu samples over %s s, sees %zu target(s)\n",
+                pp.at("status").get<std::string>().c_str(), traj.size(),
+                traj.empty() ? "0" : traj.back().at(0).dump().c_str(), pp.at("targets_seen").size());
+  }
 }
 
 }  // namespace
