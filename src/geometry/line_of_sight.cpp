@@ -128,6 +128,7 @@ std::vector<int> areaCandidates(const std::vector<Entry>& cells, double cell, st
     collectAll(boxes, &out);
     return out;
   }
+  out.reserve(64);  // typical queries return a few dozen boxes: avoid regrowing
   collectGlobal(cells, &out);
   for (int ix = x0; ix <= x1; ++ix) collectColumn(cells, ix, y0, y1, &out);
   sortUnique(&out);
