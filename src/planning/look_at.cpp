@@ -1,10 +1,9 @@
 #include "hameritt/planning/look_at.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <limits>
-
-#include <Eigen/Geometry>
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
@@ -15,12 +14,6 @@ using geometry::Vec2;
 using geometry::Vec3;
 
 namespace {
-
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
 
 Eigen::Matrix3d worldFromCamera(const scenario::CameraSpec& cam, double uav_yaw) {
   const Vec3 rpy = cam.mount_rpy * (geometry::kPi / 180.0);
@@ -63,7 +56,9 @@ std::optional<Vec2> projectToImage(const scenario::CameraSpec& cam, const Vec3& 
 
 void LookAtSettings::validate() const {
   auto need = [](bool ok, const char* f, const std::string& what, double v) {
-    if (!ok) throw scenario::ConfigError(std::string("look_at.") + f + ": expected " + what + ", got " + fmt(v));
+    if (!ok)
+      throw scenario::ConfigError(std::string("look_at.") + f + ": expected " + what + ", got " +
+                                  scenario::formatNumber(v));
   };
   need(candidates >= 1, "candidates", "an integer >= 1", candidates);
   need(range_min >= 0, "range_min", "metres >= 0", range_min);
@@ -147,7 +142,8 @@ LookAtResult planLookAtPath(const WorldValidity& validity, const scenario::Camer
       f.path.clear();
       return r;
     }
-    for (std::size_t k = f.path.empty() ? 0 : 1; k < leg.path.size(); ++k) f.path.push_back(leg.path[k]);
+    for (std::size_t k = f.path.empty() ? 0 : 1; k < leg.path.size(); ++k)
+      f.path.push_back(leg.path[k]);
     f.length += leg.length;
     auto last = f.path.back();
     const double turn = std::abs(geometry::wrapPi(order[j].yaw - last.yaw));
@@ -159,8 +155,9 @@ LookAtResult planLookAtPath(const WorldValidity& validity, const scenario::Camer
     t = last.t;
     from = Vec3(last.x, last.y, last.z);
   }
-  if (f.path.empty()) f.path.push_back({roundMilli(t0), roundMilli(start.x()), roundMilli(start.y()),
-                                        roundMilli(start.z()), 0.0});
+  if (f.path.empty())
+    f.path.push_back(
+        {roundMilli(t0), roundMilli(start.x()), roundMilli(start.y()), roundMilli(start.z()), 0.0});
   // 4. Verify on the final path: whole path valid; each dwell sample sees its target.
   const std::string err = validity.checkTrajectory(f.path, 0.25, 2e-3);
   if (!err.empty()) {

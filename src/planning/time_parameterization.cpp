@@ -13,16 +13,11 @@ using geometry::Vec3;
 
 namespace {
 
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
 void requirePositive(double v, const char* field) {
   if (!(v > 0 && std::isfinite(v))) {
     throw scenario::ConfigError(std::string("planning.speed.") + field +
-                                ": expected a positive finite number, got " + fmt(v));
+                                ": expected a positive finite number, got " +
+                                scenario::formatNumber(v));
   }
 }
 
@@ -82,8 +77,8 @@ scenario::Trajectory timeParameterize(const std::vector<Vec3>& polyline, double 
   using scenario::roundMilli;
   scenario::Trajectory out;
   if (p.size() == 1) {
-    out.push_back({roundMilli(t0), roundMilli(p[0].x()), roundMilli(p[0].y()),
-                   roundMilli(p[0].z()), roundMilli(initial_yaw)});
+    out.push_back({roundMilli(t0), roundMilli(p[0].x()), roundMilli(p[0].y()), roundMilli(p[0].z()),
+                   roundMilli(initial_yaw)});
     return out;
   }
   const std::size_t n = p.size() - 1;  // segments
@@ -109,8 +104,10 @@ scenario::Trajectory timeParameterize(const std::vector<Vec3>& polyline, double 
     v[i] = std::min(cap[i - 1], cap[i]) * (1 + c) / 2;
   }
   const double a = limits.accel;
-  for (std::size_t i = 0; i < n; ++i) v[i + 1] = std::min(v[i + 1], std::sqrt(v[i] * v[i] + 2 * a * len[i]));
-  for (std::size_t i = n; i-- > 0;) v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * a * len[i]));
+  for (std::size_t i = 0; i < n; ++i)
+    v[i + 1] = std::min(v[i + 1], std::sqrt(v[i] * v[i] + 2 * a * len[i]));
+  for (std::size_t i = n; i-- > 0;)
+    v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * a * len[i]));
 
   double t = t0;
   auto emit = [&](const Vec3& q, double time, double heading) {

@@ -1,12 +1,5 @@
 #include "hameritt/planning/uav_planner.h"
 
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <limits>
-#include <mutex>
-
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/ProblemDefinition.h>
 #include <ompl/base/objectives/PathLengthOptimizationObjective.h>
@@ -16,6 +9,13 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/geometric/planners/rrt/RRTstar.h>
 #include <ompl/util/Console.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <mutex>
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
@@ -49,12 +49,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Output paths are rounded to 1e-3; they are validated with the margin reduced by this.
 constexpr double kValidationSlack = 2e-3;
-
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
 
 // RRT-Connect and RRT* with their (otherwise process-seeded) RNG re-seeded per plan.
 class SeededRrtConnect : public og::RRTConnect {
@@ -103,9 +97,10 @@ struct TimeModel {
   }
 };
 
-Vec3 pointAt(const std::vector<Vec3>& p, const std::vector<double>& cum, double s, std::size_t* seg) {
-  std::size_t i = static_cast<std::size_t>(
-      std::upper_bound(cum.begin(), cum.end(), s) - cum.begin());
+Vec3 pointAt(const std::vector<Vec3>& p, const std::vector<double>& cum, double s,
+             std::size_t* seg) {
+  std::size_t i =
+      static_cast<std::size_t>(std::upper_bound(cum.begin(), cum.end(), s) - cum.begin());
   i = std::clamp<std::size_t>(i, 1, p.size() - 1) - 1;
   *seg = i;
   const double l = cum[i + 1] - cum[i];
@@ -176,7 +171,8 @@ Attempt runOmpl(const WorldValidity& validity, const TimeModel& tm, const Vec3& 
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker([&tm](const ob::State* s) { return tm.point(vec(s)); });
   si->setMotionValidator(std::make_shared<detail::PredicateMotionValidator>(
-      si.get(), [&tm](const ob::State* a, const ob::State* c) { return tm.segment(vec(a), vec(c)); }));
+      si.get(),
+      [&tm](const ob::State* a, const ob::State* c) { return tm.segment(vec(a), vec(c)); }));
   si->setup();
 
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
@@ -225,13 +221,16 @@ Attempt runOmpl(const WorldValidity& validity, const TimeModel& tm, const Vec3& 
   const bool approx = pdef->hasApproximateSolution();
   if (exact || (approx && st.accept_approximate)) {
     const auto& path = *pdef->getSolutionPath()->as<og::PathGeometric>();
-    for (std::size_t i = 0; i < path.getStateCount(); ++i) out.path.push_back(vec(path.getState(i)));
+    for (std::size_t i = 0; i < path.getStateCount(); ++i)
+      out.path.push_back(vec(path.getState(i)));
     out.status = exact ? PlanStatus::kExact : PlanStatus::kApproximate;
-    if (!exact) out.message = "approximate: ends " + fmt((out.path.back() - goal).norm()) +
-                              " m from the goal";
+    if (!exact)
+      out.message = "approximate: ends " + scenario::formatNumber((out.path.back() - goal).norm()) +
+                    " m from the goal";
   } else if (wall) {
     out.status = PlanStatus::kTimeout;
-    out.message = "no path within the time limit of " + fmt(st.time_limit) + " s";
+    out.message =
+        "no path within the time limit of " + scenario::formatNumber(st.time_limit) + " s";
   } else {
     out.status = PlanStatus::kNoSolution;
     out.message = "no path found within " + std::to_string(budget) + " iterations";
@@ -243,24 +242,32 @@ Attempt runOmpl(const WorldValidity& validity, const TimeModel& tm, const Vec3& 
 
 const char* toString(PlanStatus s) {
   switch (s) {
-    case PlanStatus::kExact: return "exact";
-    case PlanStatus::kApproximate: return "approximate";
-    case PlanStatus::kNoSolution: return "no_solution";
-    case PlanStatus::kInvalidStart: return "invalid_start";
-    case PlanStatus::kInvalidGoal: return "invalid_goal";
-    case PlanStatus::kTimeout: return "timeout";
+    case PlanStatus::kExact:
+      return "exact";
+    case PlanStatus::kApproximate:
+      return "approximate";
+    case PlanStatus::kNoSolution:
+      return "no_solution";
+    case PlanStatus::kInvalidStart:
+      return "invalid_start";
+    case PlanStatus::kInvalidGoal:
+      return "invalid_goal";
+    case PlanStatus::kTimeout:
+      return "timeout";
   }
   return "unknown";
 }
 
 void UavPlannerSettings::validate() const {
   auto bad = [](const char* field, const std::string& what, double v) {
-    throw scenario::ConfigError(std::string("planning.") + field + ": expected " + what +
-                                ", got " + fmt(v));
+    throw scenario::ConfigError(std::string("planning.") + field + ": expected " + what + ", got " +
+                                scenario::formatNumber(v));
   };
-  if (!(range > 0 && std::isfinite(range))) bad("range", "a positive finite distance in metres", range);
+  if (!(range > 0 && std::isfinite(range)))
+    bad("range", "a positive finite distance in metres", range);
   if (!(goal_bias >= 0 && goal_bias <= 1)) bad("goal_bias", "a probability in [0, 1]", goal_bias);
-  if (!(time_limit > 0 && time_limit <= 3600)) bad("time_limit", "seconds in (0, 3600]", time_limit);
+  if (!(time_limit > 0 && time_limit <= 3600))
+    bad("time_limit", "seconds in (0, 3600]", time_limit);
   if (max_iterations < 1) bad("max_iterations", "an integer >= 1", max_iterations);
   if (rrtstar_iterations < 1) bad("rrtstar_iterations", "an integer >= 1", rrtstar_iterations);
   if (shortcut_iterations < 0) bad("shortcut_iterations", "an integer >= 0", shortcut_iterations);
@@ -280,7 +287,8 @@ PlanResult planUavPath(const WorldValidity& validity, const Vec3& start, const V
                                     std::chrono::duration<double>(settings.time_limit));
   PlanResult r;
   auto finish = [&]() {
-    r.planning_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    r.planning_time =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
     return r;
   };
   const double vmax = std::hypot(settings.speed.max_speed,
@@ -298,7 +306,8 @@ PlanResult planUavPath(const WorldValidity& validity, const Vec3& start, const V
     r.status = PlanStatus::kInvalidGoal;
     std::string why = validity.explain(goal, t_goal);
     if (why.empty()) {
-      why = "goal lies in a keep-out zone active after the earliest arrival at t = " + fmt(t_goal);
+      why = "goal lies in a keep-out zone active after the earliest arrival at t = " +
+            scenario::formatNumber(t_goal);
     }
     r.message = "goal " + why;
     return finish();
@@ -329,8 +338,8 @@ PlanResult planUavPath(const WorldValidity& validity, const Vec3& start, const V
       last_failure = a.message;
       continue;
     }
-    std::vector<Vec3> geo = shortcut(a.path, tm, settings.shortcut_iterations,
-                                     scenario::deriveSeed(aseed, 7));
+    std::vector<Vec3> geo =
+        shortcut(a.path, tm, settings.shortcut_iterations, scenario::deriveSeed(aseed, 7));
     scenario::Trajectory traj = timeParameterize(geo, t0, settings.speed, settings.sample_spacing);
     const std::string err = validity.checkTrajectory(traj, 0.25, kValidationSlack);
     if (!err.empty()) {

@@ -18,12 +18,6 @@ using geometry::Vec3;
 
 namespace {
 
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Distance in the plane from the segment [a, b] to the polygon region (0 when they touch).
@@ -62,15 +56,16 @@ void clip(double fa, double fb, double flo, double fhi, double* lo, double* hi) 
 void ValiditySettings::validate() const {
   if (!(margin >= 0.1 && margin <= 20.0)) {
     throw scenario::ConfigError("planning.margin: expected metres in [0.1, 20], got " +
-                                fmt(margin));
+                                scenario::formatNumber(margin));
   }
   if (!(altitude_min >= 0.0 && std::isfinite(altitude_min))) {
     throw scenario::ConfigError("planning.altitude_min: expected a finite number >= 0, got " +
-                                fmt(altitude_min));
+                                scenario::formatNumber(altitude_min));
   }
   if (!(altitude_max > altitude_min && std::isfinite(altitude_max))) {
     throw scenario::ConfigError("planning.altitude_max: expected a finite number > altitude_min (" +
-                                fmt(altitude_min) + "), got " + fmt(altitude_max));
+                                scenario::formatNumber(altitude_min) + "), got " +
+                                scenario::formatNumber(altitude_max));
   }
 }
 
@@ -259,16 +254,17 @@ std::string WorldValidity::explain(const Vec3& p, double t) const {
   const std::string where = buf;
   if (!p.allFinite()) return where + ": not finite";
   if (p.z() < settings_.altitude_min || p.z() > settings_.altitude_max) {
-    return where + ": outside the altitude band [" + fmt(settings_.altitude_min) + ", " +
-           fmt(settings_.altitude_max) + "]";
+    return where + ": outside the altitude band [" +
+           scenario::formatNumber(settings_.altitude_min) + ", " +
+           scenario::formatNumber(settings_.altitude_max) + "]";
   }
   if (!bounds_.contains(p.head<2>())) return where + ": outside the neighborhood bounds";
   const Vec2 q = p.head<2>();
   for (int i : obstacles_->index.candidates(geometry::Aabb2{q, q})) {
     if (obstacles_->index.box(i).contains(p)) {
-      return where + ": inside the box of " + world_.entities()[static_cast<std::size_t>(
-                                                  world_.occluderOwner(i))].id +
-             " inflated by " + fmt(settings_.margin) + " m";
+      return where + ": inside the box of " +
+             world_.entities()[static_cast<std::size_t>(world_.occluderOwner(i))].id +
+             " inflated by " + scenario::formatNumber(settings_.margin) + " m";
     }
   }
   for (std::size_t i = 0; i < kozs_.size(); ++i) {

@@ -1,5 +1,8 @@
 #include "hameritt/planning/vehicle_routes.h"
 
+#include <ompl/base/ScopedState.h>
+#include <ompl/base/spaces/DubinsStateSpace.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,9 +11,6 @@
 #include <memory>
 #include <mutex>
 #include <queue>
-
-#include <ompl/base/ScopedState.h>
-#include <ompl/base/spaces/DubinsStateSpace.h>
 
 #include "hameritt/geometry/oriented_box.h"
 #include "hameritt/geometry/segment.h"
@@ -26,12 +26,6 @@ using scenario::World;
 
 namespace {
 
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
 struct Pose {
   Vec2 p;
   double yaw;
@@ -43,8 +37,8 @@ int nearestEdge(const World& w, const Vec2& p, double* dist) {
   *dist = std::numeric_limits<double>::infinity();
   for (std::size_t e = 0; e < w.edges().size(); ++e) {
     const auto& ed = w.edges()[e];
-    const double d = geometry::pointSegmentDistance(p, w.nodes()[ed.a].position,
-                                                    w.nodes()[ed.b].position);
+    const double d =
+        geometry::pointSegmentDistance(p, w.nodes()[ed.a].position, w.nodes()[ed.b].position);
     if (d < *dist) {
       *dist = d;
       best = static_cast<int>(e);
@@ -82,14 +76,16 @@ double along(const World& w, const Leg& l, const Vec2& p) {
 }
 
 // Dijkstra over the street graph from `from` (arriving over edge `in_edge`, no U-turn onto it)
-// to `to` (not arriving over `out_edge`, the edge it leaves by), with seeded noisy costs. Returns the node sequence, empty when unreachable.
+// to `to` (not arriving over `out_edge`, the edge it leaves by), with seeded noisy costs. Returns
+// the node sequence, empty when unreachable.
 std::vector<int> search(const World& w, int from, int in_edge, int to, std::uint64_t seed,
                         double noise, int out_edge) {
   scenario::Rng rng(seed);
   std::vector<double> cost(w.edges().size());
   for (std::size_t e = 0; e < cost.size(); ++e) {
     const auto& ed = w.edges()[e];
-    cost[e] = (w.nodes()[ed.b].position - w.nodes()[ed.a].position).norm() * (1 + noise * rng.unit());
+    cost[e] =
+        (w.nodes()[ed.b].position - w.nodes()[ed.a].position).norm() * (1 + noise * rng.unit());
   }
   // State: (node, edge it was entered by) so that U-turns can be excluded.
   const std::size_t ne = w.edges().size();
@@ -173,7 +169,8 @@ class StreetIndex {
   bool onStreet(const World& w, const Vec2& p) const {
     const double fx = (p.x() - x0_) / cell_, fy = (p.y() - y0_) / cell_;
     if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return planning::onStreet(w, p);
-    const std::size_t c = static_cast<std::size_t>(static_cast<int>(fy) * nx_ + static_cast<int>(fx));
+    const std::size_t c =
+        static_cast<std::size_t>(static_cast<int>(fy) * nx_ + static_cast<int>(fx));
     for (int e : cells_[c]) {
       const Seg& s = segs_[static_cast<std::size_t>(e)];
       if (geometry::pointSegmentDistance(p, s.a, s.b) <= s.half_width) return true;
@@ -268,8 +265,8 @@ std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::ve
 }
 
 // Dense Dubins samples (every <= 0.25 m) from a to b, or empty when some sample is invalid.
-std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose& a,
-                         const Pose& b, double radius, const RouteSettings& s) {
+std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose& a, const Pose& b,
+                         double radius, const RouteSettings& s) {
   // Poses on one line with one heading (the usual case for lane segments, up to the 1e-3
   // rounding of the inputs) are joined by a straight segment: OMPL's Dubins code snaps angles
   // within 5e-7 rad of zero and then asserts on the result, which such long near-straight
@@ -311,7 +308,8 @@ void SpeedProfile::validate() const {
   auto need = [](double v, const char* f) {
     if (!(v > 0 && std::isfinite(v))) {
       throw scenario::ConfigError(std::string("route.speed.") + f +
-                                  ": expected a positive finite number, got " + fmt(v));
+                                  ": expected a positive finite number, got " +
+                                  scenario::formatNumber(v));
     }
   };
   need(cruise_speed, "cruise_speed");
@@ -320,20 +318,24 @@ void SpeedProfile::validate() const {
   need(corner_speed, "corner_speed");
   if (corner_speed > cruise_speed) {
     throw scenario::ConfigError("route.speed.corner_speed: expected at most cruise_speed (" +
-                                fmt(cruise_speed) + "), got " + fmt(corner_speed));
+                                scenario::formatNumber(cruise_speed) + "), got " +
+                                scenario::formatNumber(corner_speed));
   }
 }
 
 void RouteSettings::validate() const {
   auto need = [](bool ok, const char* f, const std::string& what, double v) {
-    if (!ok) throw scenario::ConfigError(std::string("route.") + f + ": expected " + what + ", got " + fmt(v));
+    if (!ok)
+      throw scenario::ConfigError(std::string("route.") + f + ": expected " + what + ", got " +
+                                  scenario::formatNumber(v));
   };
   need(lane_offset >= 0 && lane_offset < 10, "lane_offset", "metres in [0, 10)", lane_offset);
   need(corner_clearance > 0 && corner_clearance < 50, "corner_clearance", "metres in (0, 50)",
        corner_clearance);
   need(turn_radius > 0.5 && turn_radius < 50, "turn_radius", "metres in (0.5, 50)", turn_radius);
   need(cost_noise >= 0 && cost_noise <= 10, "cost_noise", "a number in [0, 10]", cost_noise);
-  need(vehicle_length > 0 && vehicle_length < 20, "vehicle_length", "metres in (0, 20)", vehicle_length);
+  need(vehicle_length > 0 && vehicle_length < 20, "vehicle_length", "metres in (0, 20)",
+       vehicle_length);
   need(vehicle_width > 0 && vehicle_width < 5, "vehicle_width", "metres in (0, 5)", vehicle_width);
   need(sample_spacing >= 0.25 && sample_spacing <= 50, "sample_spacing", "metres in [0.25, 50]",
        sample_spacing);
@@ -363,7 +365,8 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   const int e0 = nearestEdge(w, sp.p, &d);
   if (e0 < 0 || !carValid(w, streets, sp, s)) {
     r.status = PlanStatus::kInvalidStart;
-    r.message = "start (" + fmt(start.x) + ", " + fmt(start.y) + ") is not a clear pose on a street";
+    r.message = "start (" + scenario::formatNumber(start.x) + ", " +
+                scenario::formatNumber(start.y) + ") is not a clear pose on a street";
     return r;
   }
   const Leg first = directed(w, e0, sp.yaw);
@@ -376,8 +379,8 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
     const int ge = nearestEdge(w, gp->p, &gd);
     if (ge < 0 || !carValid(w, streets, *gp, s)) {
       r.status = PlanStatus::kInvalidGoal;
-      r.message = "goal pose (" + fmt(gp->p.x()) + ", " + fmt(gp->p.y()) +
-                  ") is not a clear pose on a street";
+      r.message = "goal pose (" + scenario::formatNumber(gp->p.x()) + ", " +
+                  scenario::formatNumber(gp->p.y()) + ") is not a clear pose on a street";
       return r;
     }
     last = directed(w, ge, gp->yaw);
@@ -403,8 +406,8 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
     }
     if (gp) {
       // The last node must lead onto the goal's edge in its direction; and not by a U-turn.
-      const int prev_edge = nodes.size() >= 2 ? edgeBetween(w, nodes[nodes.size() - 2], nodes.back())
-                                              : first.edge;
+      const int prev_edge =
+          nodes.size() >= 2 ? edgeBetween(w, nodes[nodes.size() - 2], nodes.back()) : first.edge;
       if (prev_edge == last.edge) {
         r.status = PlanStatus::kNoSolution;
         r.message = "goal pose needs a U-turn";
@@ -442,9 +445,10 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
     }
     if (piece.empty()) {
       r.status = PlanStatus::kNoSolution;
-      r.message = "no valid Dubins curve from (" + fmt(wps[i - 1].p.x()) + ", " +
-                  fmt(wps[i - 1].p.y()) + ") to (" + fmt(wps[i].p.x()) + ", " + fmt(wps[i].p.y()) +
-                  ") on the street surface";
+      r.message = "no valid Dubins curve from (" + scenario::formatNumber(wps[i - 1].p.x()) + ", " +
+                  scenario::formatNumber(wps[i - 1].p.y()) + ") to (" +
+                  scenario::formatNumber(wps[i].p.x()) + ", " +
+                  scenario::formatNumber(wps[i].p.y()) + ") on the street surface";
       return r;
     }
     dense.insert(dense.end(), piece.begin() + 1, piece.end());
@@ -459,8 +463,10 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
     if (ds[i] > 1e-9 && turn / ds[i] > 1.0 / 25.0) cap[i] = cap[i - 1] = speed.corner_speed;
   }
   for (std::size_t i = 1; i + 1 < n; ++i) v[i] = cap[i];
-  for (std::size_t i = 1; i < n; ++i) v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * speed.accel * ds[i]));
-  for (std::size_t i = n - 1; i-- > 0;) v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * speed.decel * ds[i + 1]));
+  for (std::size_t i = 1; i < n; ++i)
+    v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * speed.accel * ds[i]));
+  for (std::size_t i = n - 1; i-- > 0;)
+    v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * speed.decel * ds[i + 1]));
   using scenario::roundMilli;
   double t = start.t, since = 0.0;
   r.trajectory.push_back({roundMilli(t), roundMilli(dense[0].p.x()), roundMilli(dense[0].p.y()),

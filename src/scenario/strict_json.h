@@ -22,11 +22,7 @@ namespace hameritt::scenario::strict_json {
 using json = nlohmann::ordered_json;
 
 // A double with all its digits, for messages.
-inline std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
+inline std::string fmt(double v) { return formatNumber(v); }
 
 // "path[i]".
 inline std::string idx(const std::string& path, std::size_t i) {

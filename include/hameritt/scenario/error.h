@@ -2,10 +2,18 @@
 // Typed errors of the scenario module. Each message names the file (when there is one), the
 // field (a JSON path) and what was expected.
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace hameritt::scenario {
+
+// A double with all its significant digits, for error messages ("got 1e-05", "got 0.1").
+inline std::string formatNumber(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.17g", v);
+  return buf;
+}
 
 // Bad configuration or input document: exit code 2 in the command-line tools.
 class ConfigError : public std::runtime_error {
