@@ -1021,6 +1021,19 @@ class MapPainter {
   }
 
   // Blends `layer` into the image with `alpha` where `mask` is set.
+  // Polygons filled with their colours and blended over the map at `alpha` (areas, zones,
+  // bands): one layer and one mask, so overlaps are not darkened twice.
+  void translucent(const std::vector<std::pair<const std::vector<Vec2>*, cv::Scalar>>& shapes,
+                   double alpha) {
+    cv::Mat layer = img_.clone();
+    cv::Mat mask = cv::Mat::zeros(img_.size(), CV_8UC1);
+    for (const auto& [poly, color] : shapes) {
+      fill(*poly, color, &layer, cv::LINE_8);
+      fill(*poly, cv::Scalar(255), &mask, cv::LINE_8);
+    }
+    blend(layer, mask, alpha);
+  }
+
   void blend(const cv::Mat& layer, const cv::Mat& mask, double alpha) {
     cv::Mat mixed;
     cv::addWeighted(img_, 1.0 - alpha, layer, alpha, 0.0, mixed);
@@ -1173,15 +1186,11 @@ class MapPainter {
   void drawPriors(const MapData& d) {
     const double pmax = maxProbability(d);
     if (d.priors.empty() || pmax <= 0.0) return;
-    cv::Mat layer = img_.clone();
-    cv::Mat mask = cv::Mat::zeros(img_.size(), CV_8UC1);
+    std::vector<std::pair<const std::vector<Vec2>*, cv::Scalar>> cells;
     for (const auto& pr : d.priors) {
-      for (const auto& c : pr.cells) {
-        fill(c.polygon, heatColor(c.probability / pmax), &layer, cv::LINE_8);
-        fill(c.polygon, cv::Scalar(255), &mask, cv::LINE_8);
-      }
+      for (const auto& c : pr.cells) cells.emplace_back(&c.polygon, heatColor(c.probability / pmax));
     }
-    blend(layer, mask, kPriorAlpha);
+    translucent(cells, kPriorAlpha);
     for (const auto& pr : d.priors) {
       for (const auto& c : pr.cells) outline(c.polygon, true, rgb(110, 140, 190), 1);
     }
@@ -1214,13 +1223,9 @@ class MapPainter {
 
   void drawKozs(const MapData& d) {
     if (d.kozs.empty()) return;
-    cv::Mat layer = img_.clone();
-    cv::Mat mask = cv::Mat::zeros(img_.size(), CV_8UC1);
-    for (const auto& k : d.kozs) {
-      fill(k.polygon, kKozColor, &layer, cv::LINE_8);
-      fill(k.polygon, cv::Scalar(255), &mask, cv::LINE_8);
-    }
-    blend(layer, mask, kKozAlpha);
+    std::vector<std::pair<const std::vector<Vec2>*, cv::Scalar>> zones;
+    for (const auto& k : d.kozs) zones.emplace_back(&k.polygon, kKozColor);
+    translucent(zones, kKozAlpha);
     for (const auto& k : d.kozs) {
       hatch(k.polygon, kKozEdge, 9);
       if (k.window.net || k.window.nlt) dashed(k.polygon, true, kKozEdge, 2);
@@ -1230,13 +1235,9 @@ class MapPainter {
 
   void drawRoutes(const MapData& d) {
     if (d.routes.empty()) return;
-    cv::Mat layer = img_.clone();
-    cv::Mat mask = cv::Mat::zeros(img_.size(), CV_8UC1);
-    for (const auto& r : d.routes) {
-      fill(r.band, kRoute, &layer, cv::LINE_8);
-      fill(r.band, cv::Scalar(255), &mask, cv::LINE_8);
-    }
-    blend(layer, mask, kBandAlpha);
+    std::vector<std::pair<const std::vector<Vec2>*, cv::Scalar>> bands;
+    for (const auto& r : d.routes) bands.emplace_back(&r.band, kRoute);
+    translucent(bands, kBandAlpha);
     for (const auto& r : d.routes) {
       dashed(r.band, true, kRoute, 2);
       outline(r.polyline, false, kRoute, 7);
