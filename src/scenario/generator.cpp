@@ -274,8 +274,7 @@ class ScenarioBuilder {
 
   // ------------------------------------------------------------------ constraints
   AreaOfInterest makeAoi(const std::string& id, const Vec2& contains, double yaw, double len,
-                         double wid, std::vector<Vec2>* grid_origin_axes) {
-    (void)grid_origin_axes;
+                         double wid) {
     AreaOfInterest a;
     a.id = id;
     const Vec2 ax(std::cos(yaw), std::sin(yaw)), ay(-std::sin(yaw), std::cos(yaw));
@@ -692,14 +691,14 @@ class ScenarioBuilder {
       const double len = rangeDraw(rng_, cfg_.aoi_length), wid = rangeDraw(rng_, cfg_.aoi_width);
       AreaOfInterest a;
       if (i == 0) {
-        a = makeAoi(id, tp, yaw0, len, wid, nullptr);
+        a = makeAoi(id, tp, yaw0, len, wid);
         if (!a.polygon.contains(tp)) throw GenerationError("target AOI does not contain the target");
       } else {
         bool ok = false;
         for (int attempt = 0; attempt < 30 && !ok; ++attempt) {
           const auto b = world_.bounds();
           const Vec2 p(rng_.uniform(b.min.x(), b.max.x()), rng_.uniform(b.min.y(), b.max.y()));
-          a = makeAoi(id, p, rng_.uniform(-0.3, 0.3), len, wid, nullptr);
+          a = makeAoi(id, p, rng_.uniform(-0.3, 0.3), len, wid);
           ok = !a.polygon.intersects(m.aois.front().polygon);
         }
         if (!ok) break;
@@ -1060,7 +1059,7 @@ class ScenarioBuilder {
 
     // AOI around where the car waits, valid until it departs.
     const double len = rangeDraw(rng_, cfg_.aoi_length), wid = rangeDraw(rng_, cfg_.aoi_width);
-    AreaOfInterest aoi = makeAoi("aoi_1", target.box.center2(), rng_.uniform(-0.3, 0.3), len, wid, nullptr);
+    AreaOfInterest aoi = makeAoi("aoi_1", target.box.center2(), rng_.uniform(-0.3, 0.3), len, wid);
     aoi.window.nlt = depart;
     m.aois.push_back(aoi);
     const Vec2 tp = target.box.center2();

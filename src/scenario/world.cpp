@@ -266,9 +266,8 @@ class WorldBuilder {
     ha.set("storeys", static_cast<std::int64_t>(storeys));
     ha.set("address", std::to_string(number) + " " + street_name_);
     const Vec2 hc = at(1.5 + 0.5 * house_w, setback + 0.5 * house_d);
-    const int house = addEntity(EntityClass::kHouse, "house", Vec3(hc.x(), hc.y(), 0.0),
-                                yaw_in, Vec3(house_d, house_w, house_h), ha, bi);
-    (void)house;
+    addEntity(EntityClass::kHouse, "house", Vec3(hc.x(), hc.y(), 0.0),
+              yaw_in, Vec3(house_d, house_w, house_h), ha, bi);
 
     // Driveway from the kerb line to the garage door (or to beside the house).
     const double drive_u = garage ? w - 1.2 - 0.5 * gw : w - 2.8;
