@@ -1,0 +1,135 @@
+#pragma once
+// The in-house off-screen renderer: OpenGL 4.5 core over EGL, headless (Mesa's surfaceless
+// platform with llvmpipe on a CPU-only machine, the EGL device platform on an NVIDIA GPU). One
+// geometry pass writes lit colour, metric depth along the optical axis and packed semantic +
+// instance labels into a multi-target framebuffer; a post pass adds weather particles and the
+// seeded camera noise to the colour only. Labels and depth are exact ground truth of the drawn
+// geometry; bounding boxes come from the instance mask. ROS-free.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hameritt/scenario/entity.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::render {
+
+// EGL/GL unavailable, a model file missing or malformed, a bad request. The message names the
+// file or the field.
+class RenderError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Pinhole intrinsics in the ROS / OpenCV convention: pixel centres at integer (u, v), u right,
+// v down, no distortion. The renderer's projection matches them exactly, so
+// sensor_msgs/CameraInfo K = [fx 0 cx; 0 fy cy; 0 0 1], P = [K | 0].
+struct Intrinsics {
+  int width = 640;
+  int height = 480;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+// Square pixels, principal point at the image centre: fx = fy = (width / 2) / tan(hfov / 2),
+// cx = (width - 1) / 2, cy = (height - 1) / 2. Throws RenderError for sizes < 1 or a field of
+// view outside (0, 180) degrees.
+Intrinsics intrinsicsFromHfov(int width, int height, double hfov_deg);
+
+// The optical frame (z forward, x right, y down) of a camera mounted on base_link (FLU) at
+// mount_xyz (m) with mount_rpy (radians, roll-pitch-yaw, positive pitch looks down), in the
+// world (ENU), given world_T_base.
+Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Eigen::Vector3d& mount_xyz,
+                              const Eigen::Vector3d& mount_rpy);
+
+struct RenderRequest {
+  Intrinsics intrinsics;
+  Eigen::Isometry3d world_T_optical = Eigen::Isometry3d::Identity();
+  // Scenario time (s): moving entities are drawn at their sim_config trajectory pose at this time.
+  double time = 0.0;
+  // Seeds the camera noise and the weather particles together with the scenario seed and the
+  // camera index: the same (seed, camera_index, frame_index) gives the same image, byte for byte.
+  int camera_index = 0;
+  std::uint64_t frame_index = 0;
+  // Colour effects; false gives the clean image (labels and depth are never affected).
+  bool weather = true;  // fog/dust attenuation, rain/snow particles, snow cover (from sim_config)
+  bool noise = true;    // sim_config perturbations.camera_noise
+  // Image-plane direction of the motion blur (perturbations.camera_noise.motion_blur_px long).
+  Eigen::Vector2d blur_direction{1.0, 0.0};
+  // Draw the UAV model at world_T_uav (for external views; a payload camera leaves it out).
+  bool draw_uav = false;
+  Eigen::Isometry3d world_T_uav = Eigen::Isometry3d::Identity();
+  double near_clip = 0.1;   // m
+  double far_clip = 2000.0; // m
+};
+
+// A 2D box of one entity of interest (every car and pedestrian: parked world cars and the
+// scenario's entities) with at least one visible pixel, computed from the instance mask.
+struct BoundingBox {
+  int instance = 0;                   // value in FrameSet::instance
+  std::string entity_id;              // "car_706"
+  scenario::EntityClass cls = scenario::EntityClass::kCar;
+  std::string role;                   // scenario role (target, confuser, ...) or "world"
+  int x_min = 0, y_min = 0, x_max = 0, y_max = 0;  // inclusive pixel bounds of the visible pixels
+  int visible_pixels = 0;             // pixels of the instance in the mask
+  int total_pixels = 0;               // pixels the entity covers with nothing in front of it
+  double occlusion = 0.0;             // 1 - visible / total
+};
+
+struct FrameSet {
+  double time = 0.0;
+  Intrinsics intrinsics;
+  Eigen::Isometry3d world_T_optical = Eigen::Isometry3d::Identity();
+  std::vector<std::uint8_t> rgb;        // width*height*3, row-major, top row first (rgb8)
+  std::vector<float> depth;             // metres along the optical axis; +inf where nothing is hit
+  std::vector<std::uint8_t> semantic;   // 0 sky, 1 ground, else scenario::semanticId(class)
+  std::vector<std::uint16_t> instance;  // 0 none, else Renderer::instanceEntityId(value)
+  std::vector<BoundingBox> boxes;       // sorted by instance
+};
+
+struct RendererOptions {
+  std::string models_dir;          // meshes (models/meshes/*.obj); empty: <package>/models
+  std::string backend = "auto";    // auto (device if an EGL device with a GPU exists, else
+                                   // surfaceless) | surfaceless | device
+};
+
+// World triangles for ray-cast checks (what the renderer draws, in world coordinates).
+struct SceneTriangles {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<std::uint32_t> indices;  // 3 per triangle
+  std::vector<int> triangle_instance;  // instance id per triangle (0 for the ground)
+};
+
+class Renderer {
+ public:
+  // Builds the scene (meshes loaded with assimp, instanced per class) for the world and the
+  // scenario's entities, and creates the EGL context (current on the calling thread).
+  Renderer(const scenario::World& world, const scenario::SimConfig& config,
+           const RendererOptions& options = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders one frame set and reads it back; `out`'s buffers are reused.
+  void render(const RenderRequest& request, FrameSet* out);
+  FrameSet render(const RenderRequest& request);
+
+  // Makes the EGL context current on the calling thread (render() from another thread).
+  void makeCurrent();
+
+  int instanceCount() const;                      // highest instance id + 1
+  const std::string& instanceEntityId(int instance) const;  // "" for 0 / out of range
+  std::string glRenderer() const;                  // GL_RENDERER, e.g. "llvmpipe (LLVM 15...)"
+  SceneTriangles sceneTriangles(double time) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Default models directory: <package>/models (from the source tree the library was built in).
+std::string defaultModelsDir();
+
+}  // namespace hameritt::render
