@@ -134,4 +134,54 @@ nav_msgs::Path toPathMsg(const scenario::Trajectory& path, const ros::Time& stam
   return m;
 }
 
+sensor_msgs::CameraInfo toCameraInfoMsg(const render::Intrinsics& k, const std_msgs::Header& header) {
+  sensor_msgs::CameraInfo m;
+  m.header = header;
+  m.width = static_cast<std::uint32_t>(k.width);
+  m.height = static_cast<std::uint32_t>(k.height);
+  m.distortion_model = "plumb_bob";
+  m.D.assign(5, 0.0);
+  m.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
+  m.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  m.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  return m;
+}
+
+hameritt::BoundingBoxArray toBoxesMsg(const std::vector<render::BoundingBox>& boxes,
+                                      const std::string& camera, const std_msgs::Header& header) {
+  hameritt::BoundingBoxArray m;
+  m.header = header;
+  m.camera = camera;
+  m.boxes.reserve(boxes.size());
+  for (const auto& b : boxes) {
+    hameritt::BoundingBox o;
+    o.entity_id = b.entity_id;
+    o.entity_class = scenario::toString(b.cls);
+    o.role = b.role;
+    o.instance_id = static_cast<std::uint16_t>(b.instance);
+    o.x_min = b.x_min;
+    o.y_min = b.y_min;
+    o.x_max = b.x_max;
+    o.y_max = b.y_max;
+    o.visible_pixels = static_cast<std::uint32_t>(b.visible_pixels);
+    o.total_pixels = static_cast<std::uint32_t>(b.total_pixels);
+    o.occlusion = static_cast<float>(b.occlusion);
+    m.boxes.push_back(std::move(o));
+  }
+  return m;
+}
+
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& t, const std::string& parent,
+                                               const std::string& child, const ros::Time& stamp) {
+  geometry_msgs::TransformStamped m;
+  m.header.stamp = stamp;
+  m.header.frame_id = parent;
+  m.child_frame_id = child;
+  m.transform.translation.x = t.translation().x();
+  m.transform.translation.y = t.translation().y();
+  m.transform.translation.z = t.translation().z();
+  m.transform.rotation = toQuat(Eigen::Quaterniond(t.linear()));
+  return m;
+}
+
 }  // namespace hameritt::ros_wrappers

@@ -55,6 +55,18 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     throw scenario::ConfigError("~real_time_factor: expected >= 0 (0 = unpaced), got " +
                                 std::to_string(real_time_factor_));
   }
+  std::string wait_for;
+  pnh.param<std::string>("wait_for", wait_for, "");
+  pnh.param("wait_timeout", wait_timeout_, wait_timeout_);
+  for (std::size_t a = 0; a < wait_for.size();) {
+    std::size_t b = wait_for.find(',', a);
+    if (b == std::string::npos) b = wait_for.size();
+    std::string t = wait_for.substr(a, b - a);
+    t.erase(0, t.find_first_not_of(' '));
+    t.erase(t.find_last_not_of(' ') + 1);
+    if (!t.empty()) wait_for_.push_back(ros::names::resolve(t));
+    a = b + 1;
+  }
   steps_per_publish_ = ratio(settings.physics_rate_hz, publish_hz, "publish_rate_hz");
   steps_per_ground_truth_ = ratio(settings.physics_rate_hz, truth_hz, "ground_truth_rate_hz");
 
@@ -62,6 +74,23 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (duration_ <= 0) duration_ = config_.duration;
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(config_, sim_config));
   sim_ = std::make_unique<sim::Simulator>(*world_, config_, sim::loadQuadrotorUrdf(urdf), settings);
+  bool cameras = true;
+  pnh.param("cameras", cameras, true);
+  if (cameras && !config_.uav.cameras.empty()) {
+    CameraRigOptions co;
+    co.physics_rate_hz = settings.physics_rate_hz;
+    pnh.param<std::string>("render_backend", co.backend, co.backend);
+    pnh.param("camera_weather", co.weather, co.weather);
+    pnh.param("camera_noise", co.noise, co.noise);
+    pnh.param("render_queue_depth", co.queue_depth, co.queue_depth);
+    pnh.param("record_image_rate", co.decimated_rate_hz, 0.0);
+    if (co.queue_depth < 1) {
+      throw scenario::ConfigError("~render_queue_depth: expected >= 1, got " + std::to_string(co.queue_depth));
+    }
+    cameras_ = std::make_unique<CameraRig>(nh, *world_, config_, co);
+    ROS_INFO("simulator: %zu cameras rendered with %s", config_.uav.cameras.size(),
+             cameras_->glRenderer().c_str());
+  }
 
   clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   odom_pub_ = nh.advertise<nav_msgs::Odometry>("uav/odom", 50);
@@ -83,6 +112,11 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 void SimulatorRos::publishStaticFrames() {
   std::vector<geometry_msgs::TransformStamped> frames;
   for (const auto& c : config_.uav.cameras) frames.push_back(toCameraTransform(c, ros::Time(0)));
+  if (cameras_) {
+    for (const auto& [frame, mount] : cameras_->opticalMounts()) {
+      frames.push_back(toTransformMsg(mount, kBaseFrame, frame, ros::Time(0)));
+    }
+  }
   static_tf_.sendTransform(frames);
 }
 
@@ -126,13 +160,52 @@ void SimulatorRos::advance(int steps) {
   for (int i = 0; i < steps; ++i) {
     sim_->step();
     ++step_count_;
+    if (cameras_) cameras_->afterStep(step_count_, sim_->uav());
     if (step_count_ % steps_per_publish_ == 0) publishState(false);
   }
 }
 
+int SimulatorRos::subscribers(const std::string& topic) const {
+  for (const ros::Publisher* p : {&clock_pub_, &odom_pub_, &imu_pub_, &truth_pub_, &crash_pub_}) {
+    if (p->getTopic() == topic) return static_cast<int>(p->getNumSubscribers());
+  }
+  return cameras_ ? cameras_->subscribers(topic) : -1;
+}
+
+void SimulatorRos::waitForSubscribers() {
+  if (wait_for_.empty()) return;
+  for (const auto& t : wait_for_) {
+    if (subscribers(t) < 0) ROS_WARN("simulator: ~wait_for: %s is not a topic of this node; ignored", t.c_str());
+  }
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait_timeout_);
+  while (ros::ok()) {
+    std::string missing;
+    for (const auto& t : wait_for_) {
+      if (subscribers(t) == 0) missing += (missing.empty() ? "" : ", ") + t;
+    }
+    if (missing.empty()) return;
+    if (ros::WallTime::now() > deadline) {
+      ROS_WARN("simulator: starting without subscribers on %s (~wait_timeout %.0f s)", missing.c_str(),
+               wait_timeout_);
+      return;
+    }
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
+  }
+}
+
 void SimulatorRos::spin() {
+  waitForSubscribers();
   ros::WallTime wall_start = ros::WallTime::now();
   double sim_start = sim_->time();
+  // Progress: sim time against wall time since the clock started (the real-time factor).
+  const ros::WallTime run_start = wall_start;
+  double next_report = 10.0;
+  auto report = [&] {
+    const double wall = (ros::WallTime::now() - run_start).toSec();
+    ROS_INFO("simulator: sim %.1f s in wall %.1f s (%.2fx real time), %llu camera frames", sim_->time(), wall,
+             sim_->time() / std::max(wall, 1e-9),
+             static_cast<unsigned long long>(cameras_ ? cameras_->framesPublished() : 0));
+  };
   bool was_paused = paused_;
   while (ros::ok()) {
     const bool running = !paused_ && sim_->time() < duration_;
@@ -148,6 +221,10 @@ void SimulatorRos::spin() {
       was_paused = false;
     }
     advance(steps_per_publish_);
+    if (sim_->time() >= next_report) {
+      report();
+      next_report += 10.0;
+    }
     ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0));
     if (real_time_factor_ > 0) {
       const double due = (sim_->time() - sim_start) / real_time_factor_;
@@ -186,6 +263,7 @@ bool SimulatorRos::onStep(hameritt::StepSimulation::Request& req,
     res.message = "steps: at most 1000000 per call";
   } else {
     advance(static_cast<int>(req.steps));
+    if (cameras_) cameras_->flush();
     publishState(true);
     res.success = true;
     res.code = 0;
@@ -206,6 +284,7 @@ bool SimulatorRos::onPause(hameritt::SetPaused::Request& req, hameritt::SetPause
 
 bool SimulatorRos::onReset(hameritt::ResetSimulation::Request&,
                            hameritt::ResetSimulation::Response& res) {
+  if (cameras_) cameras_->flush();
   sim_->reset();
   step_count_ = 0;
   crash_reported_ = false;

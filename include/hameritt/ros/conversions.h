@@ -4,9 +4,12 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Imu.h>
 
+#include "hameritt/BoundingBoxArray.h"
 #include "hameritt/EntityState.h"
+#include "hameritt/render/renderer.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/sim/simulator.h"
 
@@ -28,6 +31,16 @@ geometry_msgs::TransformStamped toCameraTransform(const scenario::CameraSpec& c,
 hameritt::EntityState toMsg(const sim::EntityState& e, const ros::Time& stamp);
 // map -> <entity id>.
 geometry_msgs::TransformStamped toEntityTransform(const sim::EntityState& e, const ros::Time& stamp);
+
+// Camera intrinsics as sensor_msgs/CameraInfo (plumb_bob with zero distortion, R = I,
+// P = [K | 0]): projecting with K lands exactly where the renderer draws.
+sensor_msgs::CameraInfo toCameraInfoMsg(const render::Intrinsics& k, const std_msgs::Header& header);
+// The boxes of one camera frame.
+hameritt::BoundingBoxArray toBoxesMsg(const std::vector<render::BoundingBox>& boxes,
+                                      const std::string& camera, const std_msgs::Header& header);
+// A static transform (parent -> child) from an isometry.
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& t, const std::string& parent,
+                                               const std::string& child, const ros::Time& stamp);
 
 // A timed path as nav_msgs/Path in map: each pose stamped with its sim time, yaw-only.
 nav_msgs::Path toPathMsg(const scenario::Trajectory& path, const ros::Time& stamp);

@@ -14,6 +14,7 @@
 #include "hameritt/ResetSimulation.h"
 #include "hameritt/SetPaused.h"
 #include "hameritt/StepSimulation.h"
+#include "hameritt/ros/camera_rig.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 #include "hameritt/sim/simulator.h"
@@ -24,7 +25,12 @@ namespace hameritt::ros_wrappers {
 //   ~sim_config (path, required), ~urdf (default: the package's models/sentinel.urdf),
 //   ~physics_rate_hz (500), ~real_time_factor (0 = as fast as possible), ~start_paused (false),
 //   ~publish_rate_hz (250: /clock, odometry, IMU, UAV tf), ~ground_truth_rate_hz (20),
-//   ~duration (0 = the scenario's; free running stops there and the node stays up).
+//   ~duration (0 = the scenario's; free running stops there and the node stays up),
+//   ~cameras (true: render and publish the payload cameras), ~render_backend (auto |
+//   surfaceless | device), ~camera_weather (true), ~camera_noise (true), ~render_queue_depth (2),
+//   ~record_image_rate (0: also publish camera images decimated to this rate for recording),
+//   ~wait_for (comma-separated topics of this node; the clock starts once each has a
+//   subscriber, or after ~wait_timeout wall seconds, 60).
 class SimulatorRos {
  public:
   // Throws scenario::ConfigError (bad parameters or sim_config): the node exits with ROS_FATAL.
@@ -35,6 +41,8 @@ class SimulatorRos {
 
  private:
   void advance(int steps);
+  void waitForSubscribers();
+  int subscribers(const std::string& topic) const;
   void publishState(bool force_ground_truth);
   void publishStaticFrames();
   void onVelocity(const geometry_msgs::Twist::ConstPtr& msg);
@@ -46,8 +54,11 @@ class SimulatorRos {
   scenario::SimConfig config_;
   std::unique_ptr<scenario::World> world_;
   std::unique_ptr<sim::Simulator> sim_;
+  std::unique_ptr<CameraRig> cameras_;
   double real_time_factor_ = 0.0;
   double duration_ = 0.0;
+  std::vector<std::string> wait_for_;
+  double wait_timeout_ = 60.0;
   bool paused_ = false;
   bool crash_reported_ = false;
   int steps_per_publish_ = 1;

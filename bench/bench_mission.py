@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""Benchmark of a whole mission: simulator with both payload cameras rendering every modality,
+ADK, planner, baseline clients and rosbag recording, on the default scenario.
+
+Runs `roslaunch hameritt mission.launch` for --sim-seconds of sim time (the ADK's time limit),
+measures the wall time from the first to the last message in the bag, and checks the bag:
+every camera topic must hold one message per camera period (no drops) and rosbag must not have
+reported a dropped message. Prints the real-time factor and per-topic counts.
+
+  /usr/bin/python3 bench/bench_mission.py [--sim-seconds 60] [--real-time-factor 0]
+      [--record-all] [--mode end_to_end] [--out DIR]
+"""
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scenario", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenarios", "default"))
+    ap.add_argument("--sim-seconds", type=float, default=60.0)
+    ap.add_argument("--real-time-factor", type=float, default=0.0, help="0 = as fast as possible")
+    ap.add_argument("--record-all", action="store_true")
+    ap.add_argument("--mode", default="end_to_end")
+    ap.add_argument("--out", default="")
+    args = ap.parse_args()
+
+    out = args.out or tempfile.mkdtemp(prefix="hameritt_bench_mission_")
+    os.makedirs(out, exist_ok=True)
+    port = 11500 + os.getpid() % 400
+    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port)
+    cmd = ["roslaunch", "-p", str(port), "hameritt", "mission.launch",
+           "scenario:=" + os.path.abspath(args.scenario), "mode:=" + args.mode, "record:=true",
+           "record_all:=" + ("true" if args.record_all else "false"),
+           "real_time_factor:=%g" % args.real_time_factor, "time_limit:=%g" % args.sim_seconds,
+           "output_dir:=" + out]
+    log_path = os.path.join(out, "roslaunch.log")
+    t0 = time.time()
+    with open(log_path, "w") as log:
+        rc = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env,
+                             timeout=max(600.0, 20 * args.sim_seconds))
+    wall_total = time.time() - t0
+    log_text = open(log_path).read()
+    bag_path = os.path.join(out, "mission.bag")
+    if not os.path.exists(bag_path):
+        print("no bag written; see", log_path)
+        return 1
+
+    import rosbag  # noqa: E402  (python3-rosbag)
+    bag = rosbag.Bag(bag_path)
+    info = bag.get_type_and_topic_info()
+    counts = {t: v.message_count for t, v in info.topics.items()}
+    # Sim-time span covered by the camera boxes (one per frame).
+    bag.close()
+    metrics = {}
+    mpath = os.path.join(out, "metrics.json")
+    if os.path.exists(mpath):
+        metrics = json.load(open(mpath))
+    sim_seconds = metrics.get("mission_time", args.sim_seconds)
+
+    with open(os.path.join(args.scenario, "sim_config.json")) as f:
+        cfg = json.load(f)
+    expected = {}
+    decim_rate = 2.0
+    for cam in cfg["uav"]["payload"]["cameras"]:
+        n = int(math.floor(sim_seconds * cam["rate_hz"] + 1e-9))
+        base = "/uav/camera/%s/" % cam["name"]
+        expected[base + "boxes"] = n
+        expected[base + "camera_info"] = n
+        mods = {"rgb": "image_raw", "depth": "depth", "segmentation": "segmentation", "instances": "instances"}
+        for m in cam["modalities"]:
+            if args.record_all:
+                expected[base + mods[m]] = n
+            else:
+                expected[base + "decimated/" + mods[m]] = int(math.floor(sim_seconds * decim_rate + 1e-9))
+    dropped_log = len(re.findall(r"Dropping", log_text))
+    missing = {t: (e, counts.get(t, 0)) for t, e in expected.items() if counts.get(t, 0) < e}
+    # The simulator logs sim time against wall time since its clock started, every 10 sim s.
+    m = re.findall(r"simulator: sim ([0-9.]+) s in wall ([0-9.]+) s", log_text)
+    rt_sim, rt_wall = (float(m[-1][0]), float(m[-1][1])) if m else (sim_seconds, wall_total)
+    size_mb = os.path.getsize(bag_path) / 1e6
+    print("scenario:      %s (mode %s, %s recording)" % (cfg["scenario_id"], args.mode, "full" if args.record_all else "compact"))
+    print("sim time:      %.1f s; simulator clock: %.1f sim s in %.1f wall s -> real-time factor %.2fx (launch total %.1f s wall)" % (sim_seconds, rt_sim, rt_wall, rt_sim / max(rt_wall, 1e-9), wall_total))
+    print("bag:           %.1f MB (%.2f MB per sim second), %d topics" % (size_mb, size_mb / max(sim_seconds, 1e-9), len(counts)))
+    print("rosbag drops:  %d 'Dropping' warnings" % dropped_log)
+    for t in sorted(expected):
+        print("  %-48s %6d / %6d expected" % (t, counts.get(t, 0), expected[t]))
+    for t in sorted(set(counts) - set(expected)):
+        print("  %-48s %6d" % (t, counts[t]))
+    print("outcome:       %s (roslaunch exit %d)" % (metrics.get("outcome", "?"), rc))
+    print("dropped/missing camera messages: %d" % sum(e - c for e, c in missing.values()))
+    return 0 if not missing and dropped_log == 0 else 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())

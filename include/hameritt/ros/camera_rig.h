@@ -1,0 +1,98 @@
+#pragma once
+// The UAV's payload cameras in the simulator node: renders each camera of the sim_config payload
+// at its rate (in sim time) on a dedicated render thread that owns the EGL context, and
+// publishes per camera /uav/camera/<name>/{image_raw, depth, segmentation, instances,
+// camera_info, boxes}, stamped with the sim time of the physics state the images show. The
+// physics loop hands over snapshots (time and UAV pose) and only waits when the render thread
+// is more than `queue_depth` frames behind, so rendering overlaps physics and publishing.
+
+#include <ros/ros.h>
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+#include "hameritt/sim/simulator.h"
+
+namespace hameritt::render {
+class Renderer;
+struct FrameSet;
+}  // namespace hameritt::render
+
+namespace hameritt::ros_wrappers {
+
+struct CameraRigOptions {
+  std::string backend = "auto";  // EGL backend (render::RendererOptions::backend)
+  std::string models_dir;        // "" = the package's models/
+  bool weather = true;           // fog, dust, rain, snow effects on the colour image
+  bool noise = true;             // sim_config camera noise
+  int queue_depth = 2;           // snapshots the physics loop may run ahead of the renderer
+  double physics_rate_hz = 500;  // camera rates must divide it
+  // Also publish every k-th frame's images on /uav/camera/<name>/decimated/<modality> at this
+  // rate (Hz of sim time; 0 = off; must divide the camera rate): the compact training stream
+  // that record.launch records by default.
+  double decimated_rate_hz = 0.0;
+};
+
+class CameraRig {
+ public:
+  // Throws scenario::ConfigError for a camera rate that does not divide the physics rate, and
+  // render::RenderError when no EGL context can be made (the message says why).
+  CameraRig(ros::NodeHandle& nh, const scenario::World& world, const scenario::SimConfig& config,
+            const CameraRigOptions& options);
+  ~CameraRig();
+  CameraRig(const CameraRig&) = delete;
+  CameraRig& operator=(const CameraRig&) = delete;
+
+  // Called after every physics step with the step count since t = 0: queues a render of every
+  // camera due at this step.
+  void afterStep(std::int64_t step, const sim::UavState& uav);
+  // Blocks until every queued frame has been rendered and published.
+  void flush();
+  // Frames rendered and published so far, all cameras.
+  std::uint64_t framesPublished() const;
+  std::string glRenderer() const;
+  // Subscribers of one of the rig's topics (resolved name), or -1 when it is not the rig's.
+  int subscribers(const std::string& topic) const;
+
+  // Static transforms uav/base_link -> uav/camera_<name>_optical (optical: z forward, x right,
+  // y down) for every camera.
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> opticalMounts() const;
+
+ private:
+  struct Camera;
+  struct Job {
+    int camera = 0;
+    std::uint64_t frame = 0;
+    double time = 0;
+    Eigen::Isometry3d world_T_base = Eigen::Isometry3d::Identity();
+    Eigen::Vector3d velocity{0, 0, 0};
+  };
+  void run();
+  void publish(const Camera& cam, const Job& job, const render::FrameSet& fs);
+
+  const scenario::World& world_;
+  const scenario::SimConfig& config_;
+  CameraRigOptions options_;
+  std::vector<std::unique_ptr<Camera>> cameras_;
+
+  std::thread thread_;
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Job> queue_;
+  bool busy_ = false;
+  bool stop_ = false;
+  bool ready_ = false;
+  std::string error_;
+  std::string gl_renderer_;
+  std::uint64_t published_ = 0;
+};
+
+}  // namespace hameritt::ros_wrappers

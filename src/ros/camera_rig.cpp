@@ -1,0 +1,262 @@
+#include "hameritt/ros/camera_rig.h"
+
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "hameritt/BoundingBoxArray.h"
+#include "hameritt/render/renderer.h"
+#include "hameritt/ros/conversions.h"
+#include "hameritt/scenario/error.h"
+
+namespace hameritt::ros_wrappers {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+}  // namespace
+
+struct CameraRig::Camera {
+  int index = 0;
+  scenario::CameraSpec spec;
+  render::Intrinsics intrinsics;
+  std::string frame_id;  // uav/camera_<name>_optical
+  int steps_per_frame = 1;
+  int frames_per_decimated = 0;  // 0 = no decimated stream
+  bool rgb = false, depth = false, segmentation = false, instances = false;
+  ros::Publisher rgb_pub, depth_pub, seg_pub, inst_pub, info_pub, boxes_pub;
+  ros::Publisher rgb_dec, depth_dec, seg_dec, inst_dec;
+
+  bool wanted() const {
+    return rgb_pub.getNumSubscribers() + depth_pub.getNumSubscribers() +
+               seg_pub.getNumSubscribers() + inst_pub.getNumSubscribers() +
+               info_pub.getNumSubscribers() + boxes_pub.getNumSubscribers() +
+               rgb_dec.getNumSubscribers() + depth_dec.getNumSubscribers() +
+               seg_dec.getNumSubscribers() + inst_dec.getNumSubscribers() >
+           0;
+  }
+};
+
+CameraRig::CameraRig(ros::NodeHandle& nh, const scenario::World& world,
+                     const scenario::SimConfig& config, const CameraRigOptions& options)
+    : world_(world), config_(config), options_(options) {
+  for (std::size_t i = 0; i < config.uav.cameras.size(); ++i) {
+    const auto& spec = config.uav.cameras[i];
+    auto cam = std::make_unique<Camera>();
+    cam->index = static_cast<int>(i);
+    cam->spec = spec;
+    cam->intrinsics = render::intrinsicsFromHfov(spec.width, spec.height, spec.hfov_deg);
+    cam->frame_id = "uav/camera_" + spec.name + "_optical";
+    const double steps = options.physics_rate_hz / spec.rate_hz;
+    if (!(spec.rate_hz > 0) || std::abs(steps - std::round(steps)) > 1e-9 || steps < 1) {
+      throw scenario::ConfigError("uav.payload.cameras[" + std::to_string(i) +
+                                  "].rate_hz: expected a rate that divides the physics rate (" +
+                                  scenario::formatNumber(options.physics_rate_hz) + " Hz), got " +
+                                  scenario::formatNumber(spec.rate_hz));
+    }
+    cam->steps_per_frame = static_cast<int>(std::round(steps));
+    for (const auto& m : spec.modalities) {
+      if (m == "rgb") cam->rgb = true;
+      if (m == "depth") cam->depth = true;
+      if (m == "segmentation") cam->segmentation = true;
+      if (m == "instances") cam->instances = true;
+    }
+    const std::string ns = "uav/camera/" + spec.name + "/";
+    if (cam->rgb) cam->rgb_pub = nh.advertise<sensor_msgs::Image>(ns + "image_raw", 4);
+    if (cam->depth) cam->depth_pub = nh.advertise<sensor_msgs::Image>(ns + "depth", 4);
+    if (cam->segmentation) cam->seg_pub = nh.advertise<sensor_msgs::Image>(ns + "segmentation", 4);
+    if (cam->instances) cam->inst_pub = nh.advertise<sensor_msgs::Image>(ns + "instances", 4);
+    if (options.decimated_rate_hz > 0) {
+      const double k = spec.rate_hz / options.decimated_rate_hz;
+      if (std::abs(k - std::round(k)) > 1e-9 || k < 1) {
+        throw scenario::ConfigError("~record_image_rate: expected a rate that divides camera " + spec.name +
+                                    "'s rate (" + scenario::formatNumber(spec.rate_hz) + " Hz), got " +
+                                    scenario::formatNumber(options.decimated_rate_hz));
+      }
+      cam->frames_per_decimated = static_cast<int>(std::round(k));
+      const std::string dns = ns + "decimated/";
+      if (cam->rgb) cam->rgb_dec = nh.advertise<sensor_msgs::Image>(dns + "image_raw", 4);
+      if (cam->depth) cam->depth_dec = nh.advertise<sensor_msgs::Image>(dns + "depth", 4);
+      if (cam->segmentation) cam->seg_dec = nh.advertise<sensor_msgs::Image>(dns + "segmentation", 4);
+      if (cam->instances) cam->inst_dec = nh.advertise<sensor_msgs::Image>(dns + "instances", 4);
+    }
+    cam->info_pub = nh.advertise<sensor_msgs::CameraInfo>(ns + "camera_info", 4);
+    cam->boxes_pub = nh.advertise<hameritt::BoundingBoxArray>(ns + "boxes", 4);
+    cameras_.push_back(std::move(cam));
+  }
+  if (cameras_.empty()) return;
+  // The renderer (and its EGL context) lives on the render thread; wait until it is up.
+  thread_ = std::thread([this] { run(); });
+  std::unique_lock<std::mutex> lock(mutex_);
+  cv_.wait(lock, [this] { return ready_; });
+  if (!error_.empty()) {
+    lock.unlock();
+    thread_.join();
+    throw render::RenderError(error_);
+  }
+}
+
+CameraRig::~CameraRig() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+std::vector<std::pair<std::string, Eigen::Isometry3d>> CameraRig::opticalMounts() const {
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> out;
+  for (const auto& cam : cameras_) {
+    const Eigen::Vector3d rpy = cam->spec.mount_rpy * kDeg;
+    out.emplace_back(cam->frame_id,
+                     render::opticalPose(Eigen::Isometry3d::Identity(), cam->spec.mount_xyz, rpy));
+  }
+  return out;
+}
+
+void CameraRig::afterStep(std::int64_t step, const sim::UavState& uav) {
+  for (const auto& cam : cameras_) {
+    if (step % cam->steps_per_frame != 0 || !cam->wanted()) continue;
+    Job job;
+    job.camera = cam->index;
+    job.frame = static_cast<std::uint64_t>(step / cam->steps_per_frame);
+    job.time = uav.t;
+    job.world_T_base = Eigen::Isometry3d::Identity();
+    job.world_T_base.linear() = uav.orientation.toRotationMatrix();
+    job.world_T_base.translation() = uav.position;
+    job.velocity = uav.velocity;
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [this] {
+      return static_cast<int>(queue_.size()) < std::max(1, options_.queue_depth) || stop_;
+    });
+    queue_.push_back(job);
+    lock.unlock();
+    cv_.notify_all();
+  }
+}
+
+void CameraRig::flush() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || stop_; });
+}
+
+std::uint64_t CameraRig::framesPublished() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return published_;
+}
+
+int CameraRig::subscribers(const std::string& topic) const {
+  for (const auto& cam : cameras_) {
+    for (const ros::Publisher* p : {&cam->rgb_pub, &cam->depth_pub, &cam->seg_pub, &cam->inst_pub, &cam->info_pub,
+                                    &cam->boxes_pub, &cam->rgb_dec, &cam->depth_dec, &cam->seg_dec, &cam->inst_dec}) {
+      if (*p && p->getTopic() == topic) return static_cast<int>(p->getNumSubscribers());
+    }
+  }
+  return -1;
+}
+
+std::string CameraRig::glRenderer() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return gl_renderer_;
+}
+
+void CameraRig::run() {
+  std::unique_ptr<render::Renderer> renderer;
+  try {
+    render::RendererOptions ro;
+    ro.backend = options_.backend;
+    ro.models_dir = options_.models_dir;
+    renderer = std::make_unique<render::Renderer>(world_, config_, ro);
+    std::lock_guard<std::mutex> lock(mutex_);
+    gl_renderer_ = renderer->glRenderer();
+    ready_ = true;
+  } catch (const std::exception& e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    error_ = e.what();
+    ready_ = true;
+  }
+  cv_.notify_all();
+  if (!renderer) return;
+
+  render::FrameSet fs;
+  while (true) {
+    Job job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [this] { return !queue_.empty() || stop_; });
+      if (stop_) return;
+      job = queue_.front();
+      queue_.pop_front();
+      busy_ = true;
+    }
+    cv_.notify_all();
+    const Camera& cam = *cameras_[static_cast<std::size_t>(job.camera)];
+    render::RenderRequest req;
+    req.intrinsics = cam.intrinsics;
+    req.world_T_optical = render::opticalPose(job.world_T_base, cam.spec.mount_xyz, cam.spec.mount_rpy * kDeg);
+    req.time = job.time;
+    req.camera_index = cam.index;
+    req.frame_index = job.frame;
+    req.weather = options_.weather;
+    req.noise = options_.noise;
+    // Motion blur along the image-plane direction of the camera's own motion.
+    const Eigen::Vector3d v_opt = req.world_T_optical.linear().transpose() * job.velocity;
+    if (std::hypot(v_opt.x(), v_opt.y()) > 0.2) req.blur_direction = Eigen::Vector2d(v_opt.x(), v_opt.y()).normalized();
+    try {
+      renderer->render(req, &fs);
+      publish(cam, job, fs);
+    } catch (const std::exception& e) {
+      ROS_ERROR_THROTTLE(5.0, "simulator: camera %s: %s", cam.spec.name.c_str(), e.what());
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+      ++published_;
+    }
+    cv_.notify_all();
+  }
+}
+
+void CameraRig::publish(const Camera& cam, const Job& job, const render::FrameSet& fs) {
+  std_msgs::Header header;
+  header.stamp.fromSec(job.time);
+  header.frame_id = cam.frame_id;
+  const int w = fs.intrinsics.width, h = fs.intrinsics.height;
+  auto image = [&](const std::string& encoding, int bytes_per_pixel, const void* data) {
+    sensor_msgs::ImagePtr m = boost::make_shared<sensor_msgs::Image>();
+    m->header = header;
+    m->width = static_cast<std::uint32_t>(w);
+    m->height = static_cast<std::uint32_t>(h);
+    m->encoding = encoding;
+    m->is_bigendian = 0;
+    m->step = static_cast<std::uint32_t>(w * bytes_per_pixel);
+    m->data.resize(static_cast<std::size_t>(w) * h * bytes_per_pixel);
+    std::memcpy(m->data.data(), data, m->data.size());
+    return m;
+  };
+  const bool decimated =
+      cam.frames_per_decimated > 0 && job.frame % static_cast<std::uint64_t>(cam.frames_per_decimated) == 0;
+  // One message per modality, shared by the full-rate and the decimated publisher.
+  auto send = [&](bool on, const ros::Publisher& full, const ros::Publisher& dec, const std::string& encoding,
+                  int bytes, const void* data) {
+    if (!on) return;
+    const bool to_full = full.getNumSubscribers() > 0;
+    const bool to_dec = decimated && dec.getNumSubscribers() > 0;
+    if (!to_full && !to_dec) return;
+    const sensor_msgs::ImagePtr m = image(encoding, bytes, data);
+    if (to_full) full.publish(m);
+    if (to_dec) dec.publish(m);
+  };
+  send(cam.rgb, cam.rgb_pub, cam.rgb_dec, sensor_msgs::image_encodings::RGB8, 3, fs.rgb.data());
+  send(cam.depth, cam.depth_pub, cam.depth_dec, sensor_msgs::image_encodings::TYPE_32FC1, 4, fs.depth.data());
+  send(cam.segmentation, cam.seg_pub, cam.seg_dec, sensor_msgs::image_encodings::MONO8, 1, fs.semantic.data());
+  send(cam.instances, cam.inst_pub, cam.inst_dec, sensor_msgs::image_encodings::TYPE_16UC1, 2,
+       fs.instance.data());
+  cam.info_pub.publish(toCameraInfoMsg(fs.intrinsics, header));
+  cam.boxes_pub.publish(toBoxesMsg(fs.boxes, cam.spec.name, header));
+}
+
+}  // namespace hameritt::ros_wrappers
