@@ -18,6 +18,12 @@
 
 namespace hameritt::render {
 
+// Semantic ids besides scenario::semanticId(class): sky (nothing hit), ground (lawn and
+// sidewalks), and the UAV model (drawn only with RenderRequest::draw_uav).
+constexpr int kSkySemantic = 0;
+constexpr int kGroundSemantic = 1;
+constexpr int kUavSemantic = 10;
+
 // EGL/GL unavailable, a model file missing or malformed, a bad request. The message names the
 // file or the field.
 class RenderError : public std::runtime_error {
@@ -63,6 +69,8 @@ struct RenderRequest {
   Eigen::Isometry3d world_T_uav = Eigen::Isometry3d::Identity();
   double near_clip = 0.1;   // m
   double far_clip = 2000.0; // m
+  // Entity ids (world or scenario) left out of this frame: not drawn, not labelled, no box.
+  std::vector<std::string> hidden_entities;
 };
 
 // A 2D box of one entity of interest (every car and pedestrian: parked world cars and the
@@ -92,7 +100,23 @@ struct FrameSet {
 struct RendererOptions {
   std::string models_dir;          // meshes (models/meshes/*.obj); empty: <package>/models
   std::string backend = "auto";    // auto (device if an EGL device with a GPU exists, else
-                                   // surfaceless) | surfaceless | device
+                                   // surfaceless) | surfaceless | device; the environment
+                                   // variable HAMERITT_EGL_BACKEND overrides it
+  // Wait for the GL at the end of each stage so that Renderer::lastStats() splits the frame
+  // time by stage (benchmarks); off, the stage times only count the calling thread's work.
+  bool stage_timing = false;
+};
+
+// What the last render() did and where its time went (milliseconds of wall time).
+struct RenderStats {
+  double cull_upload_ms = 0;  // frustum culling, instance upload
+  double draw_ms = 0;         // geometry pass (with stage_timing: until the GL has finished it)
+  double post_ms = 0;         // weather particles, blur, noise
+  double readback_ms = 0;     // colour, depth and labels read back and split
+  double boxes_ms = 0;        // boxes from the instance mask, occlusion queries
+  std::size_t instances = 0;  // instances drawn
+  std::size_t triangles = 0;  // triangles submitted to the geometry pass
+  std::size_t draw_calls = 0;
 };
 
 // World triangles for ray-cast checks (what the renderer draws, in world coordinates).
@@ -116,12 +140,21 @@ class Renderer {
   void render(const RenderRequest& request, FrameSet* out);
   FrameSet render(const RenderRequest& request);
 
-  // Makes the EGL context current on the calling thread (render() from another thread).
+  // Makes the EGL context current on the calling thread (render() from another thread; render()
+  // also does it when needed). The thread that had it must call releaseCurrent() first.
   void makeCurrent();
+  // Releases the context from the calling thread.
+  void releaseCurrent();
 
   int instanceCount() const;                      // highest instance id + 1
   const std::string& instanceEntityId(int instance) const;  // "" for 0 / out of range
   std::string glRenderer() const;                  // GL_RENDERER, e.g. "llvmpipe (LLVM 15...)"
+  std::string eglBackend() const;                  // the EGL platform used: surfaceless | device
+  const RenderStats& lastStats() const;
+  // Instance id of an entity id (world or scenario), or 0.
+  int instanceOf(const std::string& entity_id) const;
+  // Everything drawn at `time` except the UAV model, in world coordinates: the triangles the
+  // geometry pass rasterizes (same canopy scaling, same z offsets of the ground layers).
   SceneTriangles sceneTriangles(double time) const;
 
  private:

@@ -1,0 +1,943 @@
+#!/usr/bin/env python3
+"""Generate the low-poly Wavefront OBJ/MTL meshes of hameritt's renderer (models/meshes/).
+
+    /usr/bin/python3 scripts/make_meshes.py            # write models/meshes/*.obj|mtl, then check them
+    /usr/bin/python3 scripts/make_meshes.py --check    # only check the files already there
+    /usr/bin/python3 scripts/make_meshes.py --out DIR  # write somewhere else
+
+Standard library only and deterministic: running it twice gives byte-identical files.
+
+Conventions (the renderer depends on them; see models/README.md):
+* triangles only, every face "f v//vn" with its own (flat) normal, counter-clockwise seen from
+  outside; every part is a closed convex solid (boxes, prisms, cylinders, cones, icospheres).
+* class meshes: x forward (heading), y left, z up, origin at the centre of the bottom face; the
+  vertices span exactly [-0.5, 0.5] x [-0.5, 0.5] x [0, 1] (the renderer scales each axis by the
+  entity's box). Each part is designed in metres at a typical real size, then normalized.
+* sentinel.obj (the UAV) stays in metres, base_link FLU frame, origin at the centre of mass.
+* materials: one .mtl per .obj; "paint" is replaced by the entity colour at render time.
+"""
+
+import math
+import os
+import sys
+
+FMT = "%.6f"
+UNIT_BOX = ((-0.5, 0.5), (-0.5, 0.5), (0.0, 1.0))
+
+# ----------------------------------------------------------------------------------------------
+# Materials (Kd). "paint" differs per mesh (a plausible default; the renderer replaces it).
+# ----------------------------------------------------------------------------------------------
+KD = {
+    "roof": (0.30, 0.28, 0.27),
+    "trim": (0.93, 0.93, 0.90),
+    "window": (0.20, 0.26, 0.32),
+    "door": (0.42, 0.24, 0.15),
+    "garage_door": (0.86, 0.85, 0.81),
+    "chimney": (0.55, 0.30, 0.24),
+    "trunk": (0.40, 0.28, 0.18),
+    "foliage": (0.26, 0.46, 0.19),
+    "tire": (0.08, 0.08, 0.08),
+    "glass": (0.14, 0.19, 0.24),
+    "light_front": (0.95, 0.95, 0.86),
+    "light_rear": (0.75, 0.08, 0.06),
+    "bumper": (0.18, 0.18, 0.19),
+    "skin": (0.80, 0.62, 0.50),
+    "hair": (0.20, 0.14, 0.10),
+    "pants": (0.20, 0.25, 0.36),
+    "shoe": (0.12, 0.12, 0.12),
+    "frame": (0.16, 0.16, 0.17),
+    "arm": (0.22, 0.22, 0.24),
+    "motor": (0.55, 0.55, 0.58),
+    "prop": (0.10, 0.10, 0.10),
+    "camera": (0.05, 0.05, 0.06),
+}
+
+
+# ----------------------------------------------------------------------------------------------
+# Small vector helpers
+# ----------------------------------------------------------------------------------------------
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def mul(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def norm(a):
+    return math.sqrt(dot(a, a))
+
+
+def unit(a):
+    n = norm(a)
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
+def lerp(a, b, t):
+    return (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t)
+
+
+def centroid(points):
+    n = float(len(points))
+    return (sum(p[0] for p in points) / n, sum(p[1] for p in points) / n,
+            sum(p[2] for p in points) / n)
+
+
+def fmt(v):
+    s = FMT % v
+    if float(s) == 0.0:
+        s = FMT % 0.0
+    return s
+
+
+def rnd(v):
+    return float(fmt(v))
+
+
+# ----------------------------------------------------------------------------------------------
+# Mesh: a list of parts; each part is one closed convex solid of one material.
+# ----------------------------------------------------------------------------------------------
+class Mesh:
+    def __init__(self, name, budget, normalized=True, paint=(0.8, 0.8, 0.8)):
+        self.name = name
+        self.budget = budget
+        self.normalized = normalized
+        self.paint = paint
+        self.kd_override = {}
+        self.parts = []  # (material, [triangles (p0, p1, p2)])
+
+    # -- the one primitive everything is built from -------------------------------------------
+    def solid(self, mat, polygons):
+        """A closed convex solid given by its face polygons (any winding): every polygon is
+        turned to face away from the solid's centre, then fan-triangulated."""
+        allp = [p for poly in polygons for p in poly]
+        c = centroid(allp)
+        tris = []
+        for poly in polygons:
+            poly = list(poly)
+            pc = centroid(poly)
+            n = (0.0, 0.0, 0.0)
+            for i in range(1, len(poly) - 1):
+                n = add(n, cross(sub(poly[i], poly[0]), sub(poly[i + 1], poly[0])))
+            if dot(n, sub(pc, c)) < 0:
+                poly.reverse()
+            for i in range(1, len(poly) - 1):
+                tris.append((poly[0], poly[i], poly[i + 1]))
+        self.parts.append((mat, tris))
+
+    def hexa(self, mat, bottom, top):
+        """Hexahedron from two corresponding quads (planar faces expected)."""
+        faces = [list(bottom), list(top)]
+        for i in range(4):
+            j = (i + 1) % 4
+            faces.append([bottom[i], bottom[j], top[j], top[i]])
+        self.solid(mat, faces)
+
+    def box(self, mat, lo, hi):
+        x0, y0, z0 = lo
+        x1, y1, z1 = hi
+        assert x1 > x0 and y1 > y0 and z1 > z0, (self.name, mat, lo, hi)
+        self.hexa(mat, [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0)],
+                  [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)])
+
+    def extrude(self, mat, poly, offset):
+        """Prism: a convex planar polygon and its copy moved by offset."""
+        top = [add(p, offset) for p in poly]
+        n = len(poly)
+        faces = [list(poly), top]
+        for i in range(n):
+            j = (i + 1) % n
+            faces.append([poly[i], poly[j], top[j], top[i]])
+        self.solid(mat, faces)
+
+    def ring(self, c, r, n, u, v, phase):
+        return [add(c, add(mul(u, r * math.cos(phase + 2 * math.pi * k / n)),
+                           mul(v, r * math.sin(phase + 2 * math.pi * k / n)))) for k in range(n)]
+
+    def frustum(self, mat, a, b, ra, rb, n, u_hint=(1, 0, 0), v_hint=None, phase=0.0):
+        """n-sided prism/frustum from point a (radius ra) to point b (radius rb)."""
+        u, v = basis(sub(b, a), u_hint, v_hint)
+        ra_ = self.ring(a, ra, n, u, v, phase)
+        rb_ = self.ring(b, rb, n, u, v, phase)
+        faces = [ra_, rb_]
+        for i in range(n):
+            j = (i + 1) % n
+            faces.append([ra_[i], ra_[j], rb_[j], rb_[i]])
+        self.solid(mat, faces)
+
+    def cone(self, mat, base, apex, r, n, u_hint=(1, 0, 0), v_hint=None, phase=0.0):
+        u, v = basis(sub(apex, base), u_hint, v_hint)
+        rg = self.ring(base, r, n, u, v, phase)
+        faces = [rg] + [[rg[i], rg[(i + 1) % n], apex] for i in range(n)]
+        self.solid(mat, faces)
+
+    def beam(self, mat, a, b, side, wa, ha, wb=None, hb=None):
+        """Box-like beam from a to b; cross-section half-width w along `side` (made
+        perpendicular to the axis) and half-height h along axis x side; tapered if wb/hb."""
+        wb = wa if wb is None else wb
+        hb = ha if hb is None else hb
+        u, v = basis(sub(b, a), side, None)
+
+        def quad(c, w, h):
+            return [add(c, add(mul(u, su * w), mul(v, sv * h)))
+                    for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+
+        self.hexa(mat, quad(a, wa, ha), quad(b, wb, hb))
+
+    def ellipsoid(self, mat, c, radii):
+        """Icosphere (one subdivision, 80 triangles) scaled to the radii; it has vertices on
+        the six axis points, so its extents are exactly c +- radii."""
+        faces = []
+        for tri in icosphere1():
+            faces.append([add(c, (p[0] * radii[0], p[1] * radii[1], p[2] * radii[2]))
+                          for p in tri])
+        self.solid(mat, faces)
+
+    def slab(self, mat, quad, host_centre, t_out, t_in):
+        """A thin box on a planar face: quad (4 coplanar points on the host's face), pushed
+        t_out outward and t_in inward (outward = away from host_centre)."""
+        n = unit(cross(sub(quad[1], quad[0]), sub(quad[3], quad[0])))
+        if dot(n, sub(centroid(quad), host_centre)) < 0:
+            n = mul(n, -1.0)
+        self.hexa(mat, [sub(p, mul(n, t_in)) for p in quad], [add(p, mul(n, t_out)) for p in quad])
+
+    # -- output -----------------------------------------------------------------------------------
+    def finalize(self):
+        """Normalize (class meshes) and round; returns [(mat, [tri])] in final coordinates."""
+        pts = [p for _, tris in self.parts for t in tris for p in t]
+        lo = [min(p[i] for p in pts) for i in range(3)]
+        hi = [max(p[i] for p in pts) for i in range(3)]
+
+        def tf(p):
+            if not self.normalized:
+                return (rnd(p[0]), rnd(p[1]), rnd(p[2]))
+            q = [(p[i] - lo[i]) / (hi[i] - lo[i]) for i in range(3)]
+            return (rnd(q[0] - 0.5), rnd(q[1] - 0.5), rnd(q[2]))
+
+        self.design_size = tuple(hi[i] - lo[i] for i in range(3))
+        self.final = [(mat, [tuple(tf(p) for p in t) for t in tris]) for mat, tris in self.parts]
+        return self.final
+
+    def materials(self):
+        mats = []
+        for mat, _ in self.parts:
+            if mat not in mats:
+                mats.append(mat)
+        return mats
+
+    def kd(self, mat):
+        if mat in self.kd_override:
+            return self.kd_override[mat]
+        if mat == "paint":
+            return self.paint
+        return KD[mat]
+
+    def write(self, outdir):
+        final = self.finalize()
+        mats = self.materials()
+        vidx, vlist, nidx, nlist = {}, [], {}, []
+        faces = {m: [] for m in mats}
+        for mat, tris in final:
+            for t in tris:
+                nrm = unit(cross(sub(t[1], t[0]), sub(t[2], t[0])))
+                nk = " ".join(fmt(c) for c in nrm)
+                if nk not in nidx:
+                    nidx[nk] = len(nlist) + 1
+                    nlist.append(nk)
+                ids = []
+                for p in t:
+                    k = " ".join(fmt(c) for c in p)
+                    if k not in vidx:
+                        vidx[k] = len(vlist) + 1
+                        vlist.append(k)
+                    ids.append(vidx[k])
+                faces[mat].append((ids, nidx[nk]))
+        ntri = sum(len(f) for f in faces.values())
+        lines = ["# hameritt %s: generated by scripts/make_meshes.py, do not edit" % self.name,
+                 "# %s, %d triangles, materials: %s" % (
+                     "unit box [-0.5,0.5]x[-0.5,0.5]x[0,1], x forward, y left, z up"
+                     if self.normalized else "metres, base_link FLU frame", ntri, " ".join(mats)),
+                 "mtllib %s.mtl" % self.name, "o %s" % self.name]
+        lines += ["v " + k for k in vlist]
+        lines += ["vn " + k for k in nlist]
+        for m in mats:
+            lines.append("usemtl " + m)
+            for ids, n in faces[m]:
+                lines.append("f %d//%d %d//%d %d//%d" % (ids[0], n, ids[1], n, ids[2], n))
+        with open(os.path.join(outdir, self.name + ".obj"), "w", newline="\n") as f:
+            f.write("\n".join(lines) + "\n")
+        ml = ["# hameritt %s materials: generated by scripts/make_meshes.py, do not edit"
+              % self.name]
+        for m in mats:
+            kd = self.kd(m)
+            ml += ["", "newmtl " + m, "Ka 0.000000 0.000000 0.000000",
+                   "Kd " + " ".join(fmt(c) for c in kd), "Ks 0.000000 0.000000 0.000000",
+                   "Ns 1.000000", "d 1.000000", "illum 1"]
+        with open(os.path.join(outdir, self.name + ".mtl"), "w", newline="\n") as f:
+            f.write("\n".join(ml) + "\n")
+        return ntri
+
+
+def basis(axis, u_hint, v_hint):
+    """Orthonormal (u, v) perpendicular to axis, u close to u_hint (v to v_hint if given)."""
+    w = unit(axis)
+    u = sub(u_hint, mul(w, dot(u_hint, w)))
+    if norm(u) < 1e-9:
+        raise ValueError("u_hint parallel to axis")
+    u = unit(u)
+    v = cross(w, u)
+    if v_hint is not None and dot(v, v_hint) < 0:
+        v = mul(v, -1.0)
+    return u, v
+
+
+_ICO = None
+
+
+def icosphere1():
+    global _ICO
+    if _ICO is None:
+        t = (1.0 + math.sqrt(5.0)) / 2.0
+        vs = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+              (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+        vs = [unit(v) for v in vs]
+        fs = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+              (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+              (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+        out = []
+        for a, b, c in fs:
+            pa, pb, pc = vs[a], vs[b], vs[c]
+            ab, bc, ca = unit(lerp(pa, pb, 0.5)), unit(lerp(pb, pc, 0.5)), unit(lerp(pc, pa, 0.5))
+            out += [(pa, ab, ca), (pb, bc, ab), (pc, ca, bc), (ab, bc, ca)]
+        # snap the axis points exactly (so extents are exact)
+        snapped = []
+        for tri in out:
+            st = []
+            for p in tri:
+                st.append(tuple(round(c) if abs(abs(c) - 1.0) < 1e-9 or abs(c) < 1e-9 else c
+                                for c in p))
+            snapped.append(tuple(st))
+        _ICO = snapped
+    return _ICO
+
+
+def quad_point(A, B, C, D, u, v):
+    """Bilinear point on quad A (bottom-left), B (bottom-right), C (top-right), D (top-left)."""
+    return lerp(lerp(A, B, u), lerp(D, C, u), v)
+
+
+def sub_quad(A, B, C, D, u0, u1, v0, v1):
+    return [quad_point(A, B, C, D, u0, v0), quad_point(A, B, C, D, u1, v0),
+            quad_point(A, B, C, D, u1, v1), quad_point(A, B, C, D, u0, v1)]
+
+
+# ----------------------------------------------------------------------------------------------
+# Houses and garages: a gable building (walls = pentagonal prism, two roof slabs, fascia boards,
+# ridge cap). `along` is the ridge axis ("y" for houses, "x" for garages).
+# ----------------------------------------------------------------------------------------------
+def gable_building(m, along, half_across_wall, half_along_wall, half_across_roof, half_along_roof,
+                   wall_h, height, roof_t, fascia=0.04, ridge_cap=True):
+    def P(a, b, z):  # (across, along, z) -> (x, y, z)
+        return (a, b, z) if along == "y" else (b, a, z)
+
+    # slope chosen so that the roof underside meets the wall top at the wall line
+    s = (height - roof_t - wall_h) / half_across_wall
+    ridge_under = height - roof_t
+    wa, wb = half_across_wall, half_along_wall
+    prof = [(-wa, 0.0), (wa, 0.0), (wa, wall_h), (0.0, ridge_under), (-wa, wall_h)]
+    m.extrude("paint", [P(a, -wb, z) for a, z in prof], P(0.0, 2 * wb, 0.0))
+    ra, rb = half_across_roof, half_along_roof
+    slab_end = ra - fascia
+    for sg in (-1.0, 1.0):
+        def top(a):
+            return height - s * a
+
+        bottom = [P(0.0, -rb, height - roof_t), P(sg * slab_end, -rb, top(slab_end) - roof_t),
+                  P(sg * slab_end, rb, top(slab_end) - roof_t), P(0.0, rb, height - roof_t)]
+        topq = [P(0.0, -rb, height), P(sg * slab_end, -rb, top(slab_end)),
+                P(sg * slab_end, rb, top(slab_end)), P(0.0, rb, height)]
+        m.hexa("roof", bottom, topq)
+        if fascia > 0:
+            drop = roof_t + 0.05
+            fb = [P(sg * slab_end, -rb, top(slab_end) - drop), P(sg * ra, -rb, top(ra) - drop),
+                  P(sg * ra, rb, top(ra) - drop), P(sg * slab_end, rb, top(slab_end) - drop)]
+            ft = [P(sg * slab_end, -rb, top(slab_end)), P(sg * ra, -rb, top(ra)),
+                  P(sg * ra, rb, top(ra)), P(sg * slab_end, rb, top(slab_end))]
+            m.hexa("trim", fb, ft)
+    if ridge_cap:
+        w = 0.13
+        cap = [(-w, height - s * w - 0.02), (w, height - s * w - 0.02), (w, height - s * w + 0.05),
+               (0.0, height + 0.06), (-w, height - s * w + 0.05)]
+        m.extrude("roof", [P(a, -rb - 0.01, z) for a, z in cap], P(0.0, 2 * rb + 0.02, 0.0))
+    return s
+
+
+def wall_slab(m, mat, face, center, w, z0, z1, proud, inset=0.03):
+    """A window/door slab on a house wall. face: ('x', x_wall, sign) or ('y', y_wall, sign);
+    center: coordinate along the wall; w: width; z0..z1; proud: how far it stands out."""
+    axis, wall, sg = face
+    lo_o, hi_o = sorted((wall - sg * inset, wall + sg * proud))
+    if axis == "x":
+        m.box(mat, (lo_o, center - w / 2, z0), (hi_o, center + w / 2, z1))
+    else:
+        m.box(mat, (center - w / 2, lo_o, z0), (center + w / 2, hi_o, z1))
+
+
+def make_house(name, storeys):
+    m = Mesh(name, 400, paint=(0.86, 0.82, 0.70))
+    L, W = 10.0, 11.0
+    H = 5.2 if storeys == 1 else 8.0
+    wall_h = 2.9 if storeys == 1 else 5.6
+    wx, wy = 4.6, 5.2          # walls (inset so the eaves touch +-L/2, gable overhang in y)
+    rx, ry = L / 2, 5.5
+    s = gable_building(m, "y", wx, wy, rx, ry, wall_h, H, 0.2)
+    front, back = ("x", -wx, -1.0), ("x", wx, 1.0)
+    left, right = ("y", wy, 1.0), ("y", -wy, -1.0)
+    # front door, its frame and a step (door faces the street, -x)
+    door_y = -0.9
+    wall_slab(m, "trim", front, door_y, 1.3, 0.15, 2.35, 0.03)
+    wall_slab(m, "door", front, door_y, 1.0, 0.18, 2.25, 0.06)
+    m.box("trim", (-rx, door_y - 0.85, 0.0), (-wx + 0.01, door_y + 0.85, 0.18))
+    rows = [(0.9, 2.2)] if storeys == 1 else [(0.95, 2.25), (3.75, 5.0)]
+    win_w = 1.2
+    for ri, (z0, z1) in enumerate(rows):
+        # front: windows beside the door (and above it upstairs)
+        fy = [-3.5, 1.3, 3.5] if ri == 0 else [-3.5, -0.9, 1.3, 3.5]
+        for y in fy:
+            if storeys == 1:  # one-storey: trimmed front windows
+                wall_slab(m, "trim", front, y, win_w + 0.2, z0 - 0.12, z1 + 0.1, 0.025)
+            wall_slab(m, "window", front, y, win_w, z0, z1, 0.045)
+        by = [-3.6, -1.2, 1.2, 3.6] if storeys == 1 else [-3.3, 0.0, 3.3]
+        for y in by:
+            wall_slab(m, "window", back, y, win_w, z0, z1, 0.045)
+        sx = [-2.2, 2.2] if ri == 0 else [0.0]
+        for x in sx:
+            wall_slab(m, "window", left, x, win_w, z0, z1, 0.045)
+            wall_slab(m, "window", right, x, win_w, z0, z1, 0.045)
+    if storeys == 1:  # corner boards
+        for sx_ in (-1, 1):
+            for sy_ in (-1, 1):
+                x0, x1 = sorted((sx_ * (wx + 0.05), sx_ * (wx - 0.18)))
+                y0, y1 = sorted((sy_ * (wy + 0.05), sy_ * (wy - 0.18)))
+                m.box("trim", (x0, y0, 0.0), (x1, y1, wall_h - 0.02))
+    else:  # belt course between the storeys
+        m.box("trim", (-wx - 0.04, -wy - 0.04, 2.75), (wx + 0.04, wy + 0.04, 2.95))
+    # chimney on the back slope, through the ridge height, with a cap
+    cx0, cx1, cy0, cy1 = 1.3, 2.0, 3.0, 3.8
+    z_in = H - s * cx1 - 0.6
+    top = H + 0.3
+    m.box("chimney", (cx0, cy0, z_in), (cx1, cy1, top))
+    m.box("chimney", (cx0 - 0.06, cy0 - 0.06, top), (cx1 + 0.06, cy1 + 0.06, top + 0.08))
+    return m
+
+
+def make_garage(name, doors):
+    m = Mesh(name, 400, paint=(0.86, 0.82, 0.70))
+    L = 6.7
+    W = 3.9 if doors == 1 else 6.6
+    H, wall_h = 3.1, 2.6
+    wx, wy = L / 2 - 0.15, W / 2 - 0.15
+    gable_building(m, "x", wy, wx, W / 2, L / 2, wall_h, H, 0.15, fascia=0.04)
+    front = ("x", -wx, -1.0)
+    door_w = 2.7 if doors == 1 else 2.5
+    centres = [0.0] if doors == 1 else [-1.45, 1.45]
+    gap, dz, nslab = 0.035, 2.2, 4
+    sh = (dz - gap * (nslab - 1)) / nslab
+    for yc in centres:
+        wall_slab(m, "trim", front, yc, door_w + 0.16, 0.0, dz + 0.1, 0.03)
+        for k in range(nslab):
+            z0 = k * (sh + gap)
+            wall_slab(m, "garage_door", front, yc, door_w, z0 + (0.01 if k == 0 else 0.0),
+                      z0 + sh, 0.07)
+    # side door near the back and a window on the +y wall, a window on the back wall
+    wall_slab(m, "trim", ("y", wy, 1.0), 1.9, 1.05, 0.0, 2.15, 0.03)
+    wall_slab(m, "door", ("y", wy, 1.0), 1.9, 0.9, 0.01, 2.05, 0.06)
+    wall_slab(m, "window", ("y", wy, 1.0), -0.8, 1.0, 1.1, 1.9, 0.045)
+    wall_slab(m, "window", ("x", wx, 1.0), 0.0, 1.0, 1.1, 1.9, 0.045)
+    return m
+
+
+# ----------------------------------------------------------------------------------------------
+# Fences: runs along x, every part spans the whole length (the renderer stretches x to 3-30 m)
+# except the two end posts.
+# ----------------------------------------------------------------------------------------------
+def make_fence_wood():
+    m = Mesh("fence_wood", 400, paint=(0.56, 0.40, 0.25))
+    hl, H = 5.0, 1.8
+    m.box("paint", (-hl, -0.06, 0.05), (hl, -0.035, H))              # board panel
+    for z0 in (0.30, 1.38):                                          # two back rails
+        m.box("paint", (-hl, -0.036, z0), (hl, 0.035, z0 + 0.10))
+    m.box("paint", (-hl, -0.065 + 0.005, H - 0.06), (hl, -0.02, H - 0.01))  # top trim board
+    for sg in (-1, 1):                                               # end posts
+        x0, x1 = sorted((sg * hl, sg * (hl - 0.1)))
+        m.box("paint", (x0, -0.036, 0.0), (x1, 0.06, H - 0.05))
+    return m
+
+
+def make_fence_vinyl():
+    m = Mesh("fence_vinyl", 400, paint=(0.95, 0.95, 0.93))
+    hl, H = 5.0, 1.8
+    m.box("paint", (-hl, -0.02, 0.08), (hl, 0.02, 1.64))             # privacy panel
+    m.box("trim", (-hl, -0.035, 0.04), (hl, 0.035, 0.14))             # bottom rail
+    m.box("trim", (-hl, -0.045, 1.62), (hl, 0.045, 1.72))             # cap rail
+    for sg in (-1, 1):
+        x0, x1 = sorted((sg * hl, sg * (hl - 0.07)))
+        m.box("paint", (x0, -0.055, 0.0), (x1, 0.055, 1.75))         # end post
+        m.box("trim", (x0, -0.06, 1.75), (x1, 0.06, H))               # post cap
+    return m
+
+
+def make_fence_chain_link():
+    m = Mesh("fence_chain_link", 400, paint=(0.36, 0.37, 0.38))
+    hl, H = 5.0, 1.5
+    m.box("paint", (-hl, -0.006, 0.04), (hl, 0.006, H - 0.06))        # mesh panel
+    m.box("frame", (-hl, -0.025, H - 0.07), (hl, 0.025, H - 0.02))    # top rail
+    m.box("frame", (-hl, -0.01, 0.03), (hl, 0.01, 0.06))              # bottom tension wire
+    for sg in (-1, 1):
+        x0, x1 = sorted((sg * hl, sg * (hl - 0.06)))
+        m.box("frame", (x0, -0.06, 0.0), (x1, 0.06, H))              # end posts
+    return m
+
+
+# ----------------------------------------------------------------------------------------------
+# Trees
+# ----------------------------------------------------------------------------------------------
+def make_tree_deciduous():
+    m = Mesh("tree_deciduous", 400)
+    D, H = 5.0, 9.0
+    r_tr = 0.06 * D / math.cos(math.pi / 8)   # octagon across flats = 12% of the width
+    m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), r_tr, r_tr * 0.8, 8, phase=math.pi / 8)
+    for ang, z0, z1, reach in ((20.0, 2.3, 3.9, 1.3), (145.0, 2.7, 4.1, 1.2),
+                               (260.0, 2.5, 3.7, 1.25)):
+        a = math.radians(ang)
+        d = (math.cos(a), math.sin(a), 0.0)
+        tip = (reach * d[0], reach * d[1], z1)
+        m.beam("trunk", (0.0, 0.0, z0), tip, (-d[1], d[0], 0.0), 0.11, 0.11, 0.06, 0.06)
+    # canopy: 4 overlapping icospheres; their union spans exactly +-D/2 in x and y,
+    # from 35% to 100% of the height
+    h = D / 2
+    blobs = [((-0.85, 0.10, 6.9), (h - 0.85, 1.65, 2.1)),    # crown: min x, top
+             ((1.05, 0.30, 5.4), (h - 1.05, 1.45, 1.9)),     # max x
+             ((-0.15, 1.10, 5.25), (1.40, h - 1.10, 1.85)),  # max y
+             ((0.25, -1.05, 5.0), (1.45, h - 1.05, 1.85))]   # min y, bottom (3.15 = 35%)
+    for c, r in blobs:
+        m.ellipsoid("foliage", c, r)
+    return m
+
+
+def make_tree_pine():
+    m = Mesh("tree_pine", 400)
+    m.kd_override["foliage"] = (0.13, 0.31, 0.16)
+    D, H = 4.0, 10.0
+    r = D / 2
+    m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22, 0.15, 8, phase=math.pi / 8)
+    # three stacked 12-sided cones; the bottom one has vertices on the axes (extent +-D/2)
+    for (zb, zt, rr, ph) in ((0.15 * H, 0.62 * H, r, 0.0),
+                             (0.38 * H, 0.82 * H, 0.78 * r, math.pi / 12),
+                             (0.60 * H, H, 0.55 * r, 0.0)):
+        m.cone("foliage", (0, 0, zb), (0, 0, zt), rr, 12, phase=ph)
+    return m
+
+
+# ----------------------------------------------------------------------------------------------
+# Cars. Body: a convex side profile (x, z) extruded across the width; cabin: a tapered
+# hexahedron; glass slabs on the cabin faces; 10-sided wheels touching z = 0.
+# ----------------------------------------------------------------------------------------------
+def make_car(name, spec):
+    m = Mesh(name, 400, paint=(0.72, 0.12, 0.10))
+    L, W = spec["L"], spec["W"]
+    hb = W / 2 - 0.05            # body half-width (mirrors reach W/2)
+    body = spec["body"]
+    m.extrude("paint", [(x, -hb, z) for x, z in body], (0.0, 2 * hb, 0.0))
+    for x0, x1, z0, z1 in spec.get("extra_body", []):
+        m.box("paint", (x0, -hb, z0), (x1, hb, z1))
+    # cabin
+    (xr0, xf0, z0, hw0), (xr1, xf1, z1, hw1) = spec["cabin"]
+    cb = [(xr0, -hw0, z0), (xf0, -hw0, z0), (xf0, hw0, z0), (xr0, hw0, z0)]
+    ct = [(xr1, -hw1, z1), (xf1, -hw1, z1), (xf1, hw1, z1), (xr1, hw1, z1)]
+    m.hexa("paint", cb, ct)
+    cc = centroid(cb + ct)
+    belt = spec["belt"]
+    v0 = (belt + 0.04 - z0) / (z1 - z0)
+    v1 = 1.0 - 0.06 / (z1 - z0)
+    tg_o, tg_i = 0.012, 0.012
+    # windscreen, rear window
+    A, B, C, D = (xf0, -hw0, z0), (xf0, hw0, z0), (xf1, hw1, z1), (xf1, -hw1, z1)
+    m.slab("glass", sub_quad(A, B, C, D, 0.06, 0.94, v0, v1), cc, tg_o, tg_i)
+    A, B, C, D = (xr0, hw0, z0), (xr0, -hw0, z0), (xr1, -hw1, z1), (xr1, hw1, z1)
+    rv0 = spec.get("rear_v0", v0)
+    m.slab("glass", sub_quad(A, B, C, D, 0.08, 0.92, rv0, v1), cc, tg_o, tg_i)
+    # side windows (u from the rear pillar to the front pillar)
+    for sg in (-1.0, 1.0):
+        A, B = (xr0, sg * hw0, z0), (xf0, sg * hw0, z0)
+        C, D = (xf1, sg * hw1, z1), (xr1, sg * hw1, z1)
+        for u0, u1 in spec["side_windows"]:
+            m.slab("glass", sub_quad(A, B, C, D, u0, u1, v0, v1), cc, tg_o, tg_i)
+    # wheels: 10-sided, a vertex at the bottom (z = 0)
+    r, tw = spec["wheel_r"], 0.23
+    yo = W / 2 - 0.03
+    for xw in spec["wheel_x"]:
+        for sg in (-1.0, 1.0):
+            m.frustum("tire", (xw, sg * (yo - tw), r), (xw, sg * yo, r), r, r, 10,
+                      u_hint=(1, 0, 0), v_hint=(0, 0, 1), phase=-math.pi / 2)
+    # bumpers (they define the length), lights
+    bz0, bz1 = spec["bumper_z"]
+    bw = hb + 0.01
+    m.box("bumper", (L / 2 - 0.2, -bw, bz0), (L / 2, bw, bz1))
+    m.box("bumper", (-L / 2, -bw, bz0), (-L / 2 + 0.2, bw, bz1))
+    xf_face, hz0, hz1 = spec["head"]
+    xr_face, tz0, tz1 = spec["tail"]
+    ty_in = spec.get("tail_y_in", 0.50)
+    for sg in (-1.0, 1.0):
+        y0, y1 = sorted((sg * 0.48, sg * (hb - 0.07)))
+        m.box("light_front", (xf_face - 0.06, y0, hz0), (xf_face + 0.015, y1, hz1))
+        y0, y1 = sorted((sg * ty_in, sg * (hb - 0.03)))
+        m.box("light_rear", (xr_face - 0.015, y0, tz0), (xr_face + 0.06, y1, tz1))
+    # mirrors (they define the width)
+    mx, mz = spec["mirror"]
+    for sg in (-1.0, 1.0):
+        y0, y1 = sorted((sg * (hw0 - 0.06), sg * W / 2))
+        m.box("paint", (mx - 0.07, y0, mz), (mx + 0.07, y1, mz + 0.13))
+    for x0, x1, y0, y1, z0_, z1_, mat in spec.get("extras", []):
+        m.box(mat, (x0, y0, z0_), (x1, y1, z1_))
+    return m
+
+
+CARS = {
+    "car_sedan": dict(
+        L=4.9, W=1.85,
+        body=[(-2.41, 0.25), (2.41, 0.25), (2.41, 0.62), (2.30, 0.78), (0.95, 0.93),
+              (-2.25, 0.98), (-2.41, 0.88)],
+        cabin=((-1.50, 0.95, 0.90, 0.84), (-0.80, 0.22, 1.45, 0.68)), belt=0.95,
+        side_windows=[(0.10, 0.47), (0.52, 0.93)],
+        wheel_r=0.33, wheel_x=(1.47, -1.38), bumper_z=(0.22, 0.48),
+        head=(2.41, 0.52, 0.64), tail=(-2.41, 0.70, 0.84), mirror=(0.72, 0.95)),
+    "car_suv": dict(
+        L=4.85, W=1.93,
+        body=[(-2.39, 0.32), (2.39, 0.32), (2.39, 0.80), (2.22, 0.99), (1.05, 1.08),
+              (-2.32, 1.10), (-2.39, 1.03)],
+        cabin=((-2.30, 1.05, 1.04, 0.88), (-2.18, 0.12, 1.71, 0.78)), belt=1.09,
+        side_windows=[(0.04, 0.31), (0.35, 0.63), (0.67, 0.94)],
+        wheel_r=0.37, wheel_x=(1.45, -1.40), bumper_z=(0.28, 0.58),
+        head=(2.39, 0.70, 0.84), tail=(-2.39, 0.80, 1.05), tail_y_in=0.62, mirror=(0.82, 1.10),
+        extras=[(-1.90, 0.0, 0.60, 0.66, 1.70, 1.75, "bumper"),
+                (-1.90, 0.0, -0.66, -0.60, 1.70, 1.75, "bumper")]),
+    "car_pickup": dict(
+        L=5.9, W=2.05,
+        body=[(-0.74, 0.45), (2.91, 0.45), (2.91, 0.95), (2.78, 1.13), (1.35, 1.22),
+              (-0.74, 1.22)],
+        extra_body=[(-2.91, -0.73, 0.45, 0.85)],           # chassis under the bed (bed floor)
+        cabin=((-0.72, 1.35, 1.18, 0.95), (-0.68, 0.50, 1.95, 0.85)), belt=1.22,
+        side_windows=[(0.06, 0.47), (0.52, 0.93)],
+        wheel_r=0.40, wheel_x=(1.85, -1.80), bumper_z=(0.40, 0.66),
+        head=(2.91, 0.80, 0.94), tail=(-2.91, 0.90, 1.18), tail_y_in=0.875,
+        mirror=(1.05, 1.26)),
+    "car_hatchback": dict(
+        L=4.2, W=1.76,
+        body=[(-2.06, 0.22), (2.06, 0.22), (2.06, 0.58), (1.93, 0.76), (0.85, 0.92),
+              (-1.95, 0.97), (-2.06, 0.90)],
+        cabin=((-2.00, 0.85, 0.88, 0.80), (-1.68, -0.08, 1.49, 0.65)), belt=0.95,
+        side_windows=[(0.14, 0.50), (0.55, 0.93)],
+        wheel_r=0.31, wheel_x=(1.30, -1.27), bumper_z=(0.19, 0.44),
+        head=(2.06, 0.50, 0.62), tail=(-2.06, 0.72, 0.88), mirror=(0.64, 0.96)),
+    "car_van": dict(
+        L=5.16, W=1.99,
+        body=[(-2.54, 0.28), (2.54, 0.28), (2.54, 0.66), (2.38, 0.86), (1.45, 1.01),
+              (-2.45, 1.06), (-2.54, 0.98)],
+        cabin=((-2.50, 1.45, 0.98, 0.93), (-2.38, 0.42, 1.76, 0.84)), belt=1.04,
+        side_windows=[(0.04, 0.33), (0.37, 0.65), (0.69, 0.94)],
+        wheel_r=0.36, wheel_x=(1.55, -1.52), bumper_z=(0.25, 0.52),
+        head=(2.54, 0.56, 0.70), tail=(-2.54, 0.76, 1.00), tail_y_in=0.66,
+        mirror=(1.22, 1.06)),
+}
+
+
+def make_pickup_bed(m):
+    """Open bed of the pickup: side walls and tailgate on the chassis (bed floor z = 0.85)."""
+    hb = 2.05 / 2 - 0.05
+    for sg in (-1.0, 1.0):
+        y0, y1 = sorted((sg * (hb - 0.09), sg * hb))
+        m.box("paint", (-2.91, y0, 0.84), (-0.70, y1, 1.24))
+    m.box("paint", (-2.91, -hb + 0.08, 0.84), (-2.82, hb - 0.08, 1.21))
+
+
+# ----------------------------------------------------------------------------------------------
+# Pedestrian: walking stance facing +x (left leg forward, right arm forward), real metres,
+# 0.5 x 0.5 x 1.75 in design so normalization hardly distorts it.
+# ----------------------------------------------------------------------------------------------
+def make_pedestrian():
+    m = Mesh("pedestrian", 300, paint=(0.25, 0.45, 0.75))
+    # shoes (heel-to-toe spans x = -0.25 .. 0.25)
+    m.box("shoe", (-0.005, 0.04, 0.0), (0.25, 0.14, 0.09))          # left, forward
+    m.box("shoe", (-0.25, -0.14, 0.0), (0.005, -0.04, 0.09))        # right, back
+    # legs hip -> ankle
+    m.beam("pants", (0.02, 0.09, 0.95), (0.075, 0.09, 0.07), (0, 1, 0), 0.075, 0.08, 0.055, 0.055)
+    m.beam("pants", (-0.02, -0.09, 0.95), (-0.175, -0.09, 0.07), (0, 1, 0), 0.075, 0.08,
+           0.055, 0.055)
+    m.box("pants", (-0.095, -0.165, 0.86), (0.095, 0.165, 1.02))    # pelvis
+    # torso (tapered), neck, head and hair
+    m.hexa("paint", [(-0.10, -0.16, 0.98), (0.10, -0.16, 0.98), (0.10, 0.16, 0.98),
+                     (-0.10, 0.16, 0.98)],
+           [(-0.11, -0.205, 1.46), (0.11, -0.205, 1.46), (0.11, 0.205, 1.46),
+            (-0.11, 0.205, 1.46)])
+    m.box("skin", (-0.045, -0.045, 1.42), (0.045, 0.045, 1.54))
+    m.ellipsoid("skin", (0.012, 0.0, 1.62), (0.095, 0.082, 0.115))
+    m.ellipsoid("hair", (-0.012, 0.0, 1.648), (0.098, 0.088, 0.102))
+    # arms shoulder -> wrist, swinging opposite to the legs, and hands
+    for sg, wx in ((1.0, -0.085), (-1.0, 0.095)):
+        sh = (0.0, sg * 0.20, 1.42)
+        wr = (wx, sg * 0.214, 0.86)   # arm outer edge at |y| = 0.25
+        m.beam("paint", sh, wr, (0, 1, 0), 0.045, 0.05, 0.036, 0.036)
+        d = unit(sub(wr, sh))
+        hand_end = add(wr, mul(d, 0.11))
+        m.beam("skin", sub(wr, mul(d, 0.01)), hand_end, (0, 1, 0), 0.022, 0.04, 0.018, 0.034)
+    return m
+
+
+# ----------------------------------------------------------------------------------------------
+# Sentinel UAV (metres, base_link FLU, origin at the centre of mass)
+# ----------------------------------------------------------------------------------------------
+def make_sentinel():
+    m = Mesh("sentinel", 1500, normalized=False, paint=(0.16, 0.16, 0.17))
+    a = 0.106066
+    # central body: tapered box 0.12 x 0.08 x 0.05 and a battery/cover plate on top
+    m.hexa("frame", [(-0.06, -0.04, -0.025), (0.06, -0.04, -0.025), (0.06, 0.04, -0.025),
+                     (-0.06, 0.04, -0.025)],
+           [(-0.055, -0.036, 0.025), (0.055, -0.036, 0.025), (0.055, 0.036, 0.025),
+            (-0.055, 0.036, 0.025)])
+    m.box("frame", (-0.045, -0.028, 0.025), (0.035, 0.028, 0.033))
+    for sx in (-1.0, 1.0):
+        for sy in (-1.0, 1.0):
+            hub = (sx * a, sy * a, 0.03)
+            d = unit((sx, sy, 0.0))
+            side = (-d[1], d[0], 0.0)
+            # arm from inside the body to under the motor
+            m.beam("arm", (d[0] * 0.03, d[1] * 0.03, 0.008), (sx * a, sy * a, 0.008), side,
+                   0.009, 0.007)
+            # motor (bell) on the arm, hub height 0.03
+            m.frustum("motor", (hub[0], hub[1], 0.015), (hub[0], hub[1], 0.040), 0.014, 0.013,
+                      10)
+            # prop disc at z = 0.045, radius 0.065, 8 sides (vertices on the x and y axes)
+            m.frustum("prop", (hub[0], hub[1], 0.0435), (hub[0], hub[1], 0.0465), 0.065, 0.065,
+                      8)
+            # landing leg under the arm
+            lx, ly = d[0] * 0.085, d[1] * 0.085
+            m.box("frame", (lx - 0.004, ly - 0.004, -0.052), (lx + 0.004, ly + 0.004, 0.002))
+    # front camera at (0.12, 0, -0.03) on a bracket, lens looking forward
+    m.box("frame", (0.05, -0.012, -0.036), (0.108, 0.012, -0.022))
+    m.box("camera", (0.105, -0.02, -0.042), (0.13, 0.02, -0.018))
+    m.frustum("camera", (0.129, 0.0, -0.03), (0.14, 0.0, -0.03), 0.009, 0.008, 8,
+              u_hint=(0, 1, 0), phase=math.pi / 8)
+    # down camera at (0, 0, -0.06), lens looking down
+    m.box("camera", (-0.016, -0.016, -0.05), (0.016, 0.016, -0.024))
+    m.frustum("camera", (0.0, 0.0, -0.049), (0.0, 0.0, -0.06), 0.009, 0.008, 8,
+              phase=math.pi / 8)
+    return m
+
+
+# ----------------------------------------------------------------------------------------------
+def build_all():
+    meshes = [make_house("house_1", 1), make_house("house_2", 2),
+              make_garage("garage_1", 1), make_garage("garage_2", 2),
+              make_fence_wood(), make_fence_vinyl(), make_fence_chain_link(),
+              make_tree_deciduous(), make_tree_pine()]
+    for name, spec in CARS.items():
+        m = make_car(name, spec)
+        if name == "car_pickup":
+            make_pickup_bed(m)
+        meshes.append(m)
+    meshes += [make_pedestrian(), make_sentinel()]
+    return meshes
+
+
+# ----------------------------------------------------------------------------------------------
+# Checks
+# ----------------------------------------------------------------------------------------------
+def check_parts(m):
+    """In-memory checks on the final (normalized, rounded) parts: closed, outward, convex."""
+    errs = []
+    for pi, (mat, tris) in enumerate(m.final):
+        pts = [p for t in tris for p in t]
+        c = centroid(pts)
+        edges = {}
+        for t in tris:
+            n = cross(sub(t[1], t[0]), sub(t[2], t[0]))
+            if norm(n) < 1e-12:
+                errs.append("part %d (%s): degenerate triangle %s" % (pi, mat, t))
+                continue
+            if dot(n, sub(centroid(t), c)) <= 0:
+                errs.append("part %d (%s): face normal points towards the part centre" % (pi, mat))
+            for i in range(3):
+                e = (t[i], t[(i + 1) % 3])
+                edges[e] = edges.get(e, 0) + 1
+        for (a, b), k in edges.items():
+            if k != 1 or edges.get((b, a), 0) != 1:
+                errs.append("part %d (%s): not closed/consistently wound at edge %s-%s"
+                            % (pi, mat, a, b))
+                break
+    return errs
+
+
+def check_file(path, budget, normalized):
+    """Checks on the written OBJ/MTL. Returns (errors, triangles, materials)."""
+    errs = []
+    d = os.path.dirname(path)
+    vs, vns, mats_used, ntri, cur = [], [], [], 0, None
+    mtllib = None
+    per_mat = {}
+    with open(path) as f:
+        for ln in f:
+            tok = ln.split()
+            if not tok or tok[0].startswith("#"):
+                continue
+            if tok[0] == "v":
+                vs.append(tuple(float(x) for x in tok[1:4]))
+            elif tok[0] == "vn":
+                vns.append(tuple(float(x) for x in tok[1:4]))
+            elif tok[0] == "mtllib":
+                mtllib = tok[1]
+            elif tok[0] == "usemtl":
+                cur = tok[1]
+                if cur not in mats_used:
+                    mats_used.append(cur)
+            elif tok[0] == "f":
+                if len(tok) != 4:
+                    errs.append("non-triangle face: " + ln.strip())
+                    continue
+                if cur is None:
+                    errs.append("face before any usemtl")
+                ids, nids = [], []
+                for t in tok[1:]:
+                    p = t.split("/")
+                    if len(p) != 3 or p[1] != "":
+                        errs.append("face vertex not v//vn: " + t)
+                        break
+                    ids.append(int(p[0]) - 1)
+                    nids.append(int(p[2]) - 1)
+                if len(ids) != 3:
+                    continue
+                if len(set(nids)) != 1:
+                    errs.append("face with differing normals (not flat): " + ln.strip())
+                a, b, c = (vs[i] for i in ids)
+                n = cross(sub(b, a), sub(c, a))
+                if norm(n) < 1e-12:
+                    errs.append("degenerate face: " + ln.strip())
+                elif dot(unit(n), vns[nids[0]]) < 0.999:
+                    errs.append("normal disagrees with winding: " + ln.strip())
+                ntri += 1
+                per_mat[cur] = per_mat.get(cur, 0) + 1
+    if mtllib is None:
+        errs.append("no mtllib")
+        defined = []
+    else:
+        defined = []
+        mp = os.path.join(d, mtllib)
+        if not os.path.exists(mp):
+            errs.append("missing " + mtllib)
+        else:
+            with open(mp) as f:
+                for ln in f:
+                    tok = ln.split()
+                    if tok and tok[0] == "newmtl":
+                        defined.append(tok[1])
+                    if tok and tok[0] == "Kd":
+                        if not all(0.0 <= float(x) <= 1.0 for x in tok[1:4]):
+                            errs.append("Kd out of [0,1]: " + ln.strip())
+    for mname in mats_used:
+        if mname not in defined:
+            errs.append("usemtl %s not in %s" % (mname, mtllib))
+    if ntri > budget:
+        errs.append("%d triangles > budget %d" % (ntri, budget))
+    lo = tuple(min(v[i] for v in vs) for i in range(3))
+    hi = tuple(max(v[i] for v in vs) for i in range(3))
+    if normalized:
+        for i in range(3):
+            if lo[i] != UNIT_BOX[i][0] or hi[i] != UNIT_BOX[i][1]:
+                errs.append("axis %s spans [%r, %r], not the unit box" % ("xyz"[i], lo[i], hi[i]))
+    return errs, ntri, mats_used, lo, hi, per_mat
+
+
+def run_checks(outdir, meshes=None):
+    names = [m.name for m in meshes] if meshes else None
+    if names is None:
+        names = sorted(f[:-4] for f in os.listdir(outdir) if f.endswith(".obj"))
+    ok = True
+    print("%-18s %5s %6s  %-24s %s" % ("mesh", "tris", "budget", "extent (x y z)", "materials"))
+    for name in names:
+        normalized = name != "sentinel"
+        budget = 1500 if name == "sentinel" else (300 if name == "pedestrian" else 400)
+        errs, ntri, mats, lo, hi, per_mat = check_file(
+            os.path.join(outdir, name + ".obj"), budget, normalized)
+        if meshes:
+            m = [mm for mm in meshes if mm.name == name][0]
+            errs += check_parts(m)
+        ext = " ".join("%.3f" % (hi[i] - lo[i]) for i in range(3))
+        print("%-18s %5d %6d  %-24s %s" % (name, ntri, budget, ext,
+                                            " ".join("%s(%d)" % (k, per_mat[k]) for k in mats)))
+        for e in errs[:10]:
+            print("    ERROR: " + e)
+        if errs:
+            ok = False
+    print("all checks passed" if ok else "CHECKS FAILED")
+    return ok
+
+
+def main(argv):
+    here = os.path.dirname(os.path.abspath(__file__))
+    outdir = os.path.join(os.path.dirname(here), "models", "meshes")
+    check_only = False
+    i = 0
+    while i < len(argv):
+        if argv[i] == "--check":
+            check_only = True
+        elif argv[i] == "--out" and i + 1 < len(argv):
+            outdir = argv[i + 1]
+            i += 1
+        else:
+            print(__doc__)
+            return 2
+        i += 1
+    if check_only:
+        # the files must be what this script writes now (so the in-memory part checks apply)
+        import tempfile
+        meshes = build_all()
+        stale = []
+        with tempfile.TemporaryDirectory() as tmp:
+            for m in meshes:
+                m.write(tmp)
+                for ext in (".obj", ".mtl"):
+                    fn = m.name + ext
+                    old = os.path.join(outdir, fn)
+                    with open(os.path.join(tmp, fn), "rb") as f:
+                        want = f.read()
+                    have = None
+                    if os.path.exists(old):
+                        with open(old, "rb") as f:
+                            have = f.read()
+                    if have != want:
+                        stale.append(fn)
+        ok = run_checks(outdir, meshes)
+        for fn in stale:
+            print("STALE: %s differs from what the script generates (regenerate)" % fn)
+        return 0 if ok and not stale else 1
+    os.makedirs(outdir, exist_ok=True)
+    meshes = build_all()
+    for m in meshes:
+        m.write(outdir)
+    return 0 if run_checks(outdir, meshes) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,45 @@
+#pragma once
+// Camera effects on the read-back colour image: motion blur along a direction and the seeded
+// sensor noise (Gaussian and salt-and-pepper). They run on the CPU: on a CPU rasterizer
+// (llvmpipe) the same work as a full-screen GLSL pass costs about ten times more (see
+// BENCHMARKS.md "Rendering"). Every random value is a counter-based hash of (pixel, key), so
+// the result does not depend on threads or on the order of evaluation.
+
+#include <cstdint>
+#include <vector>
+
+namespace hameritt::render {
+
+struct BlurTap {
+  int dx = 0, dy = 0;
+  int weight = 0;  // fixed point, the taps sum to 256
+};
+
+struct CameraEffects {
+  std::vector<BlurTap> blur;  // empty or one tap: no blur
+  float noise_std = 0;        // fraction of full scale
+  float salt = 0;             // probability per pixel
+  std::uint32_t key[2] = {0, 0};
+
+  bool any() const { return blur.size() > 1 || noise_std > 0 || salt > 0; }
+};
+
+// The blur kernel of a motion of `length_px` along `(dir_x, dir_y)`: the segment centred on
+// the pixel sampled at up to 16 points, each rounded to a pixel offset, equal offsets merged.
+std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_px);
+
+// PCG-based 4D hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020).
+void pcg4d(std::uint32_t v[4]);
+
+// Row buffers reused from frame to frame.
+struct CameraEffectsScratch {
+  std::vector<std::uint16_t> acc;
+  std::vector<std::uint32_t> lanes;
+  std::vector<std::int16_t> sums;
+};
+
+// Applies `fx` to `in` (RGB8, rows top first) into `out` (same size).
+void applyCameraEffects(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
+                        std::uint8_t* out, CameraEffectsScratch* scratch);
+
+}  // namespace hameritt::render

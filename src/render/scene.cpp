@@ -1,0 +1,370 @@
+#include "scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <unordered_map>
+
+#include "hameritt/scenario/trajectory.h"
+
+namespace hameritt::render {
+
+namespace {
+
+using scenario::EntityClass;
+
+std::uint32_t packRgb8(int r, int g, int b) {
+  return static_cast<std::uint32_t>(r) | (static_cast<std::uint32_t>(g) << 8) |
+         (static_cast<std::uint32_t>(b) << 16) | (255u << 24);
+}
+
+std::uint32_t packLinearHalf(const Eigen::Vector3f& c) {
+  auto q = [](float v) { return static_cast<int>(std::lround(std::clamp(0.5f * v, 0.0f, 1.0f) * 255.0f)); };
+  return packRgb8(q(c.x()), q(c.y()), q(c.z()));
+}
+
+// FNV-1a of a string in [0, 1): per-entity variation that does not depend on draw order.
+float hash01(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  return static_cast<float>((h >> 40) & 0xFFFFFF) / 16777216.0f;
+}
+
+// Layers of the flat ground, above the lawn at z = 0: sidewalks, then streets. Each street gets
+// its own height so that where two street slabs overlap (intersections) the order is decided by
+// the depth test, not by the draw order, and a ray cast agrees with the rasterizer.
+constexpr double kSidewalkZ = 0.01;
+double streetTopZ(int street_index) { return 0.02 + 0.001 * (street_index % 8); }
+// The lawn extends this far beyond the street grid (the far clip is 2 km).
+constexpr double kGroundMargin = 2000.0;
+constexpr double kGroundTile = 250.0;
+
+// Display colour (gamma 2, as the shaders use) to linear albedo.
+Eigen::Vector3f srgbToLinear(int r, int g, int b) {
+  auto f = [](int v) { return std::pow(static_cast<float>(v) / 255.0f, 2.0f); };
+  return {f(r), f(g), f(b)};
+}
+
+Mesh groundMesh(const geometry::Aabb2& bounds) {
+  const double x0 = bounds.min.x() - kGroundMargin, x1 = bounds.max.x() + kGroundMargin;
+  const double y0 = bounds.min.y() - kGroundMargin, y1 = bounds.max.y() + kGroundMargin;
+  const int nx = std::max(1, static_cast<int>(std::ceil((x1 - x0) / kGroundTile)));
+  const int ny = std::max(1, static_cast<int>(std::ceil((y1 - y0) / kGroundTile)));
+  std::vector<std::array<Eigen::Vector3f, 4>> quads;
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const float xa = static_cast<float>(x0 + (x1 - x0) * i / nx);
+      const float xb = static_cast<float>(x0 + (x1 - x0) * (i + 1) / nx);
+      const float ya = static_cast<float>(y0 + (y1 - y0) * j / ny);
+      const float yb = static_cast<float>(y0 + (y1 - y0) * (j + 1) / ny);
+      quads.push_back({{{xa, ya, 0}, {xb, ya, 0}, {xb, yb, 0}, {xa, yb, 0}}});
+    }
+  }
+  return flatMesh("ground", MaterialKind::kLawn, srgbToLinear(92, 122, 58), quads);
+}
+
+// The sidewalk rings: a strip of the given width centred on each block's closed ring (convex),
+// mitred at the corners.
+Mesh sidewalkMesh(const std::vector<scenario::Block>& blocks, double width) {
+  const float z = static_cast<float>(kSidewalkZ);
+  std::vector<std::array<Eigen::Vector3f, 4>> quads;
+  for (const auto& b : blocks) {
+    std::vector<geometry::Vec2> ring(b.sidewalk.begin(), b.sidewalk.end());
+    if (ring.size() >= 2 && ring.front() == ring.back()) ring.pop_back();
+    const std::size_t n = ring.size();
+    if (n < 3) continue;
+    double area = 0;
+    for (std::size_t i = 0; i < n; ++i) area += geometry::cross2(ring[i], ring[(i + 1) % n]);
+    if (area < 0) std::reverse(ring.begin(), ring.end());
+    std::vector<geometry::Vec2> inner(n), outer(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const geometry::Vec2 u0 = (ring[i] - ring[(i + n - 1) % n]).normalized();
+      const geometry::Vec2 u1 = (ring[(i + 1) % n] - ring[i]).normalized();
+      const geometry::Vec2 n0(-u0.y(), u0.x()), n1(-u1.y(), u1.x());  // left = into the block
+      const geometry::Vec2 miter = (n0 + n1).normalized();
+      const double len = 0.5 * width / std::max(0.2, miter.dot(n0));
+      inner[i] = ring[i] + len * miter;
+      outer[i] = ring[i] - len * miter;
+    }
+    auto v = [z](const geometry::Vec2& p) {
+      return Eigen::Vector3f(static_cast<float>(p.x()), static_cast<float>(p.y()), z);
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = (i + 1) % n;
+      quads.push_back({v(outer[i]), v(outer[k]), v(inner[k]), v(inner[i])});
+    }
+  }
+  return flatMesh("sidewalks", MaterialKind::kSidewalk, srgbToLinear(188, 185, 176), quads);
+}
+
+void identityRows(float rows[3][4]) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) rows[r][c] = r == c ? 1.0f : 0.0f;
+  }
+}
+
+void isometryRows(const Eigen::Isometry3d& t, float rows[3][4]) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) rows[r][c] = static_cast<float>(t.matrix()(r, c));
+  }
+}
+
+std::uint32_t label(int semantic, int instance) {
+  return (static_cast<std::uint32_t>(semantic) << 16) | static_cast<std::uint32_t>(instance);
+}
+
+std::string attributeError(const scenario::Entity& e, const std::string& key,
+                           const std::string& expected) {
+  return "entity " + e.id + ": attribute " + key + ": expected " + expected + ", got '" +
+         e.attributes.str(key) + "'";
+}
+
+}  // namespace
+
+bool paintColor(const std::string& name, std::uint32_t* srgb8) {
+  struct Named {
+    const char* name;
+    int r, g, b;
+  };
+  // Typical paint and facade values (sRGB).
+  static const Named kColors[] = {
+      {"red", 158, 26, 28},      {"blue", 32, 62, 130},     {"white", 232, 232, 226},
+      {"black", 24, 24, 27},     {"silver", 168, 171, 175}, {"grey", 108, 110, 114},
+      {"gray", 108, 110, 114},   {"green", 38, 92, 52},     {"yellow", 222, 184, 52},
+      {"beige", 214, 196, 160},  {"brick", 146, 64, 48},    {"brown", 104, 70, 44},
+      {"orange", 222, 108, 30},  {"concrete", 178, 175, 166}, {"asphalt", 68, 68, 70},
+  };
+  for (const auto& c : kColors) {
+    if (name == c.name) {
+      *srgb8 = packRgb8(c.r, c.g, c.b);
+      return true;
+    }
+  }
+  return false;
+}
+
+void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]) {
+  const double c = std::cos(box.yaw), s = std::sin(box.yaw);
+  const double l = box.size.x(), w = box.size.y(), h = box.size.z();
+  const double m[3][4] = {{c * l, -s * w, 0, box.center.x()},
+                          {s * l, c * w, 0, box.center.y()},
+                          {0, 0, h, box.minZ() + lift}};
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 4; ++k) rows[r][k] = static_cast<float>(m[r][k]);
+  }
+}
+
+int Scene::addModel(Mesh mesh) {
+  models_.push_back(std::move(mesh));
+  return static_cast<int>(models_.size()) - 1;
+}
+
+Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
+             const std::string& models_dir)
+    : config_(config) {
+  const std::string dir = models_dir + "/meshes/";
+  std::unordered_map<std::string, int> file_model;
+  auto model = [&](const std::string& file) {
+    auto it = file_model.find(file);
+    if (it != file_model.end()) return it->second;
+    const int m = addModel(loadObjMesh(dir + file, file != "sentinel.obj"));
+    file_model[file] = m;
+    return m;
+  };
+  // Every class mesh is loaded up front, so that a missing file fails the construction.
+  for (const char* f : {"house_1.obj", "house_2.obj", "garage_1.obj", "garage_2.obj",
+                        "fence_wood.obj", "fence_vinyl.obj", "fence_chain_link.obj",
+                        "tree_deciduous.obj", "tree_pine.obj", "car_sedan.obj", "car_suv.obj",
+                        "car_pickup.obj", "car_hatchback.obj", "car_van.obj", "pedestrian.obj",
+                        "sentinel.obj"}) {
+    model(f);
+  }
+  procedural_.uav = model("sentinel.obj");
+  procedural_.ground = addModel(groundMesh(world.bounds()));
+  procedural_.sidewalks = addModel(sidewalkMesh(world.blocks(), world.params().sidewalk_width));
+  procedural_.street =
+      addModel(unitQuad("street", MaterialKind::kStreet, srgbToLinear(64, 65, 68)));
+  procedural_.driveway =
+      addModel(unitBox("driveway", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f)));
+
+  foliage_ = std::clamp(config.environment.foliage, 0.0, 1.0);
+  const std::size_t n_world = world.entities().size();
+  const std::size_t n_total = 2 + n_world + config.entities.size();  // + none, + uav
+  if (n_total > 65536) {
+    throw RenderError("scene: " + std::to_string(n_total - 1) +
+                      " instances do not fit the 16-bit instance labels (at most 65535)");
+  }
+  entity_ids_.assign(n_total, "");
+  uav_instance_ = static_cast<int>(n_total) - 1;
+  entity_ids_[static_cast<std::size_t>(uav_instance_)] = "uav";
+
+  // Ground layers: lawn and sidewalks, label "ground" with no instance.
+  for (int m : {procedural_.ground, procedural_.sidewalks}) {
+    SceneInstance si;
+    si.model = m;
+    si.semantic = kGroundSemantic;
+    identityRows(si.record.row);
+    si.record.label = label(kGroundSemantic, 0);
+    const Mesh& mesh = models_[static_cast<std::size_t>(m)];
+    si.center = 0.5f * (mesh.min + mesh.max);
+    si.radius = 0.5f * (mesh.max - mesh.min).norm();
+    instances_.push_back(si);
+  }
+
+  int street_index = 0;
+  auto add = [&](const scenario::Entity& e, int instance_id, int scenario_entity, bool mover) {
+    SceneInstance si;
+    si.instance_id = instance_id;
+    si.semantic = scenario::semanticId(e.cls);
+    si.scenario_entity = scenario_entity;
+    si.mover = mover;
+    si.interest = e.cls == EntityClass::kCar || e.cls == EntityClass::kPedestrian;
+    si.box = e.box;
+    double lift = 0.0;
+    std::string color_key;
+    switch (e.cls) {
+      case EntityClass::kStreet:
+        si.model = procedural_.street;
+        lift = streetTopZ(street_index++) - e.box.minZ();  // the slab's top face only
+        break;
+      case EntityClass::kDriveway: {
+        si.model = procedural_.driveway;
+        const std::string mat = e.attributes.str("material");
+        if (!paintColor(mat, &si.record.color) || (mat != "concrete" && mat != "asphalt")) {
+          throw RenderError(attributeError(e, "material", "concrete or asphalt"));
+        }
+        break;
+      }
+      case EntityClass::kHouse:
+        si.model = model(e.attributes.integer("storeys", 1) >= 2 ? "house_2.obj" : "house_1.obj");
+        color_key = "color";
+        break;
+      case EntityClass::kGarage:
+        si.model = model(e.attributes.integer("doors", 1) >= 2 ? "garage_2.obj" : "garage_1.obj");
+        color_key = "color";
+        break;
+      case EntityClass::kFence: {
+        const std::string mat = e.attributes.str("material");
+        if (mat != "wood" && mat != "vinyl" && mat != "chain_link") {
+          throw RenderError(attributeError(e, "material", "wood, vinyl or chain_link"));
+        }
+        si.model = model("fence_" + mat + ".obj");
+        color_key = "color";
+        break;
+      }
+      case EntityClass::kTree: {
+        const std::string species = e.attributes.str("species");
+        si.model = model(species == "pine" ? "tree_pine.obj" : "tree_deciduous.obj");
+        // Foliage density: canopies scale about their centre by 0.35 + 0.65 * foliage, a
+        // "sparse" tree by a further 0.85; at density 0 only trunks are drawn.
+        si.record.canopy = static_cast<float>((0.35 + 0.65 * foliage_) *
+                                              (e.attributes.str("foliage") == "sparse" ? 0.85 : 1.0));
+        Eigen::Vector3f tint(0.85f, 1.0f, 0.8f);  // oak
+        if (species == "maple") tint = Eigen::Vector3f(1.0f, 0.92f, 0.72f);
+        if (species == "birch") tint = Eigen::Vector3f(1.15f, 1.2f, 0.75f);
+        if (species == "pine") tint = Eigen::Vector3f(0.62f, 0.82f, 0.78f);
+        tint *= 0.9f + 0.2f * hash01(e.id);
+        si.record.color = packLinearHalf(tint);
+        break;
+      }
+      case EntityClass::kCar: {
+        const std::string vc = e.attributes.str("vehicle_class");
+        if (vc != "sedan" && vc != "suv" && vc != "pickup" && vc != "hatchback" && vc != "van") {
+          throw RenderError(attributeError(e, "vehicle_class", "sedan, suv, pickup, hatchback or van"));
+        }
+        si.model = model("car_" + vc + ".obj");
+        color_key = "color";
+        break;
+      }
+      case EntityClass::kPedestrian:
+        si.model = model("pedestrian.obj");
+        color_key = "clothing_color";
+        break;
+    }
+    if (!color_key.empty() && !paintColor(e.attributes.str(color_key), &si.record.color)) {
+      throw RenderError(attributeError(e, color_key,
+                                       "a colour name (red, blue, white, black, silver, grey, "
+                                       "green, yellow, beige, brick, brown, orange)"));
+    }
+    boxRecordRows(e.box, lift, si.record.row);
+    si.record.label = label(si.semantic, instance_id);
+    const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
+    const Eigen::Vector3f half = 0.5f * (mesh.max - mesh.min);
+    si.radius = half.cwiseProduct(e.box.size.cast<float>()).norm();
+    const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
+    for (int r = 0; r < 3; ++r) {
+      si.center[r] = si.record.row[r][0] * c.x() + si.record.row[r][1] * c.y() +
+                     si.record.row[r][2] * c.z() + si.record.row[r][3];
+    }
+    entity_ids_[static_cast<std::size_t>(instance_id)] = e.id;
+    instances_.push_back(si);
+  };
+  for (std::size_t i = 0; i < n_world; ++i) {
+    add(world.entities()[i], static_cast<int>(1 + i), -1, false);
+  }
+  for (std::size_t j = 0; j < config.entities.size(); ++j) {
+    const auto& se = config.entities[j];
+    add(se.entity, static_cast<int>(1 + n_world + j), static_cast<int>(j), !se.trajectory.empty());
+  }
+}
+
+void Scene::pose(std::size_t i, double time, InstanceRecord* record, Eigen::Vector3f* center,
+                 float* radius) const {
+  const SceneInstance& si = instances_[i];
+  *record = si.record;
+  *center = si.center;
+  *radius = si.radius;
+  if (!si.mover) return;
+  const auto& se = config_.entities[static_cast<std::size_t>(si.scenario_entity)];
+  const geometry::OrientedBox box =
+      scenario::poseBox(se.entity.box, scenario::sampleTrajectory(se.trajectory, time));
+  boxRecordRows(box, 0.0, record->row);
+  const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
+  const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
+  for (int r = 0; r < 3; ++r) {
+    (*center)[r] = record->row[r][0] * c.x() + record->row[r][1] * c.y() +
+                   record->row[r][2] * c.z() + record->row[r][3];
+  }
+}
+
+InstanceRecord Scene::uavRecord(const Eigen::Isometry3d& world_T_uav) const {
+  InstanceRecord r;
+  isometryRows(world_T_uav, r.row);
+  r.label = label(kUavSemantic, uav_instance_);
+  r.color = packRgb8(60, 60, 64);
+  return r;
+}
+
+SceneTriangles Scene::triangles(double time) const {
+  SceneTriangles out;
+  for (std::size_t i = 0; i < instances_.size(); ++i) {
+    InstanceRecord rec;
+    Eigen::Vector3f center;
+    float radius;
+    pose(i, time, &rec, &center, &radius);
+    const SceneInstance& si = instances_[i];
+    const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
+    for (const Submesh& s : mesh.submeshes) {
+      const bool canopy = s.kind == MaterialKind::kFoliage;
+      if (canopy && foliage_ <= 0) continue;
+      for (std::uint32_t k = s.first_index; k < s.first_index + s.index_count; ++k) {
+        Eigen::Vector3f p = mesh.position(mesh.indices[k]);
+        if (canopy) p = mesh.canopy_center + rec.canopy * (p - mesh.canopy_center);
+        Eigen::Vector3f w;
+        for (int r = 0; r < 3; ++r) {
+          w[r] = rec.row[r][0] * p.x() + rec.row[r][1] * p.y() + rec.row[r][2] * p.z() +
+                 rec.row[r][3];
+        }
+        out.indices.push_back(static_cast<std::uint32_t>(out.vertices.size()));
+        out.vertices.push_back(w);
+      }
+      out.triangle_instance.insert(out.triangle_instance.end(), s.index_count / 3, si.instance_id);
+    }
+  }
+  return out;
+}
+
+}  // namespace hameritt::render

@@ -1,0 +1,94 @@
+#pragma once
+// What the renderer draws, on the CPU: the class meshes, and one instance per drawn object with
+// its model matrix, colour and label. The world's instances never change; the scenario's movers
+// are posed per frame from their trajectories.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hameritt/render/renderer.h"
+#include "mesh.h"
+
+namespace hameritt::render {
+
+// Per-instance data as the vertex shader reads it (std430, 64 bytes).
+struct InstanceRecord {
+  float row[3][4];            // rows of the 3x4 model matrix (mesh -> world)
+  std::uint32_t color = 0;    // kPaint: sRGB8 colour; kFoliage: linear tint / 2 (RGB8)
+  std::uint32_t label = 0;    // semantic << 16 | instance
+  float canopy = 1.0f;        // canopy scale about the mesh's canopy centre
+  std::uint32_t pad = 0;
+};
+static_assert(sizeof(InstanceRecord) == 64, "std430 layout");
+
+// One drawn object.
+struct SceneInstance {
+  int model = 0;              // index into Scene::models()
+  int instance_id = 0;        // label instance (0 for ground layers)
+  int semantic = 0;
+  int scenario_entity = -1;   // index into SimConfig::entities when it comes from the scenario
+  bool mover = false;         // posed from its trajectory at the frame time
+  bool interest = false;      // car or pedestrian: gets a bounding box
+  geometry::OrientedBox box;  // pose and size (scale of a normalized mesh)
+  InstanceRecord record;      // at t = 0 for movers
+  Eigen::Vector3f center{0, 0, 0};  // bounding sphere
+  float radius = 0;
+};
+
+// Model indices of the procedural parts.
+struct SceneModels {
+  int ground = -1, sidewalks = -1, street = -1, driveway = -1, uav = -1;
+};
+
+class Scene {
+ public:
+  // Loads every class mesh from models_dir/meshes (RenderError naming a missing or malformed
+  // file) and builds the instances. Throws RenderError for unknown colour names and for more
+  // instances than a 16-bit label holds.
+  Scene(const scenario::World& world, const scenario::SimConfig& config,
+        const std::string& models_dir);
+
+  const std::vector<Mesh>& models() const { return models_; }
+  const SceneModels& procedural() const { return procedural_; }
+  // World instances (static) first, then the scenario's (movers among them).
+  const std::vector<SceneInstance>& instances() const { return instances_; }
+  // Instance id -> entity id ("" for 0 and the UAV is "uav").
+  const std::vector<std::string>& entityIds() const { return entity_ids_; }
+  int uavInstanceId() const { return uav_instance_; }
+  double foliage() const { return foliage_; }
+  // Record and bounding sphere of instance i at `time` (movers follow their trajectories).
+  void pose(std::size_t i, double time, InstanceRecord* record, Eigen::Vector3f* center,
+            float* radius) const;
+  // The UAV's record at world_T_uav.
+  InstanceRecord uavRecord(const Eigen::Isometry3d& world_T_uav) const;
+  // World-space triangles of every instance at `time` (what the geometry pass rasterizes).
+  SceneTriangles triangles(double time) const;
+  // Indices of model m that are drawn: all, or without the canopy at foliage density 0.
+  std::uint32_t drawnIndexCount(int m) const {
+    const Mesh& mesh = models_[static_cast<std::size_t>(m)];
+    return foliage_ > 0 ? static_cast<std::uint32_t>(mesh.indices.size()) : mesh.foliage_first;
+  }
+
+ private:
+  int addModel(Mesh mesh);
+
+  const scenario::SimConfig& config_;
+  std::vector<Mesh> models_;
+  SceneModels procedural_;
+  std::vector<SceneInstance> instances_;
+  std::vector<std::string> entity_ids_;
+  int uav_instance_ = 0;
+  double foliage_ = 1.0;
+};
+
+// Linear-RGB albedo of a named paint colour (red, blue, white, black, silver, grey, green,
+// yellow, beige, brick, brown, orange, concrete, asphalt), as sRGB8 packed in a uint32; false
+// for an unknown name.
+bool paintColor(const std::string& name, std::uint32_t* srgb8);
+
+// Model matrix rows of a normalized mesh placed at an entity box (bottom centre, yaw, size).
+void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]);
+
+}  // namespace hameritt::render

@@ -1,0 +1,282 @@
+#pragma once
+// GLSL 4.50 sources of the renderer's three programs: the geometry pass (lit colour, linear
+// depth, labels into three targets), the sky (pixels no geometry covered) and the weather
+// particles blended onto the colour. Motion blur and sensor noise follow on the CPU
+// (camera_effects.h).
+
+namespace hameritt::render::shaders {
+
+// Per-instance data are instanced vertex attributes (fetched once per instance): the culled
+// records of the frame, in draw order.
+inline constexpr const char* kGeometryVertex = R"GLSL(
+#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in uint a_material;  // Kd (sqrt-encoded RGB8) << 8 | MaterialKind
+layout(location = 3) in vec4 i_row0;      // model matrix rows (mesh -> world)
+layout(location = 4) in vec4 i_row1;
+layout(location = 5) in vec4 i_row2;
+layout(location = 6) in vec4 i_normal0;   // normal matrix rows; w: canopy scale, length, width
+layout(location = 7) in vec4 i_normal1;
+layout(location = 8) in vec4 i_normal2;
+layout(location = 9) in uvec2 i_ids;      // colour, label
+
+uniform mat4 u_view_proj;  // projection * world-to-optical rotation, camera-relative
+uniform vec3 u_camera;     // optical centre in the world
+uniform vec3 u_canopy_center;  // foliage vertices scale about it by the canopy factor
+
+out vec3 v_rel;     // world position - camera position
+out vec3 v_normal;  // world normal (not normalized)
+out vec4 v_street;  // mesh-local x, y in metres; instance length, width (street markings)
+flat out uvec3 v_ids;  // colour, label, material
+invariant gl_Position;
+
+void main() {
+  vec3 p = a_position;
+  if ((a_material & 255u) == 2u) p = u_canopy_center + i_normal0.w * (p - u_canopy_center);
+  vec4 p4 = vec4(p, 1.0);
+  vec3 world = vec3(dot(i_row0, p4), dot(i_row1, p4), dot(i_row2, p4));
+  v_normal = vec3(dot(i_normal0.xyz, a_normal), dot(i_normal1.xyz, a_normal),
+                  dot(i_normal2.xyz, a_normal));
+  v_rel = world - u_camera;
+  vec2 extent = vec2(i_normal1.w, i_normal2.w);
+  v_street = vec4(a_position.xy * extent, extent);
+  v_ids = uvec3(i_ids, a_material);
+  gl_Position = u_view_proj * vec4(v_rel, 1.0);
+}
+)GLSL";
+
+inline constexpr const char* kCommon = R"GLSL(
+uniform vec3 u_haze_color;
+uniform float u_haze_k;
+
+// A soft shoulder (Reinhard-like), then a display gamma of 2 (colours are defined in a gamma-2
+// space and squared to linear: cheaper than pow() on a CPU rasterizer).
+vec3 toDisplay(vec3 c) {
+  return sqrt(c / (vec3(1.0) + 0.25 * c));
+}
+// Fog, dust and rain: exponential extinction towards the haze colour.
+vec3 haze(vec3 c, float distance) {
+  if (u_haze_k > 0.0) c = mix(u_haze_color, c, exp(-u_haze_k * distance));
+  return c;
+}
+)GLSL";
+
+inline constexpr const char* kGeometryFragment = R"GLSL(
+in vec3 v_rel;
+in vec3 v_normal;
+in vec4 v_street;
+flat in uvec3 v_ids;
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_depth;
+layout(location = 2) out uint o_label;
+
+uniform float u_near;
+uniform float u_far;
+uniform vec3 u_sun_dir;
+uniform vec3 u_sun_color;
+uniform vec3 u_sky_ambient;
+uniform vec3 u_ground_ambient;
+uniform float u_snow;
+uniform float u_wet;
+uniform vec3 u_camera;
+
+vec3 unpack8(uint c) {
+  return vec3(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) / 255.0;
+}
+float hash21(vec2 p) {
+  uvec2 q = uvec2(ivec2(floor(p)) + 32768) * uvec2(1597334673u, 3812015801u);
+  uint n = (q.x ^ q.y) * 1597334673u;
+  return float(n >> 8) * (1.0 / 16777216.0);
+}
+float valueNoise(vec2 p) {
+  vec2 i = floor(p), f = fract(p);
+  vec2 u = f * f * (3.0 - 2.0 * f);
+  return mix(mix(hash21(i), hash21(i + vec2(1, 0)), u.x),
+             mix(hash21(i + vec2(0, 1)), hash21(i + vec2(1, 1)), u.x), u.y);
+}
+
+void main() {
+  vec3 n = normalize(v_normal);
+  uint material = v_ids.z;
+  uint kind = material & 255u;
+  vec3 kd = vec3(float(material >> 24), float((material >> 16) & 255u),
+                 float((material >> 8) & 255u)) / 255.0;
+  vec3 albedo = kd * kd;
+  float snow_hold = 1.0;  // how well snow stays on the surface
+  if (kind == 1u) {
+    albedo = unpack8(v_ids.x);
+    albedo *= albedo;
+  } else if (kind == 2u) {
+    albedo *= 2.0 * unpack8(v_ids.x);
+  } else if (kind == 3u) {
+    vec2 w = v_rel.xy + u_camera.xy;
+    float patches = valueNoise(w * (1.0 / 9.0));
+    albedo *= 0.8 + 0.4 * patches;
+    albedo = mix(albedo, vec3(0.26, 0.25, 0.13), 0.4 * smoothstep(0.6, 0.95, patches));
+  } else if (kind == 4u) {
+    vec2 w = v_rel.xy + u_camera.xy;
+    albedo *= 0.85 + 0.3 * valueNoise(w * 0.9);
+    // Dashed yellow centre line, not across the intersections at either end.
+    float along = v_street.x, across = v_street.y;
+    float open = 0.5 * v_street.z - v_street.w - 1.0;
+    if (abs(across) < 0.07 && abs(along) < open && fract(along / 6.0) < 0.5) {
+      albedo = vec3(0.62, 0.45, 0.06);
+    }
+    snow_hold = 0.55;  // traffic clears part of it
+  } else if (kind == 5u) {
+    vec2 w = v_rel.xy + u_camera.xy;
+    albedo *= 0.92 + 0.12 * valueNoise(w * 1.7);
+  }
+  if (u_wet > 0.0) albedo *= 1.0 - u_wet * (0.18 + 0.22 * max(n.z, 0.0));
+  if (u_snow > 0.0) {
+    float cover = u_snow * snow_hold * smoothstep(0.3, 0.85, n.z);
+    albedo = mix(albedo, vec3(0.82, 0.84, 0.88), cover);
+  }
+  float ndl = max(dot(n, u_sun_dir), 0.0);
+  vec3 hemi = mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
+  vec3 c = albedo * (u_sun_color * ndl + hemi);
+  c = haze(c, length(v_rel));
+  o_color = vec4(toDisplay(c), 1.0);
+  // Distance along the optical axis from the reversed-Z window depth (exact inverse of the
+  // projection): z_w = n (f - Z) / (Z (f - n)).
+  o_depth = u_near * u_far / (gl_FragCoord.z * (u_far - u_near) + u_near);
+  o_label = v_ids.y;
+}
+)GLSL";
+
+// A full-screen triangle at the far plane (window depth 0), drawn with GL_EQUAL after the
+// geometry, so it shades only the pixels nothing covered.
+inline constexpr const char* kFullscreenVertex = R"GLSL(
+#version 450 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)GLSL";
+
+inline constexpr const char* kSkyFragment = R"GLSL(
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_depth;
+layout(location = 2) out uint o_label;
+
+uniform mat3 u_world_R_optical;
+uniform vec4 u_intrinsics;  // fx, fy, cx, cy
+uniform vec3 u_zenith;
+uniform vec3 u_horizon;
+uniform vec3 u_sun_dir;
+uniform vec3 u_glow;
+uniform float u_far;
+
+void main() {
+  // Rows are rendered top first: window (x, y) is pixel (u, v) = (x - 0.5, y - 0.5).
+  vec2 uv = gl_FragCoord.xy - 0.5;
+  vec3 ray = vec3((uv.x - u_intrinsics.z) / u_intrinsics.x, (uv.y - u_intrinsics.w) / u_intrinsics.y, 1.0);
+  vec3 d = normalize(u_world_R_optical * ray);
+  float up = max(d.z, 0.0);
+  vec3 c = mix(u_horizon, u_zenith, pow(up, 0.6));
+  if (d.z < 0.0) c = u_horizon * (1.0 - 0.3 * min(-d.z * 4.0, 1.0));
+  float s = max(dot(d, u_sun_dir), 0.0);
+  c += u_glow * (0.35 * pow(s, 8.0) + 2.0 * pow(s, 600.0));
+  c = haze(c, u_far);
+  o_color = vec4(toDisplay(c), 1.0);
+  o_depth = uintBitsToFloat(0x7F800000u);  // +inf: nothing hit
+  o_label = 0u;
+}
+)GLSL";
+
+// PCG-based 4D hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020): a
+// counter-based generator, so every value depends only on its inputs, never on threads or order.
+inline constexpr const char* kHash = R"GLSL(
+uvec4 pcg4d(uvec4 v) {
+  v = v * 1664525u + 1013904223u;
+  v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
+  v ^= v >> 16u;
+  v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
+  return v;
+}
+vec4 uniform01(uvec4 h) { return vec4(h >> 8u) * (1.0 / 16777216.0); }
+)GLSL";
+
+// Weather particles: one screen-space particle per cell of a grid (a rain streak or a snow
+// flake), present with probability `density`, drawn as an instanced quad and blended onto the
+// colour. Each instance is a cell; its particle comes from the hash of (cell, layer, key).
+inline constexpr const char* kParticleVertex = R"GLSL(
+uniform uvec4 u_key;
+uniform vec2 u_size;       // image width, height
+uniform int u_cells_x;
+uniform float u_cell;      // cell size (px)
+uniform float u_length;    // streak length (px); 0: a flake
+uniform float u_radius;    // half width of a streak, radius of a flake (px)
+uniform float u_density;
+uniform uint u_layer;
+uniform vec3 u_fall;       // falling direction in the optical frame
+uniform vec4 u_intrinsics; // fx, fy, cx, cy
+
+out vec2 v_coord;  // streak: (along, across) in px from the centre; flake: offset in px
+flat out float v_half_length;
+
+void main() {
+  int cell = gl_InstanceID;
+  vec2 id = vec2(float(cell % u_cells_x), float(cell / u_cells_x));
+  vec4 h = uniform01(pcg4d(uvec4(uint(cell), u_layer, u_key.x, u_key.y)));
+  const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1),
+                                  vec2(1, 1), vec2(-1, 1));
+  vec2 corner = corners[gl_VertexID];
+  vec2 p;
+  if (h.x >= u_density) {
+    gl_Position = vec4(2.0, 2.0, 0.5, 1.0);  // no particle in this cell: outside the view
+    v_coord = vec2(0.0);
+    v_half_length = 0.0;
+    return;
+  }
+  if (u_length > 0.0) {
+    // Image-plane motion of a falling drop at the cell centre: towards the vanishing point of
+    // the fall direction, as fast as a level view sees it at most.
+    vec2 c0 = (id + 0.5) * u_cell;
+    vec2 f = vec2(u_intrinsics.x * u_fall.x - (c0.x - u_intrinsics.z) * u_fall.z,
+                  u_intrinsics.y * u_fall.y - (c0.y - u_intrinsics.w) * u_fall.z) / u_intrinsics.x;
+    float speed = clamp(length(f), 0.15, 1.0);
+    vec2 dir = normalize(f + vec2(1e-4, 0.0));
+    float half_len = 0.5 * u_length * speed * (0.7 + 0.3 * h.w);
+    vec2 center = c0 + (h.yz - 0.5) * (u_cell - u_length - 2.0);
+    vec2 across = vec2(-dir.y, dir.x);
+    float ext_along = half_len + u_radius + 1.0, ext_across = u_radius + 1.0;
+    p = center + corner.x * ext_along * dir + corner.y * ext_across * across;
+    v_coord = vec2(corner.x * ext_along, corner.y * ext_across);
+    v_half_length = half_len;
+  } else {
+    float r = u_radius * (0.6 + 0.4 * h.w);
+    vec2 center = (id + 0.5) * u_cell + (h.yz - 0.5) * (u_cell - 2.0 * r - 2.0);
+    p = center + corner * (r + 1.0);
+    v_coord = corner * (r + 1.0);
+    v_half_length = r;
+  }
+  // Pixel (u, v) centre -> NDC, rows top first as in the geometry pass.
+  gl_Position = vec4(2.0 * (p + 0.5) / u_size - 1.0, 0.5, 1.0);
+}
+)GLSL";
+
+inline constexpr const char* kParticleFragment = R"GLSL(
+in vec2 v_coord;
+flat in float v_half_length;
+layout(location = 0) out vec4 o_color;
+uniform float u_length;
+uniform float u_radius;
+uniform float u_alpha;
+uniform float u_brightness;
+
+void main() {
+  float a;
+  if (u_length > 0.0) {
+    vec2 d = vec2(max(abs(v_coord.x) - v_half_length, 0.0), v_coord.y);
+    a = u_alpha * clamp(1.0 - length(d) / u_radius, 0.0, 1.0);
+  } else {
+    a = u_alpha * (1.0 - smoothstep(0.5 * v_half_length, v_half_length, length(v_coord)));
+  }
+  o_color = vec4(vec3(u_brightness), a);
+}
+)GLSL";
+
+}  // namespace hameritt::render::shaders
