@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Quick start, command 1: install, build, and run the main job on the shipped scenario:
-# validate it, summarize it, draw its map, and generate a fresh batch of all three classes.
+# validate it, summarize it, draw its map, run the whole mission end to end with the baseline
+# clients (headless, recording a bag), print its metrics, and generate a fresh batch of
+# scenarios of all three classes.
 source "$(dirname "$0")/common.sh"
 install_deps
 build
@@ -15,6 +17,21 @@ echo "== summary"
 rosrun hameritt hameritt_summary "$SCENARIO"
 echo "== map -> $OUT/default_map.png"
 rosrun hameritt hameritt_map "$SCENARIO" --out "$OUT/default_map.png"
+echo "== mission: roslaunch hameritt mission.launch mode:=${HAMERITT_MODE:-end_to_end} record:=true -> $OUT/mission"
+rm -rf "$OUT/mission"
+mkdir -p "$OUT/mission"
+# A private ROS master port, so that a running roscore is left alone.
+port=$((11400 + $$ % 500))
+ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" hameritt mission.launch \
+  scenario:="$SCENARIO" mode:="${HAMERITT_MODE:-end_to_end}" record:=true output_dir:="$OUT/mission" \
+  real_time_factor:="${HAMERITT_REAL_TIME_FACTOR:-0}" >"$OUT/mission/launch.log" 2>&1 ||
+  { tail -40 "$OUT/mission/launch.log"; echo "hameritt: the mission launch failed (log: $OUT/mission/launch.log)"; exit 1; }
+grep -E "simulator: sim .* wall" "$OUT/mission/launch.log" | tail -1 || true
+echo "== metrics ($OUT/mission/metrics.json)"
+cat "$OUT/mission/metrics.json"
+echo
+echo "== bag ($OUT/mission/mission.bag)"
+rosbag info "$OUT/mission/mission.bag" | head -60
 echo "== generating 30 scenarios (all classes, seed 1) -> $OUT/generated"
 rosrun hameritt hameritt_generate --class all --count 30 --seed 1 --out "$OUT/generated" --quiet
 rosrun hameritt hameritt_validate "$OUT"/generated/*/mission.json "$OUT"/generated/*/sim_config.json >/dev/null
