@@ -35,13 +35,18 @@ void EnergyModel::validate() const {
     throw scenario::ConfigError("energy.drag_area: expected a finite number >= 0, got " +
                                 scenario::formatNumber(drag_area));
   }
+  if (!(max_thrust_to_weight >= 1.0) || !std::isfinite(max_thrust_to_weight)) {
+    throw scenario::ConfigError("energy.max_thrust_to_weight: expected a finite number >= 1, got " +
+                                scenario::formatNumber(max_thrust_to_weight));
+  }
   if (!(airborne_altitude >= 0.0) || !(moving_speed >= 0.0)) {
     throw scenario::ConfigError("energy.airborne_altitude, energy.moving_speed: expected >= 0");
   }
 }
 
 double EnergyModel::power(const Vec3& v, const Vec3& a) const {
-  const double thrust = mass * (a + Vec3(0, 0, gravity)).norm();
+  const double thrust =
+      std::min(mass * (a + Vec3(0, 0, gravity)).norm(), max_thrust_to_weight * mass * gravity);
   const double disk = rotors * geometry::kPi * rotor_radius * rotor_radius;
   const double induced = std::pow(thrust, 1.5) / std::sqrt(2.0 * air_density * disk);
   const double speed = v.norm();
@@ -273,6 +278,7 @@ std::string metricsJson(const MissionMetrics& m) {
   em["rotor_radius"] = m.energy_model.rotor_radius;
   em["figure_of_merit"] = m.energy_model.figure_of_merit;
   em["drag_area"] = m.energy_model.drag_area;
+  em["max_thrust_to_weight"] = m.energy_model.max_thrust_to_weight;
   em["air_density"] = m.energy_model.air_density;
   em["hover_power"] = m.energy_model.hoverPower();
   f["energy_model"] = em;

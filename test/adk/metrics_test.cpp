@@ -26,6 +26,8 @@ TEST(EnergyModel, HoverPowerFromMomentumTheory) {
   EXPECT_NEAR(e.power(Vec3::Zero(), Vec3(0, 0, 9.81)), e.hoverPower() * std::pow(2.0, 1.5), 1e-9);
   EXPECT_NEAR(e.power(Vec3(10, 0, 0), Vec3::Zero()) - e.hoverPower(), 0.5 * 1.225 * 0.02 * 1000,
               1e-9);
+  // The thrust is capped at 3 m g: an acceleration of 100 g costs what 2 g up costs.
+  EXPECT_NEAR(e.power(Vec3::Zero(), Vec3(0, 0, 981)), e.hoverPower() * std::pow(3.0, 1.5), 1e-9);
   EnergyModel bad;
   bad.figure_of_merit = 1.5;
   EXPECT_THROW(bad.validate(), scenario::ConfigError);

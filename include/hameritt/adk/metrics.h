@@ -21,7 +21,9 @@ namespace hameritt::adk {
 // T^(3/2) / sqrt(2 rho A) (Leishman, Principles of Helicopter Aerodynamics, 2nd ed., ch. 2),
 // divided by the figure of merit for the profile and motor losses. The thrust is the one the
 // measured acceleration needs, T = m |a + g z|, shared by the rotors; a parasitic drag term
-// 1/2 rho CdA |v|^3 is added. The induced-power saving of forward flight (translational lift)
+// 1/2 rho CdA |v|^3 is added. The thrust is capped at max_thrust_to_weight x m g, what the
+// rotors can give, so that a jump in the odometry (a teleport, a reset) cannot claim unbounded
+// power. The induced-power saving of forward flight (translational lift)
 // is neglected, so the estimate errs high at speed. Landed (not airborne), the power is 0.
 // Defaults: the Sentinel-class quadrotor of models/sentinel.urdf (1.04 kg, four 5-inch props
 // of radius 0.0635 m): about 154 W hovering.
@@ -33,6 +35,7 @@ struct EnergyModel {
   double rotor_radius = 0.0635;   // m
   double figure_of_merit = 0.6;   // induced / total rotor power
   double drag_area = 0.02;        // Cd x frontal area, m^2
+  double max_thrust_to_weight = 3.0;
   double airborne_altitude = 0.3; // m above ground: above it the UAV is flying
   double moving_speed = 0.2;      // m/s: faster than this it is flying, whatever its height
 
