@@ -76,10 +76,14 @@ struct Keyed {
 
 int rankOf(ConstraintEvent::Kind k) {
   switch (k) {
-    case ConstraintEvent::Kind::kEnter: return 0;
-    case ConstraintEvent::Kind::kViolationStart: return 1;
-    case ConstraintEvent::Kind::kViolationEnd: return 2;
-    case ConstraintEvent::Kind::kExit: return 3;
+    case ConstraintEvent::Kind::kEnter:
+      return 0;
+    case ConstraintEvent::Kind::kViolationStart:
+      return 1;
+    case ConstraintEvent::Kind::kViolationEnd:
+      return 2;
+    case ConstraintEvent::Kind::kExit:
+      return 3;
   }
   return 4;
 }
@@ -88,10 +92,14 @@ int rankOf(ConstraintEvent::Kind k) {
 
 const char* toString(ConstraintEvent::Kind k) {
   switch (k) {
-    case ConstraintEvent::Kind::kEnter: return "enter";
-    case ConstraintEvent::Kind::kExit: return "exit";
-    case ConstraintEvent::Kind::kViolationStart: return "violation_start";
-    case ConstraintEvent::Kind::kViolationEnd: return "violation_end";
+    case ConstraintEvent::Kind::kEnter:
+      return "enter";
+    case ConstraintEvent::Kind::kExit:
+      return "exit";
+    case ConstraintEvent::Kind::kViolationStart:
+      return "violation_start";
+    case ConstraintEvent::Kind::kViolationEnd:
+      return "violation_end";
   }
   return "?";
 }
@@ -133,8 +141,8 @@ std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon, con
       // Parallel: collinear when c lies on the segment's line; the overlap's ends are the
       // edge's ends projected onto the segment.
       const double offset = std::fabs(cross2(w, d)) / len;
-      const double scale = std::max({1.0, std::fabs(a.x()), std::fabs(a.y()), std::fabs(c.x()),
-                                     std::fabs(c.y())});
+      const double scale =
+          std::max({1.0, std::fabs(a.x()), std::fabs(a.y()), std::fabs(c.x()), std::fabs(c.y())});
       if (offset <= geometry::kEpsilon * scale) {
         for (const Vec2& p : {c, e}) {
           const double u = (p - a).dot(d) / dd;
@@ -143,8 +151,7 @@ std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon, con
       }
     }
   }
-  std::sort(breaks.begin(), breaks.end(),
-            [](const Break& x, const Break& y) { return x.u < y.u; });
+  std::sort(breaks.begin(), breaks.end(), [](const Break& x, const Break& y) { return x.u < y.u; });
   // Merge equal parameters.
   std::vector<Break> pts;
   for (const auto& br : breaks) {

@@ -65,10 +65,10 @@ Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base,
   const Vec3 rpy = camera.mount_rpy * (geometry::kPi / 180.0);
   Eigen::Isometry3d base_T_link = Eigen::Isometry3d::Identity();
   base_T_link.translation() = camera.mount_xyz;
-  base_T_link.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) *
-                          Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                          Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
-                             .toRotationMatrix();
+  base_T_link.linear() =
+      (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+       Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+          .toRotationMatrix();
   // REP 103: the optical frame's x is the link's -y, its y the link's -z, its z the link's x.
   Eigen::Matrix3d link_R_optical;
   link_R_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
@@ -174,9 +174,11 @@ int CoverageGrid::addFootprint(const Polygon& footprint, double t) {
   for (auto& g : areas_) {
     if (!g.window.active(t)) continue;
     const int x0 = std::max(0, static_cast<int>(std::ceil((fb.min.x() - g.origin.x()) / cell_)));
-    const int x1 = std::min(g.nx - 1, static_cast<int>(std::floor((fb.max.x() - g.origin.x()) / cell_)));
+    const int x1 =
+        std::min(g.nx - 1, static_cast<int>(std::floor((fb.max.x() - g.origin.x()) / cell_)));
     const int y0 = std::max(0, static_cast<int>(std::ceil((fb.min.y() - g.origin.y()) / cell_)));
-    const int y1 = std::min(g.ny - 1, static_cast<int>(std::floor((fb.max.y() - g.origin.y()) / cell_)));
+    const int y1 =
+        std::min(g.ny - 1, static_cast<int>(std::floor((fb.max.y() - g.origin.y()) / cell_)));
     for (int iy = y0; iy <= y1; ++iy) {
       for (int ix = x0; ix <= x1; ++ix) {
         const std::size_t i = static_cast<std::size_t>(iy) * g.nx + ix;
@@ -207,8 +209,8 @@ std::vector<AoiCoverage> CoverageGrid::coverage() const {
     c.fraction = g.cells > 0 ? static_cast<double>(c.covered) / g.cells : 0.0;
     for (std::size_t pc = 0; pc < g.prior_cells.size(); ++pc) {
       if (g.prior_cells[pc] > 0) {
-        c.prior_weighted +=
-            g.prior_probability[pc] * covered_per_prior[pc] / static_cast<double>(g.prior_cells[pc]);
+        c.prior_weighted += g.prior_probability[pc] * covered_per_prior[pc] /
+                            static_cast<double>(g.prior_cells[pc]);
       }
     }
     out.push_back(c);

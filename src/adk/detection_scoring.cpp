@@ -94,10 +94,14 @@ void ScoringSettings::validate() const {
 
 const char* toString(Verdict v) {
   switch (v) {
-    case Verdict::kTarget: return "target";
-    case Verdict::kConfuser: return "confuser";
-    case Verdict::kOther: return "other";
-    case Verdict::kNone: return "none";
+    case Verdict::kTarget:
+      return "target";
+    case Verdict::kConfuser:
+      return "confuser";
+    case Verdict::kOther:
+      return "other";
+    case Verdict::kNone:
+      return "none";
   }
   return "?";
 }

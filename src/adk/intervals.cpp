@@ -9,8 +9,8 @@ namespace hameritt::adk {
 
 void IntervalUnion::add(double lo, double hi) {
   if (!std::isfinite(lo) || !std::isfinite(hi) || lo > hi) {
-    throw InputError("interval [" + scenario::formatNumber(lo) + ", " +
-                     scenario::formatNumber(hi) + "]: expected finite bounds with lo <= hi");
+    throw InputError("interval [" + scenario::formatNumber(lo) + ", " + scenario::formatNumber(hi) +
+                     "]: expected finite bounds with lo <= hi");
   }
   // First interval that ends at or after lo: everything before it stays as it is.
   auto it = std::lower_bound(intervals_.begin(), intervals_.end(), lo,

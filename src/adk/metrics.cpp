@@ -61,10 +61,14 @@ bool EnergyModel::airborne(const Vec3& p, const Vec3& v) const {
 
 const char* toString(Outcome o) {
   switch (o) {
-    case Outcome::kSuccess: return "success";
-    case Outcome::kTimeout: return "timeout";
-    case Outcome::kCrashed: return "crashed";
-    case Outcome::kAborted: return "aborted";
+    case Outcome::kSuccess:
+      return "success";
+    case Outcome::kTimeout:
+      return "timeout";
+    case Outcome::kCrashed:
+      return "crashed";
+    case Outcome::kAborted:
+      return "aborted";
   }
   return "?";
 }
@@ -138,9 +142,15 @@ void MetricsAccumulator::addVerdict(double stamp, const DetectionVerdict& verdic
       if (m && !objective_.found_by_sighting) m->found = true;
       break;
     }
-    case Verdict::kConfuser: ++counts_.false_on_confusers; break;
-    case Verdict::kOther: ++counts_.false_on_other_entities; break;
-    case Verdict::kNone: ++counts_.false_on_nothing; break;
+    case Verdict::kConfuser:
+      ++counts_.false_on_confusers;
+      break;
+    case Verdict::kOther:
+      ++counts_.false_on_other_entities;
+      break;
+    case Verdict::kNone:
+      ++counts_.false_on_nothing;
+      break;
   }
 }
 
@@ -170,8 +180,7 @@ bool MetricsAccumulator::objectiveMet(double t) const {
 
 MissionMetrics MetricsAccumulator::finish(Outcome outcome, const std::string& reason,
                                           double start_time, double end_time, double time_limit,
-                                          const std::string& mode,
-                                          const ConstraintMonitor& monitor,
+                                          const std::string& mode, const ConstraintMonitor& monitor,
                                           const CoverageGrid& coverage) const {
   MissionMetrics m;
   m.scenario_id = scenario_id_;
@@ -313,29 +322,38 @@ void writeMetricsJson(const MissionMetrics& m, const std::string& path) {
 
 const char* toString(MissionState s) {
   switch (s) {
-    case MissionState::kWaiting: return "waiting";
-    case MissionState::kRunning: return "running";
-    case MissionState::kSucceeded: return "succeeded";
-    case MissionState::kTimeout: return "timeout";
-    case MissionState::kCrashed: return "crashed";
-    case MissionState::kAborted: return "aborted";
+    case MissionState::kWaiting:
+      return "waiting";
+    case MissionState::kRunning:
+      return "running";
+    case MissionState::kSucceeded:
+      return "succeeded";
+    case MissionState::kTimeout:
+      return "timeout";
+    case MissionState::kCrashed:
+      return "crashed";
+    case MissionState::kAborted:
+      return "aborted";
   }
   return "?";
 }
 
 Outcome outcomeOf(MissionState s) {
   switch (s) {
-    case MissionState::kSucceeded: return Outcome::kSuccess;
-    case MissionState::kTimeout: return Outcome::kTimeout;
-    case MissionState::kCrashed: return Outcome::kCrashed;
-    default: return Outcome::kAborted;
+    case MissionState::kSucceeded:
+      return Outcome::kSuccess;
+    case MissionState::kTimeout:
+      return Outcome::kTimeout;
+    case MissionState::kCrashed:
+      return Outcome::kCrashed;
+    default:
+      return Outcome::kAborted;
   }
 }
 
 MissionLifecycle::MissionLifecycle(double time_limit) : time_limit_(time_limit) {
   if (!(time_limit > 0.0) || !std::isfinite(time_limit)) {
-    throw InputError("time_limit: expected seconds > 0, got " +
-                     scenario::formatNumber(time_limit));
+    throw InputError("time_limit: expected seconds > 0, got " + scenario::formatNumber(time_limit));
   }
 }
 

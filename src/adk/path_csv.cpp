@@ -28,8 +28,8 @@ std::vector<std::string> split(const std::string& line) {
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    out.push_back(trim(line.substr(start, comma == std::string::npos ? std::string::npos
-                                                                      : comma - start)));
+    out.push_back(
+        trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -70,8 +70,7 @@ std::vector<PathSample> parsePathCsv(const std::string& text, const std::string&
     std::vector<std::string> fields = split(line);
     if (header.empty()) {
       if (fields.size() < 4) {
-        throw ConfigError(where + "header: expected the columns t,x,y,z first, got '" + line +
-                          "'");
+        throw ConfigError(where + "header: expected the columns t,x,y,z first, got '" + line + "'");
       }
       for (std::size_t c = 0; c < fields.size(); ++c) {
         if (c < 4 && fields[c] != kRequired[c]) {

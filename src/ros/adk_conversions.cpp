@@ -46,8 +46,7 @@ std_msgs::ColorRGBA color(float r, float g, float b, float a) {
   return c;
 }
 
-visualization_msgs::Marker marker(const std::string& ns, int id, int type,
-                                  const ros::Time& stamp) {
+visualization_msgs::Marker marker(const std::string& ns, int id, int type, const ros::Time& stamp) {
   visualization_msgs::Marker m;
   m.header.frame_id = kMap;
   m.header.stamp = stamp;
@@ -65,7 +64,8 @@ std::string windowText(const geometry::TimeWindow& w) {
   if (w.unbounded()) return "always";
   std::string s;
   if (w.net) s += "from " + scenario::formatNumber(*w.net) + " s";
-  if (w.nlt) s += std::string(s.empty() ? "" : " ") + "until " + scenario::formatNumber(*w.nlt) + " s";
+  if (w.nlt)
+    s += std::string(s.empty() ? "" : " ") + "until " + scenario::formatNumber(*w.nlt) + " s";
   return s;
 }
 

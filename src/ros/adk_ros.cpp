@@ -92,8 +92,8 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   sim_config_ = scenario::loadSimConfig(sim_config_path);
   if (sim_config_.scenario_id != mission_.scenario_id) {
     throw ConfigError(sim_config_path + ": scenario_id: expected '" + mission_.scenario_id +
-                      "' (the mission's, " + mission_path + "), got '" +
-                      sim_config_.scenario_id + "'");
+                      "' (the mission's, " + mission_path + "), got '" + sim_config_.scenario_id +
+                      "'");
   }
   double time_limit = mission_.time_limit;
   pnh.param("time_limit", time_limit, time_limit);
@@ -147,11 +147,12 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   mission_pub_.publish(toMsg(mission_, stamp));
   markers_pub_.publish(missionMarkers(mission_, sim_config_.uav.altitude_max + 20.0, stamp));
   publishState();
-  ROS_INFO("adk: %s (%s), mode %s, perfect perception %s, time limit %.1f s, %zu cameras, "
-           "metrics to %s",
-           mission_.scenario_id.c_str(), mission_.objective.type.c_str(), mode_.c_str(),
-           perfect_perception_ ? "on" : "off", time_limit, intrinsics_.size(),
-           output_dir_.empty() ? "(not written)" : (output_dir_ + "/metrics.json").c_str());
+  ROS_INFO(
+      "adk: %s (%s), mode %s, perfect perception %s, time limit %.1f s, %zu cameras, "
+      "metrics to %s",
+      mission_.scenario_id.c_str(), mission_.objective.type.c_str(), mode_.c_str(),
+      perfect_perception_ ? "on" : "off", time_limit, intrinsics_.size(),
+      output_dir_.empty() ? "(not written)" : (output_dir_ + "/metrics.json").c_str());
 }
 
 std::vector<adk::EntityTruth> AdkRos::truthAt(double t) const {
@@ -203,8 +204,10 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     // The simulator publishes the state twice at a step it was asked for; a time going back is
     // a reset, which a mission run does not do.
     if (t < last_odom_t_) {
-      ROS_WARN_THROTTLE(5.0, "adk: odometry at t = %.6f s is older than the last (%.6f s); "
-                             "ignored (was the simulator reset?)", t, last_odom_t_);
+      ROS_WARN_THROTTLE(5.0,
+                        "adk: odometry at t = %.6f s is older than the last (%.6f s); "
+                        "ignored (was the simulator reset?)",
+                        t, last_odom_t_);
     }
     return;
   }
@@ -307,9 +310,10 @@ void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::Const
       pe.role = "world";
       pe.attributes = toKeyValues(we.attributes);
     } else {
-      ROS_WARN_THROTTLE(5.0, "adk: camera %s: box of '%s', which is neither a scenario entity "
-                             "nor a parked world car; ignored", cam.name.c_str(),
-                        box.entity_id.c_str());
+      ROS_WARN_THROTTLE(5.0,
+                        "adk: camera %s: box of '%s', which is neither a scenario entity "
+                        "nor a parked world car; ignored",
+                        cam.name.c_str(), box.entity_id.c_str());
       continue;
     }
     pe.position.x = where.position.x();
@@ -374,11 +378,11 @@ void AdkRos::finish() {
   if (monitor_->sampleCount() > 0) publishConstraints(monitor_->lastTime());
   metrics_pub_.publish(toMsg(m, file, stamp));
   publishState();
-  ROS_INFO("adk: mission %s at t = %.3f s (%s); %zu keep-out violations, path %.1f m, "
-           "energy %.0f J%s%s",
-           adk::toString(m.outcome), m.end_time, m.reason.c_str(), m.violations.size(),
-           m.flight.path_length, m.flight.energy, file.empty() ? "" : "; metrics in ",
-           file.c_str());
+  ROS_INFO(
+      "adk: mission %s at t = %.3f s (%s); %zu keep-out violations, path %.1f m, "
+      "energy %.0f J%s%s",
+      adk::toString(m.outcome), m.end_time, m.reason.c_str(), m.violations.size(),
+      m.flight.path_length, m.flight.energy, file.empty() ? "" : "; metrics in ", file.c_str());
 }
 
 int AdkRos::spin() {

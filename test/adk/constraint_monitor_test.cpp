@@ -15,7 +15,8 @@ using namespace testing;  // NOLINT
 
 using Kind = ConstraintEvent::Kind;
 
-std::vector<Violation> fly(const scenario::Mission& m, const std::vector<std::pair<double, Vec3>>& s,
+std::vector<Violation> fly(const scenario::Mission& m,
+                           const std::vector<std::pair<double, Vec3>>& s,
                            std::vector<ConstraintEvent>* events = nullptr) {
   ConstraintMonitor mon(m);
   for (const auto& [t, p] : s) {
@@ -96,8 +97,8 @@ TEST(ConstraintMonitor, SampleFreeCornerCrossingHasExactTimes) {
 
 TEST(ConstraintMonitor, AltitudeBandAboveBelowAndThrough) {
   const auto m = squareMission();
-  EXPECT_TRUE(fly(m, {{0.0, Vec3(-5, 5, 25)}, {20.0, Vec3(15, 5, 25)}}).empty());  // above
-  EXPECT_TRUE(fly(m, {{0.0, Vec3(-5, 5, 2)}, {20.0, Vec3(15, 5, 2)}}).empty());    // below
+  EXPECT_TRUE(fly(m, {{0.0, Vec3(-5, 5, 25)}, {20.0, Vec3(15, 5, 25)}}).empty());   // above
+  EXPECT_TRUE(fly(m, {{0.0, Vec3(-5, 5, 2)}, {20.0, Vec3(15, 5, 2)}}).empty());     // below
   EXPECT_EQ(fly(m, {{0.0, Vec3(-5, 5, 20)}, {20.0, Vec3(15, 5, 20)}}).size(), 1u);  // on the top
   // Climbing vertically inside the polygon: z = 5 t is in [5, 20] for t in [1, 4].
   const auto v = fly(m, {{0.0, Vec3(5, 5, 0)}, {6.0, Vec3(5, 5, 30)}});
@@ -176,8 +177,8 @@ TEST(ConstraintMonitor, GrazingAVertexIsAZeroLengthViolation) {
   EXPECT_EQ(ev[0].kind, Kind::kEnter);
   EXPECT_EQ(ev[3].kind, Kind::kExit);
   // Passing 1 mm outside the vertex is clear.
-  EXPECT_TRUE(fly(squareMission(), {{0.0, Vec3(5.001, 15, 10)}, {10.0, Vec3(15.001, 5, 10)}})
-                  .empty());
+  EXPECT_TRUE(
+      fly(squareMission(), {{0.0, Vec3(5.001, 15, 10)}, {10.0, Vec3(15.001, 5, 10)}}).empty());
 }
 
 TEST(ConstraintMonitor, SamplesInsideMergeIntoOneViolationAndOngoingIsReported) {
@@ -257,7 +258,7 @@ TEST(ConstraintMonitor, AreaOfInterestTimesAndEntries) {
   const auto s = mon.areas();
   ASSERT_EQ(s.size(), 1u);
   EXPECT_EQ(s[0].id, "aoi_x");
-  EXPECT_NEAR(s[0].time_inside, 20.0, 1e-12);        // [5, 15] and [25, 35]
+  EXPECT_NEAR(s[0].time_inside, 20.0, 1e-12);         // [5, 15] and [25, 35]
   EXPECT_NEAR(s[0].time_inside_active, 18.0, 1e-12);  // [7, 15] and [25, 35]
   EXPECT_EQ(s[0].entries, 2);
   EXPECT_FALSE(s[0].inside);
@@ -327,7 +328,8 @@ TEST(ConstraintMonitor, IntervalsAgreeWithDenseSampling) {
         const Vec3 p = a + (c - a) * ((tt - ta) / (tb - ta));
         bool truth = false;
         for (const auto& k : m.kozs) {
-          const bool band = (!k.alt_min || p.z() >= *k.alt_min) && (!k.alt_max || p.z() <= *k.alt_max);
+          const bool band =
+              (!k.alt_min || p.z() >= *k.alt_min) && (!k.alt_max || p.z() <= *k.alt_max);
           if (band && k.window.active(tt) && k.polygon.contains(p.head<2>())) truth = true;
         }
         bool reported = false, near_end = false;

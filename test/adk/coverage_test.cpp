@@ -158,7 +158,8 @@ TEST(CoverageGrid, ShippedMissionFromADownCameraSweep) {
   // Across aoi_2 (open from 130 s) at 50 m: a swath of about 60 m.
   int added = 0;
   for (double x = -300; x <= 10; x += 5) {
-    added += g.addFootprint(groundFootprint(k, opticalPose(basePose(Vec3(x, -80, 50), 0), cam)), 150);
+    added +=
+        g.addFootprint(groundFootprint(k, opticalPose(basePose(Vec3(x, -80, 50), 0), cam)), 150);
   }
   const auto c = g.coverage();
   EXPECT_EQ(c[0].covered, 0);  // aoi_1's window (48..192) is active, but the sweep is elsewhere

@@ -110,7 +110,8 @@ TEST(DetectionScorer, RejectsAMissionWhoseTargetIsNotInTheSimConfig) {
 TEST(GroundTruthHistory, InterpolatesBetweenSnapshotsAndHoldsOutside) {
   GroundTruthHistory h(5.0);
   EXPECT_TRUE(h.at(1.0).empty());
-  h.add(1.0, {{"a", "car", "traffic", Vec3(0, 0, 0), 3.0}, {"b", "car", "traffic", Vec3(9, 9, 0), 0}});
+  h.add(1.0,
+        {{"a", "car", "traffic", Vec3(0, 0, 0), 3.0}, {"b", "car", "traffic", Vec3(9, 9, 0), 0}});
   h.add(2.0, {{"a", "car", "traffic", Vec3(10, 0, 0), -3.0}});
   auto at = h.at(1.25);
   ASSERT_EQ(at.size(), 2u);

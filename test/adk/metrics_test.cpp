@@ -76,8 +76,8 @@ TEST(MetricsAccumulator, DetectionsSightingsAndTheFindObjective) {
   acc.addSighting("car_721", 15.0, 0.1);  // not a target: no in-view time
   ConstraintMonitor mon(shippedMission());
   CoverageGrid cov(shippedMission());
-  const MissionMetrics m = acc.finish(Outcome::kSuccess, "all targets found", 1.0, 21.0, 472,
-                                      "end_to_end", mon, cov);
+  const MissionMetrics m =
+      acc.finish(Outcome::kSuccess, "all targets found", 1.0, 21.0, 472, "end_to_end", mon, cov);
   ASSERT_EQ(m.targets.size(), 1u);
   EXPECT_TRUE(m.targets[0].found);
   EXPECT_EQ(*m.targets[0].first_correct_time, 18.0);
@@ -127,8 +127,8 @@ TEST(MetricsJson, StableFieldOrderNullsAndAtomicWrite) {
   EXPECT_EQ(keys, (std::vector<std::string>{
                       "schema", "schema_version", "scenario_id", "class", "objective_type", "mode",
                       "outcome", "reason", "start_time", "end_time", "time_limit", "targets",
-                      "time_to_first_correct_detection", "time_to_all_targets_found",
-                      "detections", "keep_out_zones", "flight", "coverage"}));
+                      "time_to_first_correct_detection", "time_to_all_targets_found", "detections",
+                      "keep_out_zones", "flight", "coverage"}));
   EXPECT_EQ(j["outcome"], "timeout");
   EXPECT_TRUE(j["time_to_first_correct_detection"].is_null());
   EXPECT_TRUE(j["targets"][0]["first_seen_time"].is_null());
@@ -155,8 +155,8 @@ TEST(MetricsJson, StableFieldOrderNullsAndAtomicWrite) {
 TEST(MissionLifecycle, Transitions) {
   MissionLifecycle l(10.0);
   EXPECT_EQ(l.state(), MissionState::kWaiting);
-  EXPECT_FALSE(l.update(0.0, true));    // sim time 0 is not a start
-  EXPECT_FALSE(l.update(1.0, false));   // no odometry yet
+  EXPECT_FALSE(l.update(0.0, true));   // sim time 0 is not a start
+  EXPECT_FALSE(l.update(1.0, false));  // no odometry yet
   EXPECT_TRUE(l.update(1.5, true));
   EXPECT_EQ(l.state(), MissionState::kRunning);
   EXPECT_EQ(l.startTime(), 1.5);

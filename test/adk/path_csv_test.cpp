@@ -29,7 +29,8 @@ TEST(PathCsv, ParsesSamplesPaddingCrlfAndIgnoresExtraColumns) {
 }
 
 TEST(PathCsv, RoundTripsExactly) {
-  std::vector<PathSample> path = {{0.1, {1.0 / 3.0, -2e-7, 45.25}}, {0.30000000000000004, {1, 2, 3}}};
+  std::vector<PathSample> path = {{0.1, {1.0 / 3.0, -2e-7, 45.25}},
+                                  {0.30000000000000004, {1, 2, 3}}};
   const auto back = parsePathCsv(pathCsv(path), "x");
   ASSERT_EQ(back.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {

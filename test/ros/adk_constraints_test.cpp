@@ -103,8 +103,7 @@ TEST(AdkConstraints, ActiveZoneReportedExactlyInactiveNotAndCheckPathAgrees) {
   }
   const double t_end = samples.back().t;
   ASSERT_TRUE(hameritt::testing::spinUntil(
-      [&] { return !status.all.empty() && status.last().header.stamp.toSec() >= t_end - 0.1; },
-      30))
+      [&] { return !status.all.empty() && status.last().header.stamp.toSec() >= t_end - 0.1; }, 30))
       << "constraint status did not reach the end of the flight";
   ASSERT_TRUE(hameritt::testing::spinUntil(
       [&] { return !state.all.empty() && state.last().state == "running"; }, 10));
@@ -151,7 +150,8 @@ TEST(AdkConstraints, ActiveZoneReportedExactlyInactiveNotAndCheckPathAgrees) {
       EXPECT_NEAR(e.header.stamp.toSec(), 60.0, 1e-6);
     }
   }
-  EXPECT_EQ(koz1, (std::vector<std::string>{"enter+", "violation_start+", "violation_end+", "exit-"}));
+  EXPECT_EQ(koz1,
+            (std::vector<std::string>{"enter+", "violation_start+", "violation_end+", "exit-"}));
   // koz_2 twice: the descent cuts its corner below 36 m, then the northbound leg crosses it.
   EXPECT_EQ(koz2, (std::vector<std::string>{"enter-", "exit-", "enter-", "exit-"}));
 

@@ -98,7 +98,7 @@ TEST(AdkLifecycle, TimeoutCrashAndAbort) {
       c.speed = 5.0;
       crash_pub.publish(c);
     }
-    if (k == 150) {  // 3.0 s
+    if (k == 150) {                          // 3.0 s
       spinUntil([] { return false; }, 0.2);  // let the abort node take 3.0 s
       ASSERT_EQ(::kill(abort_pid, SIGINT), 0);
     }
@@ -142,7 +142,8 @@ TEST(AdkLifecycle, TimeoutCrashAndAbort) {
       << "/timeout/adk still running";
 
   // Crash.
-  ASSERT_TRUE(spinUntil([&] { return !crash_state.all.empty() && crash_state.last().state == "crashed"; }, 10));
+  ASSERT_TRUE(spinUntil(
+      [&] { return !crash_state.all.empty() && crash_state.last().state == "crashed"; }, 10));
   const auto cm = readMetrics("crash");
   EXPECT_EQ(cm["outcome"], "crashed");
   EXPECT_NE(cm["reason"].get<std::string>().find("house_12"), std::string::npos);

@@ -13,8 +13,8 @@
 #include "hameritt/Mission.h"
 #include "hameritt/MissionState.h"
 #include "hameritt/ros/adk_conversions.h"
-#include "hameritt/scenario/generator.h"
 #include "hameritt/scenario/error.h"
+#include "hameritt/scenario/generator.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/scenario_io.h"
 
@@ -197,8 +197,10 @@ TEST(AdkMission, MissionTopicMatchesTheJson) {
 // conversion on generated route-search and pursuit missions.
 TEST(AdkMission, ConversionOfRouteSearchAndPursuitMissions) {
   namespace sc = hameritt::scenario;
-  const sc::World world = sc::generateWorld(sc::loadWorldParams(sc::defaultConfigDir() + "/world.json"));
-  const sc::GeneratorConfig config = sc::loadGeneratorConfig(sc::defaultConfigDir() + "/generator.json");
+  const sc::World world =
+      sc::generateWorld(sc::loadWorldParams(sc::defaultConfigDir() + "/world.json"));
+  const sc::GeneratorConfig config =
+      sc::loadGeneratorConfig(sc::defaultConfigDir() + "/generator.json");
   bool routes = false, eventually = false;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     for (sc::ScenarioClass cls : {sc::ScenarioClass::kRouteSearch, sc::ScenarioClass::kPursuit}) {
@@ -210,8 +212,8 @@ TEST(AdkMission, ConversionOfRouteSearchAndPursuitMissions) {
       }
       const std::string text = sc::missionJson(s.mission);
       const ordered_json j = ordered_json::parse(text);
-      const hameritt::Mission m = hameritt::ros_wrappers::toMsg(
-          sc::missionFromJson(j, "generated"), ros::Time(0));
+      const hameritt::Mission m =
+          hameritt::ros_wrappers::toMsg(sc::missionFromJson(j, "generated"), ros::Time(0));
       expectMissionMatches(j, m);
       routes = routes || !m.routes.empty();
       for (const auto& r : m.relations) eventually = eventually || r.eventually;
@@ -254,10 +256,13 @@ TEST(AdkMission, MarkersCoverTheMissionAndNoTargetPositionAppears) {
       EXPECT_GT(std::hypot(p.x - x, p.y - y), 1.0) << what << " at a target position";
     }
   };
-  for (const auto& a : m.areas_of_interest) for (const auto& p : a.polygon) far(p, "AOI");
-  for (const auto& k : m.keep_out_zones) for (const auto& p : k.polygon) far(p, "KOZ");
+  for (const auto& a : m.areas_of_interest)
+    for (const auto& p : a.polygon) far(p, "AOI");
+  for (const auto& k : m.keep_out_zones)
+    for (const auto& p : k.polygon) far(p, "KOZ");
   for (const auto& pr : m.area_priors) {
-    for (const auto& c : pr.cells) for (const auto& p : c.polygon) far(p, "prior cell");
+    for (const auto& c : pr.cells)
+      for (const auto& p : c.polygon) far(p, "prior cell");
   }
   for (const auto& r : m.routes) {
     for (const auto& p : r.polyline) far(p, "route");

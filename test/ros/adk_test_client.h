@@ -32,7 +32,8 @@ template <class M>
 class Collector {
  public:
   Collector(ros::NodeHandle& nh, const std::string& topic, int queue = 1000) {
-    sub_ = nh.subscribe<M>(topic, queue, [this](const typename M::ConstPtr& m) { all.push_back(*m); });
+    sub_ =
+        nh.subscribe<M>(topic, queue, [this](const typename M::ConstPtr& m) { all.push_back(*m); });
   }
   bool connected() const { return sub_.getNumPublishers() > 0; }
   bool waitFor(std::size_t n, double seconds) {

@@ -20,8 +20,8 @@ namespace hameritt::adk {
 // region (boundary counts as inside; a segment that only touches a vertex gives a zero-length
 // interval). Exact up to rounding: the breakpoints are the segment's intersections with the
 // polygon's edges, and every piece between two breakpoints is classified by its midpoint.
-std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon, const geometry::Vec2& a,
-                                           const geometry::Vec2& b);
+std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon,
+                                           const geometry::Vec2& a, const geometry::Vec2& b);
 
 // Time intervals within [ta, tb] during which the path from a (at ta) to b (at tb), linear in
 // time, is inside the keep-out zone's prism (polygon x altitude band; a missing bound is open;
@@ -30,9 +30,8 @@ std::vector<Interval> prismIntervals(const scenario::KeepOutZone& zone, const ge
                                      const geometry::Vec3& b, double ta, double tb);
 
 // The same intersected with the zone's time window: when the path violates the zone.
-std::vector<Interval> violationIntervals(const scenario::KeepOutZone& zone,
-                                         const geometry::Vec3& a, const geometry::Vec3& b,
-                                         double ta, double tb);
+std::vector<Interval> violationIntervals(const scenario::KeepOutZone& zone, const geometry::Vec3& a,
+                                         const geometry::Vec3& b, double ta, double tb);
 
 // One time interval during which the UAV was inside an active keep-out zone. Intervals of the
 // same zone that touch (across samples, or where a window opens as the UAV enters) are merged.
@@ -72,10 +71,10 @@ struct ZoneStatus {
 struct AoiStatus {
   std::string id;
   bool inside = false;
-  bool active = false;               // its window is active now
-  double time_inside = 0.0;          // total
-  double time_inside_active = 0.0;   // while its window was active
-  int entries = 0;                   // times the UAV entered (the first sample inside counts)
+  bool active = false;              // its window is active now
+  double time_inside = 0.0;         // total
+  double time_inside_active = 0.0;  // while its window was active
+  int entries = 0;                  // times the UAV entered (the first sample inside counts)
 };
 
 // Feeds timed positions and keeps violations, events and area times up to the latest sample.

@@ -47,10 +47,10 @@ geometry::Polygon groundFootprint(const CameraIntrinsics& intrinsics,
 // Coverage of one area of interest.
 struct AoiCoverage {
   std::string aoi_id;
-  int cells = 0;             // grid cells whose centre lies in the area
-  int covered = 0;           // of those, seen while the area's window was active
-  double fraction = 0.0;     // covered / cells
-  bool has_prior = false;    // the mission gives this area a prior
+  int cells = 0;                // grid cells whose centre lies in the area
+  int covered = 0;              // of those, seen while the area's window was active
+  double fraction = 0.0;        // covered / cells
+  bool has_prior = false;       // the mission gives this area a prior
   double prior_weighted = 0.0;  // sum over prior cells of probability x covered fraction
 };
 

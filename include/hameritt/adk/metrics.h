@@ -28,16 +28,16 @@ namespace hameritt::adk {
 // Defaults: the Sentinel-class quadrotor of models/sentinel.urdf (1.04 kg, four 5-inch props
 // of radius 0.0635 m): about 154 W hovering.
 struct EnergyModel {
-  double mass = 1.04;             // kg
-  double gravity = 9.81;          // m/s^2
-  double air_density = 1.225;     // kg/m^3 (ISA sea level)
+  double mass = 1.04;          // kg
+  double gravity = 9.81;       // m/s^2
+  double air_density = 1.225;  // kg/m^3 (ISA sea level)
   int rotors = 4;
-  double rotor_radius = 0.0635;   // m
-  double figure_of_merit = 0.6;   // induced / total rotor power
-  double drag_area = 0.02;        // Cd x frontal area, m^2
+  double rotor_radius = 0.0635;  // m
+  double figure_of_merit = 0.6;  // induced / total rotor power
+  double drag_area = 0.02;       // Cd x frontal area, m^2
   double max_thrust_to_weight = 3.0;
-  double airborne_altitude = 0.3; // m above ground: above it the UAV is flying
-  double moving_speed = 0.2;      // m/s: faster than this it is flying, whatever its height
+  double airborne_altitude = 0.3;  // m above ground: above it the UAV is flying
+  double moving_speed = 0.2;       // m/s: faster than this it is flying, whatever its height
 
   // Throws scenario::ConfigError naming "energy.<field>" and the bad value.
   void validate() const;
@@ -66,18 +66,18 @@ struct ObjectiveSettings {
 
 struct TargetMetrics {
   std::string id;
-  bool found = false;                         // by the rule of ObjectiveSettings
-  std::optional<double> first_correct_time;   // stamp of the first correct detection claim
-  std::optional<double> first_seen_time;      // stamp of the first perfect-perception sighting
-  double in_view_time = 0.0;                  // seconds in some camera's view
+  bool found = false;                        // by the rule of ObjectiveSettings
+  std::optional<double> first_correct_time;  // stamp of the first correct detection claim
+  std::optional<double> first_seen_time;     // stamp of the first perfect-perception sighting
+  double in_view_time = 0.0;                 // seconds in some camera's view
 };
 
 struct DetectionCounts {
   int total = 0;
-  int correct = 0;                // verdict target (repeats included)
-  int false_on_confusers = 0;     // verdict confuser
+  int correct = 0;                  // verdict target (repeats included)
+  int false_on_confusers = 0;       // verdict confuser
   int false_on_other_entities = 0;  // verdict other
-  int false_on_nothing = 0;       // verdict none
+  int false_on_nothing = 0;         // verdict none
 };
 
 struct FlightMetrics {

@@ -5,6 +5,7 @@
 // detection claims, and judges the mission's lifecycle and metrics (metrics.json). The logic is
 // the ROS-free hameritt_adk library; this class wires topics to it. See README "ADK".
 
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 
@@ -23,7 +24,6 @@
 #include "hameritt/adk/metrics.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
-#include <nav_msgs/Odometry.h>
 
 namespace hameritt::ros_wrappers {
 
