@@ -18,6 +18,7 @@ HAMERITT_PACKAGES=(
   rosbash python3-roslaunch python3-rostest python3-rosbag ros-environment
   libgtest-dev googletest
   libnav-msgs-dev libsensor-msgs-dev libros-rosgraph-msgs-dev libtf2-dev libtf2-ros-dev
+  libvisualization-msgs-dev
   libeigen3-dev nlohmann-json3-dev libopencv-dev
   libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev libompl-dev
   python3-jsonschema python3-rospy python3-nav-msgs python3-rosgraph-msgs

@@ -1,0 +1,112 @@
+#pragma once
+// The ADK node: the ROS API that client algorithms touch. It publishes the mission (never the
+// targets' positions), monitors the flown path against the keep-out zones and areas of
+// interest, gives perfect perception from the renderer's boxes in maneuver-only runs, scores
+// detection claims, and judges the mission's lifecycle and metrics (metrics.json). The logic is
+// the ROS-free hameritt_adk library; this class wires topics to it. See README "ADK".
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hameritt/BoundingBoxArray.h"
+#include "hameritt/CrashEvent.h"
+#include "hameritt/Detection.h"
+#include "hameritt/EntityStateArray.h"
+#include "hameritt/adk/constraint_monitor.h"
+#include "hameritt/adk/coverage.h"
+#include "hameritt/adk/detection_scoring.h"
+#include "hameritt/adk/metrics.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::ros_wrappers {
+
+// Parameters (private namespace):
+//   ~mission, ~sim_config (paths, required), ~output_dir ("" = no metrics.json),
+//   ~mode (maneuver_only | perception_only | end_to_end; maneuver_only),
+//   ~perfect_perception (default: mode == maneuver_only), ~min_visible_pixels (20),
+//   ~status_rate_hz (10, sim time), ~shutdown_on_end (true), ~end_linger (1.0 wall s),
+//   ~time_limit (mission.time_limit), ~car_gate (6), ~pedestrian_gate (3),
+//   ~found_by_sighting (default: mode == maneuver_only), ~track_fraction (0.5),
+//   ~coverage_cell_size (2), ~coverage_max_range (150).
+// Topics are relative to the node's namespace (/mission, /adk/... in the root namespace).
+class AdkRos {
+ public:
+  // Throws scenario::ConfigError (bad parameters, mission or sim_config): the node exits 1.
+  AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+  // Serves callbacks until the mission has ended and (shutdown_on_end) its metrics have been
+  // published for ~end_linger wall seconds, or until ROS shuts down or a signal arrives
+  // (outcome aborted if the mission had not ended). Metrics are written either way. Returns the
+  // process exit code (0; 1 if metrics.json could not be written).
+  int spin();
+
+  // Called by the node's SIGINT/SIGTERM handler (async-signal-safe: sets a flag).
+  static void requestStop();
+
+ private:
+  void onClock(const rosgraph_msgs::Clock::ConstPtr& msg);
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  void onTruth(const hameritt::EntityStateArray::ConstPtr& msg);
+  void onCrash(const hameritt::CrashEvent::ConstPtr& msg);
+  void onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg);
+  void onDetection(const hameritt::Detection::ConstPtr& msg);
+  void onStateTimer(const ros::WallTimerEvent&);
+
+  // Scenario entities at time t (ground truth history when there is one, else their
+  // sim_config trajectories) and parked world cars.
+  std::vector<adk::EntityTruth> truthAt(double t) const;
+  void publishState();
+  void publishConstraints(double t);
+  void checkObjective(double t);
+  // Ends the mission (lifecycle already ended): metrics.json, /adk/metrics, /adk/state.
+  void finish();
+
+  // Configuration.
+  scenario::Mission mission_;
+  scenario::SimConfig sim_config_;
+  std::unique_ptr<scenario::World> world_;
+  std::string mode_, output_dir_;
+  bool perfect_perception_ = false;
+  int min_visible_pixels_ = 20;
+  double status_period_ = 0.1;
+  bool shutdown_on_end_ = true;
+  double end_linger_ = 1.0;
+  double coverage_max_range_ = 150.0;
+  std::vector<adk::CameraIntrinsics> intrinsics_;
+  std::map<std::string, std::size_t> scenario_index_;  // scenario entity id -> sim_config index
+  std::vector<adk::EntityTruth> world_cars_;
+  std::map<std::string, std::size_t> world_car_index_;
+
+  // Core objects.
+  std::unique_ptr<adk::ConstraintMonitor> monitor_;
+  std::unique_ptr<adk::CoverageGrid> coverage_;
+  std::unique_ptr<adk::DetectionScorer> scorer_;
+  std::unique_ptr<adk::MetricsAccumulator> metrics_;
+  std::unique_ptr<adk::MissionLifecycle> lifecycle_;
+  adk::GroundTruthHistory truth_{10.0};
+
+  // Run state.
+  bool have_odom_ = false;
+  double last_odom_t_ = 0.0;
+  double now_ = 0.0;  // latest sim time seen (clock or odometry)
+  double next_status_t_ = 0.0;
+  std::vector<double> next_footprint_t_;
+  bool finished_ = false;
+  bool write_failed_ = false;
+  ros::WallTime finished_at_;
+
+  ros::Publisher mission_pub_, markers_pub_, constraints_pub_, events_pub_, perception_pub_,
+      scores_pub_, state_pub_, metrics_pub_;
+  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_;
+  std::vector<ros::Subscriber> box_subs_;
+  ros::WallTimer state_timer_;
+};
+
+}  // namespace hameritt::ros_wrappers

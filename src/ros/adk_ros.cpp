@@ -1,0 +1,409 @@
+#include "hameritt/ros/adk_ros.h"
+
+#include <ros/callback_queue.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+
+#include "hameritt/ConstraintEvent.h"
+#include "hameritt/ConstraintStatus.h"
+#include "hameritt/DetectionScore.h"
+#include "hameritt/Mission.h"
+#include "hameritt/MissionMetrics.h"
+#include "hameritt/MissionState.h"
+#include "hameritt/PerceptionReport.h"
+#include "hameritt/ros/adk_conversions.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/mission_io.h"
+#include "hameritt/scenario/sim_config_io.h"
+
+namespace hameritt::ros_wrappers {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+using scenario::ConfigError;
+
+ros::Time stampOf(double t) {
+  ros::Time s;
+  s.fromSec(std::max(0.0, t));
+  return s;
+}
+
+}  // namespace
+
+void AdkRos::requestStop() { g_stop = true; }
+
+AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string mission_path, sim_config_path;
+  if (!pnh.getParam("mission", mission_path) || mission_path.empty()) {
+    throw ConfigError("~mission: required parameter (path of a mission.json)");
+  }
+  if (!pnh.getParam("sim_config", sim_config_path) || sim_config_path.empty()) {
+    throw ConfigError("~sim_config: required parameter (path of a sim_config.json)");
+  }
+  pnh.param<std::string>("output_dir", output_dir_, "");
+  pnh.param<std::string>("mode", mode_, "maneuver_only");
+  if (mode_ != "maneuver_only" && mode_ != "perception_only" && mode_ != "end_to_end") {
+    throw ConfigError("~mode: expected maneuver_only, perception_only or end_to_end, got '" +
+                      mode_ + "'");
+  }
+  pnh.param("perfect_perception", perfect_perception_, mode_ == "maneuver_only");
+  pnh.param("min_visible_pixels", min_visible_pixels_, 20);
+  if (min_visible_pixels_ < 1) {
+    throw ConfigError("~min_visible_pixels: expected an integer >= 1, got " +
+                      std::to_string(min_visible_pixels_));
+  }
+  double status_rate = 10.0;
+  pnh.param("status_rate_hz", status_rate, status_rate);
+  if (!(status_rate > 0.0 && status_rate <= 1000.0)) {
+    throw ConfigError("~status_rate_hz: expected a rate in (0, 1000], got " +
+                      scenario::formatNumber(status_rate));
+  }
+  status_period_ = 1.0 / status_rate;
+  pnh.param("shutdown_on_end", shutdown_on_end_, true);
+  pnh.param("end_linger", end_linger_, 1.0);
+  if (!(end_linger_ >= 0.0 && end_linger_ <= 60.0)) {
+    throw ConfigError("~end_linger: expected wall seconds in [0, 60], got " +
+                      scenario::formatNumber(end_linger_));
+  }
+  adk::ScoringSettings scoring;
+  pnh.param("car_gate", scoring.car_gate, scoring.car_gate);
+  pnh.param("pedestrian_gate", scoring.pedestrian_gate, scoring.pedestrian_gate);
+  adk::ObjectiveSettings objective;
+  pnh.param("found_by_sighting", objective.found_by_sighting, mode_ == "maneuver_only");
+  pnh.param("track_fraction", objective.track_fraction, objective.track_fraction);
+  double cell = 2.0;
+  pnh.param("coverage_cell_size", cell, cell);
+  if (!(cell >= 0.25 && cell <= 100.0)) {
+    throw ConfigError("~coverage_cell_size: expected metres in [0.25, 100], got " +
+                      scenario::formatNumber(cell));
+  }
+  pnh.param("coverage_max_range", coverage_max_range_, coverage_max_range_);
+  if (!(coverage_max_range_ > 0.0 && coverage_max_range_ <= 5000.0)) {
+    throw ConfigError("~coverage_max_range: expected metres in (0, 5000], got " +
+                      scenario::formatNumber(coverage_max_range_));
+  }
+
+  mission_ = scenario::loadMission(mission_path);
+  sim_config_ = scenario::loadSimConfig(sim_config_path);
+  if (sim_config_.scenario_id != mission_.scenario_id) {
+    throw ConfigError(sim_config_path + ": scenario_id: expected '" + mission_.scenario_id +
+                      "' (the mission's, " + mission_path + "), got '" + sim_config_.scenario_id +
+                      "'");
+  }
+  double time_limit = mission_.time_limit;
+  pnh.param("time_limit", time_limit, time_limit);
+  if (!(time_limit > 0.0 && std::isfinite(time_limit))) {
+    throw ConfigError("~time_limit: expected seconds > 0, got " +
+                      scenario::formatNumber(time_limit));
+  }
+  world_ = std::make_unique<scenario::World>(
+      scenario::generateCheckedWorld(sim_config_, sim_config_path));
+  for (std::size_t i = 0; i < sim_config_.entities.size(); ++i) {
+    scenario_index_[sim_config_.entities[i].entity.id] = i;
+  }
+  for (const auto& e : world_->entities()) {
+    if (e.cls != scenario::EntityClass::kCar) continue;
+    world_car_index_[e.id] = world_cars_.size();
+    world_cars_.push_back({e.id, "car", "world", e.position(), e.yaw()});
+  }
+  for (const auto& c : sim_config_.uav.cameras) {
+    intrinsics_.push_back(adk::intrinsicsFromHfov(c.width, c.height, c.hfov_deg));
+  }
+  next_footprint_t_.assign(sim_config_.uav.cameras.size(), 0.0);
+
+  monitor_ = std::make_unique<adk::ConstraintMonitor>(mission_);
+  coverage_ = std::make_unique<adk::CoverageGrid>(mission_, cell);
+  scorer_ = std::make_unique<adk::DetectionScorer>(mission_, sim_config_.entities, scoring);
+  metrics_ = std::make_unique<adk::MetricsAccumulator>(mission_, objective);
+  lifecycle_ = std::make_unique<adk::MissionLifecycle>(time_limit);
+
+  mission_pub_ = nh.advertise<hameritt::Mission>("mission", 1, true);
+  markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("mission/markers", 1, true);
+  constraints_pub_ = nh.advertise<hameritt::ConstraintStatus>("adk/constraints", 10);
+  events_pub_ = nh.advertise<hameritt::ConstraintEvent>("adk/constraint_events", 100);
+  perception_pub_ = nh.advertise<hameritt::PerceptionReport>("adk/perfect_perception", 20);
+  scores_pub_ = nh.advertise<hameritt::DetectionScore>("adk/detection_scores", 100);
+  state_pub_ = nh.advertise<hameritt::MissionState>("adk/state", 10, true);
+  metrics_pub_ = nh.advertise<hameritt::MissionMetrics>("adk/metrics", 1, true);
+
+  clock_sub_ = nh.subscribe("/clock", 10, &AdkRos::onClock, this);
+  odom_sub_ = nh.subscribe("uav/odom", 1000, &AdkRos::onOdometry, this);
+  truth_sub_ = nh.subscribe("ground_truth/entities", 100, &AdkRos::onTruth, this);
+  crash_sub_ = nh.subscribe("uav/crash", 10, &AdkRos::onCrash, this);
+  detection_sub_ = nh.subscribe("perception/detections", 100, &AdkRos::onDetection, this);
+  for (std::size_t i = 0; i < sim_config_.uav.cameras.size(); ++i) {
+    const std::string topic = "uav/camera/" + sim_config_.uav.cameras[i].name + "/boxes";
+    box_subs_.push_back(nh.subscribe<hameritt::BoundingBoxArray>(
+        topic, 20, [this, i](const hameritt::BoundingBoxArray::ConstPtr& m) { onBoxes(i, m); }));
+  }
+  state_timer_ = nh.createWallTimer(ros::WallDuration(1.0), &AdkRos::onStateTimer, this);
+
+  const ros::Time stamp = stampOf(0.0);
+  mission_pub_.publish(toMsg(mission_, stamp));
+  markers_pub_.publish(missionMarkers(mission_, sim_config_.uav.altitude_max + 20.0, stamp));
+  publishState();
+  ROS_INFO(
+      "adk: %s (%s), mode %s, perfect perception %s, time limit %.1f s, %zu cameras, "
+      "metrics to %s",
+      mission_.scenario_id.c_str(), mission_.objective.type.c_str(), mode_.c_str(),
+      perfect_perception_ ? "on" : "off", time_limit, intrinsics_.size(),
+      output_dir_.empty() ? "(not written)" : (output_dir_ + "/metrics.json").c_str());
+}
+
+std::vector<adk::EntityTruth> AdkRos::truthAt(double t) const {
+  std::vector<adk::EntityTruth> out;
+  if (!truth_.empty()) {
+    out = truth_.at(t);
+  } else {
+    for (const auto& e : sim_config_.entities) out.push_back(adk::scenarioEntityAt(e, t));
+  }
+  out.insert(out.end(), world_cars_.begin(), world_cars_.end());
+  return out;
+}
+
+void AdkRos::publishState() {
+  hameritt::MissionState s;
+  s.header.stamp = stampOf(now_);
+  s.state = adk::toString(lifecycle_->state());
+  s.mode = mode_;
+  s.elapsed = lifecycle_->ended() ? lifecycle_->endTime() : now_;
+  s.time_limit = lifecycle_->timeLimit();
+  s.reason = lifecycle_->reason();
+  state_pub_.publish(s);
+}
+
+void AdkRos::publishConstraints(double t) {
+  constraints_pub_.publish(toMsg(*monitor_, stampOf(t)));
+}
+
+void AdkRos::onStateTimer(const ros::WallTimerEvent&) { publishState(); }
+
+void AdkRos::onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
+  if (finished_) return;
+  const double t = msg->clock.toSec();
+  now_ = std::max(now_, t);
+  // While odometry flows, it drives the start and the time limit, so that the metrics include
+  // the sample at the limit (the simulator publishes the clock before the odometry of a step);
+  // the clock alone decides without odometry or when it has stalled for a second.
+  if (have_odom_ && t - last_odom_t_ <= 1.0) return;
+  if (lifecycle_->update(t, have_odom_)) {
+    publishState();
+    if (lifecycle_->ended()) finish();
+  }
+}
+
+void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  if (finished_) return;
+  const double t = msg->header.stamp.toSec();
+  if (have_odom_ && !(t > last_odom_t_)) {
+    // The simulator publishes the state twice at a step it was asked for; a time going back is
+    // a reset, which a mission run does not do.
+    if (t < last_odom_t_) {
+      ROS_WARN_THROTTLE(5.0,
+                        "adk: odometry at t = %.6f s is older than the last (%.6f s); "
+                        "ignored (was the simulator reset?)",
+                        t, last_odom_t_);
+    }
+    return;
+  }
+  const Eigen::Isometry3d pose = poseOf(*msg);
+  const Eigen::Vector3d p = pose.translation();
+  const Eigen::Vector3d v = worldVelocityOf(*msg);
+  try {
+    for (const auto& e : monitor_->add(t, p)) events_pub_.publish(toMsg(e));
+    metrics_->addState(t, p, v);
+  } catch (const adk::InputError& e) {
+    ROS_WARN_THROTTLE(5.0, "adk: odometry ignored: %s", e.what());
+    return;
+  }
+  have_odom_ = true;
+  last_odom_t_ = t;
+  now_ = std::max(now_, t);
+  for (std::size_t c = 0; c < intrinsics_.size(); ++c) {
+    if (t < next_footprint_t_[c]) continue;
+    const auto& cam = sim_config_.uav.cameras[c];
+    coverage_->addFootprint(
+        adk::groundFootprint(intrinsics_[c], adk::opticalPose(pose, cam), coverage_max_range_), t);
+    next_footprint_t_[c] = t + 1.0 / cam.rate_hz;
+  }
+  if (t >= next_status_t_) {
+    publishConstraints(t);
+    next_status_t_ = t + status_period_;
+  }
+  if (lifecycle_->update(t, true)) {
+    publishState();
+    if (lifecycle_->ended()) finish();
+  }
+  // A target found before the mission started running ends it as soon as it runs.
+  checkObjective(t);
+}
+
+void AdkRos::onTruth(const hameritt::EntityStateArray::ConstPtr& msg) {
+  try {
+    truth_.add(msg->header.stamp.toSec(), fromMsg(*msg));
+  } catch (const adk::InputError& e) {
+    ROS_WARN_THROTTLE(5.0, "adk: ground truth ignored: %s", e.what());
+  }
+}
+
+void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {
+  if (finished_) return;
+  const double t = msg->header.stamp.toSec();
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "crashed into %s at %.2f m/s", msg->entity_id.c_str(),
+                msg->speed);
+  if (lifecycle_->crash(std::max(t, 0.0), buf)) {
+    publishState();
+    finish();
+  }
+}
+
+void AdkRos::checkObjective(double t) {
+  if (lifecycle_->state() != adk::MissionState::kRunning || metrics_->isTrack()) return;
+  if (!metrics_->objectiveMet(t)) return;
+  const std::string how = metrics_->targets().size() == 1 ? "the target" : "every target";
+  if (lifecycle_->succeed(t, how + (mode_ == "maneuver_only" ? " seen" : " correctly detected"))) {
+    publishState();
+    finish();
+  }
+}
+
+void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg) {
+  if (finished_) return;
+  const auto& cam = sim_config_.uav.cameras[camera];
+  const double stamp = msg->header.stamp.toSec();
+  hameritt::PerceptionReport report;
+  report.header = msg->header;
+  report.camera = cam.name;
+  std::vector<adk::EntityTruth> truth;
+  bool have_truth = false;
+  for (const auto& box : msg->boxes) {
+    if (box.visible_pixels < static_cast<std::uint32_t>(min_visible_pixels_)) continue;
+    hameritt::PerceivedEntity pe;
+    pe.entity_id = box.entity_id;
+    pe.box = box;
+    const auto s = scenario_index_.find(box.entity_id);
+    const auto w = world_car_index_.find(box.entity_id);
+    adk::EntityTruth where;
+    if (s != scenario_index_.end()) {
+      if (!have_truth) {
+        truth = truthAt(stamp);
+        have_truth = true;
+      }
+      const auto& se = sim_config_.entities[s->second];
+      where = adk::scenarioEntityAt(se, stamp);
+      for (const auto& e : truth) {
+        if (e.id == box.entity_id) where = e;
+      }
+      pe.entity_class = scenario::toString(se.entity.cls);
+      pe.role = se.role;
+      pe.attributes = toKeyValues(se.entity.attributes);
+    } else if (w != world_car_index_.end()) {
+      where = world_cars_[w->second];
+      const auto& we = world_->entities()[static_cast<std::size_t>(world_->find(box.entity_id))];
+      pe.entity_class = "car";
+      pe.role = "world";
+      pe.attributes = toKeyValues(we.attributes);
+    } else {
+      ROS_WARN_THROTTLE(5.0,
+                        "adk: camera %s: box of '%s', which is neither a scenario entity "
+                        "nor a parked world car; ignored",
+                        cam.name.c_str(), box.entity_id.c_str());
+      continue;
+    }
+    pe.position.x = where.position.x();
+    pe.position.y = where.position.y();
+    pe.position.z = where.position.z();
+    pe.yaw = where.yaw;
+    metrics_->addSighting(box.entity_id, stamp, 1.0 / cam.rate_hz);
+    report.entities.push_back(pe);
+  }
+  if (perfect_perception_) perception_pub_.publish(report);
+  checkObjective(std::max(now_, stamp));
+}
+
+void AdkRos::onDetection(const hameritt::Detection::ConstPtr& msg) {
+  if (finished_) return;
+  const adk::DetectionClaim claim = fromMsg(*msg);
+  adk::DetectionVerdict v;
+  try {
+    v = scorer_->score(claim, truthAt(claim.stamp));
+  } catch (const adk::InputError& e) {
+    ROS_WARN_THROTTLE(5.0, "adk: detection from '%s' ignored: %s", msg->client.c_str(), e.what());
+    return;
+  }
+  metrics_->addVerdict(claim.stamp, v);
+  hameritt::DetectionScore s;
+  s.header.stamp = msg->header.stamp;
+  s.header.frame_id = "map";
+  s.detection = *msg;
+  s.verdict = adk::toString(v.verdict);
+  s.matched_entity_id = v.entity_id;
+  s.matched_role = v.role;
+  s.position_error = v.position_error;
+  s.first_correct = v.first_correct;
+  scores_pub_.publish(s);
+  checkObjective(std::max(now_, claim.stamp));
+}
+
+void AdkRos::finish() {
+  if (finished_) return;
+  finished_ = true;
+  finished_at_ = ros::WallTime::now();
+  const adk::MissionMetrics m = metrics_->finish(
+      adk::outcomeOf(lifecycle_->state()), lifecycle_->reason(), lifecycle_->startTime(),
+      lifecycle_->endTime(), lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+  std::string file;
+  if (!output_dir_.empty()) {
+    try {
+      std::error_code ec;
+      std::filesystem::create_directories(output_dir_, ec);
+      if (ec) {
+        throw scenario::OutputError(output_dir_ + ": cannot create directory: " + ec.message());
+      }
+      file = output_dir_ + "/metrics.json";
+      adk::writeMetricsJson(m, file);
+    } catch (const std::exception& e) {
+      ROS_ERROR("adk: metrics not written: %s", e.what());
+      file.clear();
+      write_failed_ = true;
+    }
+  }
+  const ros::Time stamp = stampOf(lifecycle_->endTime());
+  if (monitor_->sampleCount() > 0) publishConstraints(monitor_->lastTime());
+  metrics_pub_.publish(toMsg(m, file, stamp));
+  publishState();
+  ROS_INFO(
+      "adk: mission %s at t = %.3f s (%s); %zu keep-out violations, path %.1f m, "
+      "energy %.0f J%s%s",
+      adk::toString(m.outcome), m.end_time, m.reason.c_str(), m.violations.size(),
+      m.flight.path_length, m.flight.energy, file.empty() ? "" : "; metrics in ", file.c_str());
+}
+
+int AdkRos::spin() {
+  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+  while (true) {
+    queue->callAvailable(ros::WallDuration(0.02));
+    if (g_stop || !ros::ok()) {
+      if (!finished_) {
+        lifecycle_->abort(now_, g_stop ? "interrupted (SIGINT/SIGTERM) before the end"
+                                       : "ROS shut down before the end");
+        finish();
+      }
+      break;
+    }
+    if (finished_ && shutdown_on_end_ &&
+        (ros::WallTime::now() - finished_at_).toSec() >= end_linger_) {
+      break;
+    }
+  }
+  ros::shutdown();
+  return write_failed_ ? 1 : 0;
+}
+
+}  // namespace hameritt::ros_wrappers
