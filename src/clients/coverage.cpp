@@ -117,10 +117,11 @@ class Planner {
     return false;
   }
 
-  // Waypoints of one pattern flown from `from` at time t0 (arriving at its first waypoint no
-  // earlier than `start_at`): lines cut around keep-out zones, with arrival times.
+  // Waypoints of one pattern flown from `from`, leaving at max(t0, depart): lines cut around
+  // keep-out zones, with arrival times.
   std::vector<SearchWaypoint> sweep(const std::vector<Line>& lines, const Vec2& from, double t0,
-                                    double start_at) const {
+                                    double depart) const {
+    t0 = std::max(t0, depart);
     // Cut each line into its free pieces, timing the unclipped pattern to decide which zones
     // are active where.
     struct Sample {
@@ -135,7 +136,6 @@ class Planner {
       const Line& line = lines[li];
       t += flightTime((line.front() - here).norm() * (li == 0 ? s_.detour_factor : 1.0),
                       s_.max_speed, s_.accel);
-      if (li == 0) t = std::max(t, start_at);
       std::vector<Sample> samples;
       samples.push_back({line.front(), true, !blocked(line.front(), t)});
       for (std::size_t i = 0; i + 1 < line.size(); ++i) {
@@ -180,7 +180,6 @@ class Planner {
         if (!out.empty() && (p - here).norm() < 1e-6) continue;
         t += flightTime((p - here).norm() * (out.empty() ? s_.detour_factor : 1.0), s_.max_speed,
                         s_.accel);
-        if (out.empty()) t = std::max(t, start_at);
         out.push_back({Vec3(p.x(), p.y(), s_.altitude), t});
         here = p;
       }
@@ -279,6 +278,7 @@ void CoverageSettings::validate() const {
   need(koz_time_slack >= 0, "koz_time_slack", "seconds >= 0", koz_time_slack);
   need(sample_step > 0, "sample_step", "metres > 0", sample_step);
   need(min_line >= 0, "min_line", "metres >= 0", min_line);
+  need(window_margin >= 0, "window_margin", "seconds >= 0", window_margin);
   need(max_leg_waypoints >= 2, "max_leg_waypoints", "an integer >= 2", max_leg_waypoints);
 }
 
@@ -407,7 +407,7 @@ SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& 
     if (!best) break;
     const Region& r = *best;
     const double close = best_close;
-    bool staged = false;
+    bool staged = false, waiting = false;
     // Greedy over the region's cells: probability per metre flown.
     for (;;) {
       const Cell* cell = nullptr;
@@ -439,8 +439,8 @@ SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& 
       done.insert(cell->id);
       const double net = r.window.net.value_or(-kInf);
       const Vec2 entry = lines.front().front();
-      if (!staged && t + transit(entry) < net) {
-        // Early: wait just outside the region, near the entry, until the window opens.
+      if (!staged && t + transit(entry) < net + settings.window_margin) {
+        // Early, or nearly: wait just outside the region, near the entry, until it opens.
         Vec2 stage = entry;
         const Vec2 c = r.area.centroid();
         Vec2 out = entry - c;
@@ -462,9 +462,11 @@ SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& 
         plan.legs.push_back(leg);
         pos = stage;
         t = eta;
+        waiting = true;
       }
       staged = true;
-      std::vector<SearchWaypoint> wps = planner.sweep(lines, pos, t, net);
+      // After a stage leg the sweep leaves the stage point when the window opens.
+      std::vector<SearchWaypoint> wps = planner.sweep(lines, pos, t, waiting ? net : -kInf);
       if (wps.empty()) {
         plan.skipped.push_back(cell->id + ": every line lies in a keep-out zone");
         continue;
@@ -486,12 +488,13 @@ SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& 
         leg.region_id = r.id;
         leg.cell_id = cell->id;
         leg.probability = cell->probability;
-        leg.not_before = i == 0 ? std::max(net, 0.0) : 0.0;
+        leg.not_before = i == 0 && waiting ? std::max(net, 0.0) : 0.0;
         leg.waypoints.assign(wps.begin() + static_cast<long>(i),
                              wps.begin() + static_cast<long>(std::min(wps.size(), i + chunk)));
         leg.completes_cell = i + chunk >= wps.size();
         plan.legs.push_back(std::move(leg));
       }
+      waiting = false;
       pos = wps.back().position.head<2>();
       t = wps.back().eta;
       if (t >= close) break;

@@ -45,6 +45,9 @@ struct CoverageSettings {
                                  // [eta - slack, eta + slack]: estimates are not exact
   double sample_step = 1.0;      // m, resolution of the line clipping against zones
   double min_line = 2.0;         // m, shorter free pieces of a line are dropped
+  double window_margin = 10.0;   // s: when the estimated arrival is less than this after a
+                                 // region's window opens, wait outside it (estimates are not
+                                 // exact: the UAV must not enter before the window opens)
   int max_leg_waypoints = 12;    // a cell's pattern is sent in legs of at most this many
   bool cover_zero_cells = false; // also sweep prior cells of probability 0 (last)
   void validate() const;
@@ -76,7 +79,8 @@ struct SearchLeg {
   std::string region_id;  // AOI or route id
   std::string cell_id;    // prior cell id (the region id for regions without priors)
   double probability = 0.0;
-  double not_before = 0.0;  // do not send before this mission time (window opening)
+  double not_before = 0.0;  // do not send before this mission time (the window opening, after a
+                            // stage leg)
   bool completes_cell = true;  // the cell is covered once this leg is done
   std::vector<SearchWaypoint> waypoints;
 };
