@@ -20,7 +20,8 @@ std::string fmt(double v) { return scenario::formatNumber(v); }
 // Union-find over blob indices.
 int root(std::vector<int>& parent, int i) {
   while (parent[static_cast<std::size_t>(i)] != i) {
-    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    parent[static_cast<std::size_t>(i)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
     i = parent[static_cast<std::size_t>(i)];
   }
   return i;
@@ -73,9 +74,10 @@ geometry::OrientedBox boxOfPoints(const std::vector<Vec3>& pts) {
 
 PinholeCamera pinholeFromHfov(int width, int height, double hfov_deg) {
   if (width < 1 || height < 1 || !(hfov_deg > 0 && hfov_deg < 180)) {
-    throw scenario::ConfigError("camera: expected a size >= 1 px and a field of view in (0, 180) "
-                                "degrees, got " + std::to_string(width) + "x" +
-                                std::to_string(height) + ", " + fmt(hfov_deg));
+    throw scenario::ConfigError(
+        "camera: expected a size >= 1 px and a field of view in (0, 180) "
+        "degrees, got " +
+        std::to_string(width) + "x" + std::to_string(height) + ", " + fmt(hfov_deg));
   }
   PinholeCamera c;
   c.width = width;
@@ -92,10 +94,10 @@ Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Vec3&
   Eigen::Isometry3d base_T_link = Eigen::Isometry3d::Identity();
   base_T_link.translation() = mount_xyz;
   // Positive pitch about +y (left) turns the forward axis down (as the planner's look-at code).
-  base_T_link.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) *
-                          Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
-                          Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
-                             .toRotationMatrix();
+  base_T_link.linear() =
+      (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
+       Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
+          .toRotationMatrix();
   // Optical axes in the link frame (x forward, y left, z up): x right = -y, y down = -z,
   // z forward = x.
   Eigen::Isometry3d link_T_optical = Eigen::Isometry3d::Identity();
@@ -106,7 +108,8 @@ Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Vec3&
 void DetectorSettings::validate() const {
   auto need = [](bool ok, const std::string& field, const std::string& what,
                  const std::string& got) {
-    if (!ok) throw scenario::ConfigError("detector." + field + ": expected " + what + ", got " + got);
+    if (!ok)
+      throw scenario::ConfigError("detector." + field + ": expected " + what + ", got " + got);
   };
   need(!colors.empty(), "colors", "at least one colour", "none");
   for (const auto& [name, ranges] : colors) {
@@ -190,10 +193,12 @@ std::vector<CarCandidate> ColorShapeDetector::detect(const cv::Mat& rgb, const c
                                                      const std::string& color,
                                                      const Vec3& expected) const {
   if (depth.type() != CV_32FC1 || depth.size() != rgb.size()) {
-    throw scenario::ConfigError("detector: expected a 32-bit float depth image of the colour "
-                                "image's size");
+    throw scenario::ConfigError(
+        "detector: expected a 32-bit float depth image of the colour "
+        "image's size");
   }
-  if (!(cam.fx > 0 && cam.fy > 0)) throw scenario::ConfigError("detector: camera fx, fy must be > 0");
+  if (!(cam.fx > 0 && cam.fy > 0))
+    throw scenario::ConfigError("detector: camera fx, fy must be > 0");
   const DetectorSettings& s = settings_;
   const cv::Mat colour = colorMask(rgb, color);
 

@@ -186,8 +186,8 @@ ContextVerdict ContextFilter::check(const CandidatePose& c, double t,
   return v;
 }
 
-std::string ContextFilter::checkRelation(const scenario::SceneRelation& rel,
-                                         const CandidatePose& c, bool* skipped) const {
+std::string ContextFilter::checkRelation(const scenario::SceneRelation& rel, const CandidatePose& c,
+                                         bool* skipped) const {
   *skipped = false;
   const std::string name = "[" + rel.related_id + "] [" + scenario::toString(rel.op) + "]";
   if (rel.op == RelationOp::kPartOf) {

@@ -296,8 +296,8 @@ CoverageSettings coverageSettingsFor(const scenario::UavSpec& uav, const std::st
     altitude = std::clamp(heightForPixels(cam, car_width, min_car_pixels), lo, std::max(lo, hi));
   } else if (altitude < uav.altitude_min || altitude > uav.altitude_max) {
     throw scenario::ConfigError("coverage.altitude: expected a height inside the altitude band [" +
-                                fmt(uav.altitude_min) + ", " + fmt(uav.altitude_max) +
-                                "], got " + fmt(altitude));
+                                fmt(uav.altitude_min) + ", " + fmt(uav.altitude_max) + "], got " +
+                                fmt(altitude));
   }
   s.altitude = altitude;
   s.footprint = groundFootprint(cam, altitude);
@@ -383,22 +383,22 @@ SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& 
     double best_start = kInf, best_close = kInf;
     for (const auto& r : regions) {
       if (std::none_of(r.cells.begin(), r.cells.end(), eligible)) continue;
-      const double arrival =
-          t + flightTime(r.area.distance(pos) * settings.detour_factor, settings.max_speed,
-                         settings.accel);
+      const double arrival = t + flightTime(r.area.distance(pos) * settings.detour_factor,
+                                            settings.max_speed, settings.accel);
       const double start = std::max(arrival, r.window.net.value_or(-kInf));
       const double close = std::min(r.window.nlt.value_or(kInf), time_limit);
       if (start > close) {
         for (const auto& c : r.cells) {
           if (eligible(c)) {
-            plan.skipped.push_back(c.id + ": " + r.id + " cannot be reached before " +
-                                   fmt(close) + " s");
+            plan.skipped.push_back(c.id + ": " + r.id + " cannot be reached before " + fmt(close) +
+                                   " s");
             done.insert(c.id);
           }
         }
         continue;
       }
-      if (start < best_start - 1e-9 || (std::abs(start - best_start) <= 1e-9 && close < best_close)) {
+      if (start < best_start - 1e-9 ||
+          (std::abs(start - best_start) <= 1e-9 && close < best_close)) {
         best = &r;
         best_start = start;
         best_close = close;
@@ -417,8 +417,8 @@ SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& 
         if (!eligible(c)) continue;
         for (int v = 0; v < 4; ++v) {
           std::vector<Line> ls = variant(c.lines, v);
-          const double cost = (ls.front().front() - pos).norm() * settings.detour_factor +
-                              patternLength(ls) + 1.0;
+          const double cost =
+              (ls.front().front() - pos).norm() * settings.detour_factor + patternLength(ls) + 1.0;
           // Probability gathered per metre; cells of probability 0 (when swept at all) after
           // every other, nearest first.
           const double score = c.probability > 0 ? c.probability / cost : -cost;

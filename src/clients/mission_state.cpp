@@ -14,7 +14,7 @@ namespace {
 struct Field {
   std::string type;  // base type ("uint8", "string", "std_msgs/Header", "Foo")
   std::string name;
-  int array = -1;    // -1 scalar, 0 variable length, N fixed length
+  int array = -1;  // -1 scalar, 0 variable length, N fixed length
 };
 
 using Definitions = std::map<std::string, std::vector<Field>>;
@@ -115,8 +115,8 @@ class Reader {
     }
     const std::vector<Field>* fields = find(type, package);
     if (!fields) return false;
-    const std::string pkg = type.find('/') != std::string::npos ? type.substr(0, type.find('/'))
-                                                                 : package;
+    const std::string pkg =
+        type.find('/') != std::string::npos ? type.substr(0, type.find('/')) : package;
     for (const auto& f : *fields) {
       if (!skipField(f, pkg, depth + 1)) return false;
     }
@@ -200,9 +200,9 @@ std::optional<MissionStateReading> readMissionState(const std::string& definitio
 
 bool isTerminalState(const std::string& state) {
   static const std::vector<std::string> kWords = {
-      "ended",   "end",     "done",    "finished", "complete", "completed", "succeeded",
-      "success", "failed",  "failure", "aborted",  "timeout",  "timed_out", "time_up",
-      "crashed", "cancelled", "canceled", "over"};
+      "ended",     "end",     "done",    "finished",  "complete", "completed",
+      "succeeded", "success", "failed",  "failure",   "aborted",  "timeout",
+      "timed_out", "time_up", "crashed", "cancelled", "canceled", "over"};
   const std::string s = lower(state);
   // Whole name, or one of its words separated by '_', '-', ' ' or ':'.
   std::vector<std::string> words{s};

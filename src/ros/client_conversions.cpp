@@ -12,7 +12,8 @@ namespace hameritt::ros_wrappers {
 namespace {
 
 void checkSize(const sensor_msgs::Image& msg, int bytes_per_pixel) {
-  if (msg.width == 0 || msg.height == 0 || msg.step < msg.width * static_cast<unsigned>(bytes_per_pixel) ||
+  if (msg.width == 0 || msg.height == 0 ||
+      msg.step < msg.width * static_cast<unsigned>(bytes_per_pixel) ||
       msg.data.size() < static_cast<std::size_t>(msg.step) * msg.height) {
     throw scenario::ConfigError("image: " + std::to_string(msg.width) + "x" +
                                 std::to_string(msg.height) + " " + msg.encoding + ", step " +

@@ -44,16 +44,18 @@ void loadColors(ros::NodeHandle& pnh, clients::DetectorSettings* s) {
     const std::string field = "~colors/" + it->first;
     XmlRpc::XmlRpcValue& list = it->second;
     if (list.getType() != XmlRpc::XmlRpcValue::TypeArray || list.size() == 0) {
-      throw scenario::ConfigError(field + ": expected a list of [h_min, h_max, s_min, s_max, "
-                                          "v_min, v_max] ranges");
+      throw scenario::ConfigError(field +
+                                  ": expected a list of [h_min, h_max, s_min, s_max, "
+                                  "v_min, v_max] ranges");
     }
     std::vector<clients::HsvRange> ranges;
     for (int i = 0; i < list.size(); ++i) {
       XmlRpc::XmlRpcValue& r = list[i];
       const std::string f = field + "[" + std::to_string(i) + "]";
       if (r.getType() != XmlRpc::XmlRpcValue::TypeArray || r.size() != 6) {
-        throw scenario::ConfigError(f + ": expected 6 integers [h_min, h_max, s_min, s_max, "
-                                        "v_min, v_max]");
+        throw scenario::ConfigError(f +
+                                    ": expected 6 integers [h_min, h_max, s_min, s_max, "
+                                    "v_min, v_max]");
       }
       clients::HsvRange h;
       h.h_min = toInt(r[0], f);
@@ -131,13 +133,12 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
         std::make_unique<message_filters::Subscriber<sensor_msgs::Image>>(nh, ns + "image_raw", 4);
     cam->depth_sub =
         std::make_unique<message_filters::Subscriber<sensor_msgs::Image>>(nh, ns + "depth", 4);
-    cam->sync = std::make_unique<
-        message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::Image>>(
-        *cam->image_sub, *cam->depth_sub, 8);
+    cam->sync =
+        std::make_unique<message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::Image>>(
+            *cam->image_sub, *cam->depth_sub, 8);
     Camera* raw = cam.get();
-    cam->sync->registerCallback(
-        boost::bind(&ColorShapeDetectorRos::onFrame, this, raw, boost::placeholders::_1,
-                    boost::placeholders::_2));
+    cam->sync->registerCallback(boost::bind(&ColorShapeDetectorRos::onFrame, this, raw,
+                                            boost::placeholders::_1, boost::placeholders::_2));
     cam->info_sub = nh.subscribe<sensor_msgs::CameraInfo>(
         ns + "camera_info", 1, [raw](const sensor_msgs::CameraInfo::ConstPtr& m) {
           try {
@@ -225,23 +226,22 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
         camera->intrinsics ? *camera->intrinsics
                            : clients::pinholeFromHfov(rgb.cols, rgb.rows, camera->spec.hfov_deg);
     if (intrinsics.width != rgb.cols || intrinsics.height != rgb.rows) {
-      ROS_WARN_THROTTLE(10.0, "%s: %s: camera_info is %dx%d, the image %dx%d: skipped",
-                        kClientName, camera->name.c_str(), intrinsics.width, intrinsics.height,
-                        rgb.cols, rgb.rows);
+      ROS_WARN_THROTTLE(10.0, "%s: %s: camera_info is %dx%d, the image %dx%d: skipped", kClientName,
+                        camera->name.c_str(), intrinsics.width, intrinsics.height, rgb.cols,
+                        rgb.rows);
       return;
     }
     camera->last_processed = stamp;
     const double t = stamp - mission_start_;
     std::set<std::string> looked;  // one pass per distinct description
     for (const auto& target : mission_->objective.targets) {
-      const std::string key = target.color + "/" + target.make + "/" + target.model + "/" +
-                              target.vehicle_class;
+      const std::string key =
+          target.color + "/" + target.make + "/" + target.model + "/" + target.vehicle_class;
       if (!looked.insert(key).second || !detector_->settings().colors.count(target.color)) {
         continue;
       }
       const geometry::Vec3 size = clients::nominalSize(target);
-      for (const auto& c :
-           detector_->detect(rgb, range, intrinsics, *pose, target.color, size)) {
+      for (const auto& c : detector_->detect(rgb, range, intrinsics, *pose, target.color, size)) {
         if (!c.reject.empty()) {
           ROS_DEBUG("%s: %s blob at (%.1f, %.1f): %s", kClientName, target.color.c_str(),
                     c.position.x(), c.position.y(), c.reject.c_str());
@@ -254,8 +254,9 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
         p.size = geometry::Vec3(c.length, c.width, size.z());
         const clients::ContextVerdict v = filter_->check(p, t, target);
         if (!v.accepted) {
-          ROS_INFO_THROTTLE(5.0, "%s: a %s-sized %s blob at (%.1f, %.1f) does not fit the "
-                                 "context: %s",
+          ROS_INFO_THROTTLE(5.0,
+                            "%s: a %s-sized %s blob at (%.1f, %.1f) does not fit the "
+                            "context: %s",
                             kClientName, target.vehicle_class.c_str(), target.color.c_str(),
                             c.position.x(), c.position.y(), v.reason.c_str());
           continue;
@@ -265,11 +266,11 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
         if (confidence < min_confidence_ || !claims_.claim(c.position, t)) continue;
         detection_pub_.publish(
             makeDetection(kClientName, target, c.position, confidence, image->header.stamp));
-        ROS_INFO("%s: claim: %s at (%.1f, %.1f) from the %s camera, %.1f x %.1f m, confidence "
-                 "%.2f (%s)",
-                 kClientName, clients::describe(target).c_str(), c.position.x(),
-                 c.position.y(), camera->name.c_str(), c.length, c.width, confidence,
-                 v.reason.c_str());
+        ROS_INFO(
+            "%s: claim: %s at (%.1f, %.1f) from the %s camera, %.1f x %.1f m, confidence "
+            "%.2f (%s)",
+            kClientName, clients::describe(target).c_str(), c.position.x(), c.position.y(),
+            camera->name.c_str(), c.length, c.width, confidence, v.reason.c_str());
       }
     }
   } catch (const std::exception& e) {

@@ -273,14 +273,13 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       v = filter_->check(c, t, target);
     }
     if (!v.accepted) {
-      ROS_INFO_THROTTLE(5.0, "%s: a %s at (%.1f, %.1f) does not fit the context: %s",
-                        kClientName, clients::describe(target).c_str(), p.x(), p.y(),
-                        v.reason.c_str());
+      ROS_INFO_THROTTLE(5.0, "%s: a %s at (%.1f, %.1f) does not fit the context: %s", kClientName,
+                        clients::describe(target).c_str(), p.x(), p.y(), v.reason.c_str());
       continue;
     }
     if (!claims_.claim(p, t)) continue;
-    const double confidence = clients::claimConfidence(1.0, v.relations_checked,
-                                                       v.relations_skipped);
+    const double confidence =
+        clients::claimConfidence(1.0, v.relations_checked, v.relations_skipped);
     detection_pub_.publish(makeDetection(kClientName, target, p, confidence, msg->header.stamp));
     ROS_INFO("%s: claim: %s at (%.1f, %.1f), confidence %.2f (%s)", kClientName,
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());

@@ -31,8 +31,10 @@ std::vector<geometry::Vec2> vecs(const std::vector<geometry_msgs::Point>& v) {
 
 geometry::Polygon polygon(const std::vector<geometry_msgs::Point>& v, const std::string& field) {
   if (v.size() < 3) {
-    throw scenario::ConfigError("mission message: " + field + ": expected a polygon of 3 or more "
-                                "points, got " + std::to_string(v.size()));
+    throw scenario::ConfigError("mission message: " + field +
+                                ": expected a polygon of 3 or more "
+                                "points, got " +
+                                std::to_string(v.size()));
   }
   return geometry::Polygon(vecs(v));
 }
@@ -162,8 +164,10 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
   scenario::Mission mission;
   mission.scenario_id = m.scenario_id;
   if (!scenario::parseScenarioClass(m.scenario_class, &mission.cls)) {
-    throw scenario::ConfigError("mission message: scenario_class: expected area_search, "
-                                "route_search or pursuit, got '" + m.scenario_class + "'");
+    throw scenario::ConfigError(
+        "mission message: scenario_class: expected area_search, "
+        "route_search or pursuit, got '" +
+        m.scenario_class + "'");
   }
   mission.seed = m.seed;
   mission.origin.latitude = m.origin_latitude;
@@ -204,8 +208,8 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
     prior.aoi_id = p.aoi_id;
     prior.depth = p.depth;
     for (const auto& c : p.cells) {
-      prior.cells.push_back({c.id, c.row, c.col, polygon(c.polygon, "area_priors." + c.id),
-                             c.probability});
+      prior.cells.push_back(
+          {c.id, c.row, c.col, polygon(c.polygon, "area_priors." + c.id), c.probability});
     }
     mission.priors.push_back(prior);
   }

@@ -1,11 +1,12 @@
 // Colour/shape detector on synthetic frames (flat-topped coloured car bodies on a grey or green
 // ground, exact depth, known intrinsics and pose), alone and with the context filter over the
 // shipped scenario's neighborhood.
+#include "hameritt/clients/color_detector.h"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 
-#include "hameritt/clients/color_detector.h"
 #include "hameritt/clients/context_filter.h"
 #include "hameritt/clients/public_config.h"
 #include "hameritt/scenario/error.h"
@@ -80,10 +81,10 @@ TEST(ColorDetector, ColourMasksSeparateTheCatalogColours) {
 TEST(ColorDetector, FindsTheCarOfTheRightColourAndSizeWithItsPosition) {
   const Vec3 uav(10.0, -5.0, 38.0);
   const std::vector<testing::ColoredBox> scene = {
-      car(12.3, -3.1, 0.6, 4.6, 1.855, 1.685, kWhite),    // the target's kind
-      car(0.0, -12.0, 1.2, 4.6, 1.855, 1.685, kBlue),     // wrong colour
-      car(16.0, -12.0, 0.0, 10.0, 4.0, 2.0, kWhite),      // white, but a shed
-      car(-2.0, 5.0, 0.3, 2.0, 1.0, 1.2, kWhite),         // white, too small
+      car(12.3, -3.1, 0.6, 4.6, 1.855, 1.685, kWhite),  // the target's kind
+      car(0.0, -12.0, 1.2, 4.6, 1.855, 1.685, kBlue),   // wrong colour
+      car(16.0, -12.0, 0.0, 10.0, 4.0, 2.0, kWhite),    // white, but a shed
+      car(-2.0, 5.0, 0.3, 2.0, 1.0, 1.2, kWhite),       // white, too small
   };
   const Eigen::Isometry3d pose = nadirCamera(uav, 0.4);
   const testing::Frame f = renderFrame(downCamera(), pose, scene, kAsphalt);
@@ -139,7 +140,8 @@ TEST(ColorDetector, CarsCutByTheImageBorderAreNotMeasured) {
   const std::vector<testing::ColoredBox> scene = {car(17.0, 0.0, 0.0, 4.6, 1.855, 1.6, kWhite)};
   const Eigen::Isometry3d pose = nadirCamera(uav, 0.0);
   const testing::Frame f = renderFrame(downCamera(), pose, scene, kAsphalt);
-  const auto found = ColorShapeDetector().detect(f.rgb, f.depth, downCamera(), pose, "white", kRav4);
+  const auto found =
+      ColorShapeDetector().detect(f.rgb, f.depth, downCamera(), pose, "white", kRav4);
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found.front().reject, "touches the image border");
 }
@@ -167,7 +169,7 @@ class DetectorInContext : public ::testing::Test {
     const ContextFilter filter(*mission_, world_);
     std::vector<std::pair<CarCandidate, ContextVerdict>> out;
     for (const auto& c : ColorShapeDetector().detect(f.rgb, f.depth, downCamera(), pose,
-                                                      target.color, nominalSize(target))) {
+                                                     target.color, nominalSize(target))) {
       if (!c.reject.empty()) continue;
       CandidatePose p;
       p.position = c.position;

@@ -1,10 +1,11 @@
 // Context filter: description matching, the region gate, scene-relation checks against the
 // public map, and the claim ledger; on the shipped scenario, whose confusers must all be told
 // apart from its target by the context alone.
+#include "hameritt/clients/context_filter.h"
+
 #include <gtest/gtest.h>
 
 #include "hameritt/clients/claims.h"
-#include "hameritt/clients/context_filter.h"
 #include "hameritt/clients/public_config.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"
@@ -59,8 +60,8 @@ scenario::World* ContextFilterTest::world_ = nullptr;
 scenario::SimConfig* ContextFilterTest::truth_ = nullptr;
 
 TEST_F(ContextFilterTest, DescriptionsMatchAttributesCaseInsensitively) {
-  const Observation rav4{"car", {{"vehicle_class", "suv"}, {"make", "Toyota"}, {"model", "RAV4"},
-                                 {"color", "White"}}};
+  const Observation rav4{
+      "car", {{"vehicle_class", "suv"}, {"make", "Toyota"}, {"model", "RAV4"}, {"color", "White"}}};
   EXPECT_TRUE(matchesDescription(rav4, target()));
   Observation red = rav4;
   red.attributes.back().second = "red";

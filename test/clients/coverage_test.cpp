@@ -1,11 +1,12 @@
 // Coverage search: footprint geometry, lawnmower coverage, prior order, keep-out zones and
 // windows, on the shipped scenario and on small hand-made missions.
+#include "hameritt/clients/coverage.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 
-#include "hameritt/clients/coverage.h"
 #include "hameritt/clients/public_config.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"
@@ -385,7 +386,7 @@ TEST(Coverage, PlansAreDeterministicAndFlightTimeIsTrapezoidal) {
     }
   }
   EXPECT_DOUBLE_EQ(flightTime(0, 12, 2), 0.0);
-  EXPECT_DOUBLE_EQ(flightTime(72, 12, 2), 12.0);   // exactly the ramp: 6 s up, 6 s down
+  EXPECT_DOUBLE_EQ(flightTime(72, 12, 2), 12.0);  // exactly the ramp: 6 s up, 6 s down
   EXPECT_DOUBLE_EQ(flightTime(172, 12, 2), 12.0 + 100.0 / 12.0);
   EXPECT_DOUBLE_EQ(flightTime(8, 12, 2), 4.0);
 }

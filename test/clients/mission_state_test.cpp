@@ -1,10 +1,10 @@
 // Reading the ADK's mission state from any message type: definitions and serialized bytes built
 // by hand as ROS would send them (little-endian, strings and variable arrays length-prefixed).
+#include "hameritt/clients/mission_state.h"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
-
-#include "hameritt/clients/mission_state.h"
 
 namespace hameritt::clients {
 namespace {

@@ -31,14 +31,15 @@ inline Frame renderFrame(const PinholeCamera& cam, const Eigen::Isometry3d& worl
                          const std::vector<ColoredBox>& boxes, const cv::Vec3b& ground) {
   Frame f;
   f.rgb = cv::Mat(cam.height, cam.width, CV_8UC3, cv::Scalar(ground[0], ground[1], ground[2]));
-  f.depth = cv::Mat(cam.height, cam.width, CV_32FC1,
-                    cv::Scalar(std::numeric_limits<float>::infinity()));
+  f.depth =
+      cv::Mat(cam.height, cam.width, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
   const Eigen::Matrix3d R = world_T_optical.linear();
   const Eigen::Vector3d o = world_T_optical.translation();
   for (int v = 0; v < cam.height; ++v) {
     for (int u = 0; u < cam.width; ++u) {
       // Ray direction with optical z = 1: the ray parameter is the depth.
-      const Eigen::Vector3d d = R * Eigen::Vector3d((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1);
+      const Eigen::Vector3d d =
+          R * Eigen::Vector3d((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1);
       double best = std::numeric_limits<double>::infinity();
       cv::Vec3b colour = ground;
       if (d.z() < -1e-9) {

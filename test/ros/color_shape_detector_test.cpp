@@ -51,7 +51,8 @@ TEST(ColorShapeDetector, ClaimsTheTargetOnceAndNeverItsLookAlike) {
   ros::Publisher mission_pub = nh.advertise<hameritt::Mission>("/mission", 1, true);
   ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/uav/camera/down/image_raw", 2);
   ros::Publisher depth_pub = nh.advertise<sensor_msgs::Image>("/uav/camera/down/depth", 2);
-  ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("/uav/camera/down/camera_info", 2, true);
+  ros::Publisher info_pub =
+      nh.advertise<sensor_msgs::CameraInfo>("/uav/camera/down/camera_info", 2, true);
   std::vector<hameritt::Detection> detections;
   ros::Subscriber det_sub = nh.subscribe<hameritt::Detection>(
       "/perception/detections", 20,
@@ -71,8 +72,8 @@ TEST(ColorShapeDetector, ClaimsTheTargetOnceAndNeverItsLookAlike) {
     }
   };
   tick(0.5);
-  mission_pub.publish(hameritt::ros_wrappers::toMsg(
-      hameritt::scenario::loadMission(kScenario + "mission.json")));
+  mission_pub.publish(
+      hameritt::ros_wrappers::toMsg(hameritt::scenario::loadMission(kScenario + "mission.json")));
   const ros::WallTime up = ros::WallTime::now() + ros::WallDuration(30);
   while ((image_pub.getNumSubscribers() == 0 || depth_pub.getNumSubscribers() == 0 ||
           det_sub.getNumPublishers() == 0) &&
@@ -89,7 +90,8 @@ TEST(ColorShapeDetector, ClaimsTheTargetOnceAndNeverItsLookAlike) {
     if (c.name == "down") down = &c;
   }
   ASSERT_NE(down, nullptr);
-  const clients::PinholeCamera cam = clients::pinholeFromHfov(down->width, down->height, down->hfov_deg);
+  const clients::PinholeCamera cam =
+      clients::pinholeFromHfov(down->width, down->height, down->hfov_deg);
   Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
   base.translation() = Vec3(-271.039 + 5.0, 248.982, 38.0);
   const Eigen::Isometry3d optical = clients::opticalPose(base, down->mount_xyz, down->mount_rpy);

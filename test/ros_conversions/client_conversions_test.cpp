@@ -1,12 +1,13 @@
 // ROS message conversions of the baseline clients: the mission message both ways (every shipped
 // and test mission survives toMsg -> fromMsg byte for byte as mission.json), camera images and
 // intrinsics, claims, and the ADK state read from a message of any type. No ROS master needed.
+#include "hameritt/ros/client_conversions.h"
+
 #include <gtest/gtest.h>
 #include <std_msgs/String.h>
 
 #include <cmath>
 
-#include "hameritt/ros/client_conversions.h"
 #include "hameritt/ros/mission_conversions.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"

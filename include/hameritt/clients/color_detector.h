@@ -29,8 +29,7 @@ PinholeCamera pinholeFromHfov(int width, int height, double hfov_deg);
 // The optical frame (z forward, x right, y down) of a camera mounted on base_link (FLU) at
 // mount_xyz (m) with mount_rpy_deg (roll, pitch, yaw in degrees; positive pitch looks down).
 Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base,
-                              const geometry::Vec3& mount_xyz,
-                              const geometry::Vec3& mount_rpy_deg);
+                              const geometry::Vec3& mount_xyz, const geometry::Vec3& mount_rpy_deg);
 
 // One HSV box in OpenCV's scale (H 0..179, S and V 0..255). h_min > h_max wraps around red.
 struct HsvRange {
@@ -43,14 +42,14 @@ struct HsvRange {
 struct DetectorSettings {
   // Colour name -> HSV boxes (a pixel of the colour lies in at least one).
   std::map<std::string, std::vector<HsvRange>> colors;
-  int min_blob_pixels = 25;  // fewer pixels of colour: noise
-  int open_kernel = 3;       // px, morphological opening (speckle removal); 0 or 1: none
-  int close_kernel = 5;      // px, closing (fills seams); 0 or 1: none
-  double ground_z = 0.0;     // m, the ground plane (streets are at 0)
-  double height_min = 0.25;  // m above the ground: car pixels lie in [height_min, height_max]
-  double height_max = 2.6;   //   (rejects the street, lawns, roofs and canopies)
-  double merge_gap = 0.8;    // m, blobs whose footprints come closer are one vehicle (windows
-                             //   split a car's body into hood, roof and trunk)
+  int min_blob_pixels = 25;     // fewer pixels of colour: noise
+  int open_kernel = 3;          // px, morphological opening (speckle removal); 0 or 1: none
+  int close_kernel = 5;         // px, closing (fills seams); 0 or 1: none
+  double ground_z = 0.0;        // m, the ground plane (streets are at 0)
+  double height_min = 0.25;     // m above the ground: car pixels lie in [height_min, height_max]
+  double height_max = 2.6;      //   (rejects the street, lawns, roofs and canopies)
+  double merge_gap = 0.8;       // m, blobs whose footprints come closer are one vehicle (windows
+                                //   split a car's body into hood, roof and trunk)
   double size_tolerance = 0.3;  // relative, on length and width
   double max_range = 150.0;     // m, farther blobs are too coarse to measure
   bool reject_border = true;    // blobs touching the image border are cut: not measurable
@@ -64,14 +63,14 @@ DetectorSettings defaultDetectorSettings();
 // A colour blob measured on the ground.
 struct CarCandidate {
   geometry::Vec3 position{0, 0, 0};  // map frame: centre of the footprint at ground_z
-  double yaw = 0.0;                   // direction of the long axis, [0, pi): heading or reverse
-  double length = 0.0, width = 0.0;   // m, minimum-area rectangle of the blob's ground points
-  double top = 0.0;                   // m, highest point of the blob
-  double range = 0.0;                 // m, median depth
-  int pixels = 0;                     // pixels of colour at car height
-  cv::Rect box;                       // image bounding box
-  double size_score = 0.0;            // 1: exact size, 0: at the tolerance
-  std::string reject;                 // "" for a candidate; else why not
+  double yaw = 0.0;                  // direction of the long axis, [0, pi): heading or reverse
+  double length = 0.0, width = 0.0;  // m, minimum-area rectangle of the blob's ground points
+  double top = 0.0;                  // m, highest point of the blob
+  double range = 0.0;                // m, median depth
+  int pixels = 0;                    // pixels of colour at car height
+  cv::Rect box;                      // image bounding box
+  double size_score = 0.0;           // 1: exact size, 0: at the tolerance
+  std::string reject;                // "" for a candidate; else why not
 };
 
 class ColorShapeDetector {

@@ -39,18 +39,18 @@ geometry::Vec3 nominalSize(const scenario::TargetDescription& target);
 
 // A candidate's estimated pose on the ground.
 struct CandidatePose {
-  geometry::Vec3 position{0, 0, 0};  // bottom-face centre, map frame
-  double yaw = 0.0;                   // heading, radians
-  bool yaw_ambiguous = true;          // true: the heading may be yaw + pi (an image blob's axis)
+  geometry::Vec3 position{0, 0, 0};     // bottom-face centre, map frame
+  double yaw = 0.0;                     // heading, radians
+  bool yaw_ambiguous = true;            // true: the heading may be yaw + pi (an image blob's axis)
   geometry::Vec3 size{4.6, 1.85, 1.6};  // length, width, height
 };
 
 // Tolerances of the checks. validate() throws scenario::ConfigError naming "context.<field>".
 struct ContextSettings {
-  double region_tolerance = 1.5;     // m outside an AOI polygon or band that still counts
-  double distance_tolerance = 1.5;   // m between a measured footprint distance and the evidence
-  double over_tolerance = 0.75;      // m, ON_TOP_OF / NOT_ON_TOP_OF footprint containment
-  double bearing_tolerance_deg = 35; // directional relations: |bearing - evidence bearing|
+  double region_tolerance = 1.5;      // m outside an AOI polygon or band that still counts
+  double distance_tolerance = 1.5;    // m between a measured footprint distance and the evidence
+  double over_tolerance = 0.75;       // m, ON_TOP_OF / NOT_ON_TOP_OF footprint containment
+  double bearing_tolerance_deg = 35;  // directional relations: |bearing - evidence bearing|
   bool check_relations = true;
   scenario::RelationConfig thresholds;  // the generator's operator thresholds
   void validate() const;

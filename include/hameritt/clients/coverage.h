@@ -33,23 +33,23 @@ double heightForPixels(const scenario::CameraSpec& camera, double size, double p
 
 // Coverage settings. validate() throws scenario::ConfigError naming "coverage.<field>".
 struct CoverageSettings {
-  double altitude = 0.0;         // flight altitude, m above ground (z); must be inside the band
-  Footprint footprint;           // of the search camera at `altitude`
-  double overlap = 0.2;          // of neighbouring swaths, [0, 0.9]
-  double max_speed = 12.0;       // m/s, for arrival-time estimates (the planner's limits:
-  double accel = 2.0;            // m/s^2  it stops at each waypoint, trapezoidal profile)
-  double climb_rate = 3.0;       // m/s
-  double detour_factor = 1.15;   // transits are longer than straight lines (obstacles, zones)
-  double koz_margin = 3.0;       // waypoints stay this far (m) outside active keep-out zones
-  double koz_time_slack = 20.0;  // a zone counts as active if it is at any instant of
-                                 // [eta - slack, eta + slack]: estimates are not exact
-  double sample_step = 1.0;      // m, resolution of the line clipping against zones
-  double min_line = 2.0;         // m, shorter free pieces of a line are dropped
-  double window_margin = 10.0;   // s: when the estimated arrival is less than this after a
-                                 // region's window opens, wait outside it (estimates are not
-                                 // exact: the UAV must not enter before the window opens)
-  int max_leg_waypoints = 12;    // a cell's pattern is sent in legs of at most this many
-  bool cover_zero_cells = false; // also sweep prior cells of probability 0 (last)
+  double altitude = 0.0;          // flight altitude, m above ground (z); must be inside the band
+  Footprint footprint;            // of the search camera at `altitude`
+  double overlap = 0.2;           // of neighbouring swaths, [0, 0.9]
+  double max_speed = 12.0;        // m/s, for arrival-time estimates (the planner's limits:
+  double accel = 2.0;             // m/s^2  it stops at each waypoint, trapezoidal profile)
+  double climb_rate = 3.0;        // m/s
+  double detour_factor = 1.15;    // transits are longer than straight lines (obstacles, zones)
+  double koz_margin = 3.0;        // waypoints stay this far (m) outside active keep-out zones
+  double koz_time_slack = 20.0;   // a zone counts as active if it is at any instant of
+                                  // [eta - slack, eta + slack]: estimates are not exact
+  double sample_step = 1.0;       // m, resolution of the line clipping against zones
+  double min_line = 2.0;          // m, shorter free pieces of a line are dropped
+  double window_margin = 10.0;    // s: when the estimated arrival is less than this after a
+                                  // region's window opens, wait outside it (estimates are not
+                                  // exact: the UAV must not enter before the window opens)
+  int max_leg_waypoints = 12;     // a cell's pattern is sent in legs of at most this many
+  bool cover_zero_cells = false;  // also sweep prior cells of probability 0 (last)
   void validate() const;
 };
 
@@ -79,8 +79,8 @@ struct SearchLeg {
   std::string region_id;  // AOI or route id
   std::string cell_id;    // prior cell id (the region id for regions without priors)
   double probability = 0.0;
-  double not_before = 0.0;  // do not send before this mission time (the window opening, after a
-                            // stage leg)
+  double not_before = 0.0;     // do not send before this mission time (the window opening, after a
+                               // stage leg)
   bool completes_cell = true;  // the cell is covered once this leg is done
   std::vector<SearchWaypoint> waypoints;
 };
