@@ -1,0 +1,44 @@
+#pragma once
+// ROS <-> core conversions used by the baseline clients: camera messages to OpenCV images and
+// pinhole intrinsics, claims to hameritt/Detection, perfect-perception entities to observations,
+// and the ADK's mission state from a message of any type.
+
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <topic_tools/shape_shifter.h>
+
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+#include "hameritt/Detection.h"
+#include "hameritt/PerceivedEntity.h"
+#include "hameritt/clients/color_detector.h"
+#include "hameritt/clients/context_filter.h"
+#include "hameritt/clients/mission_state.h"
+
+namespace hameritt::ros_wrappers {
+
+// An rgb8 or bgr8 image as CV_8UC3 in RGB order (copied). Throws scenario::ConfigError for
+// other encodings or a bad size.
+cv::Mat rgbFromMsg(const sensor_msgs::Image& msg);
+// A 32FC1 (metres) or 16UC1 (millimetres, 0 = none) depth image as CV_32FC1 metres (copied;
+// missing depth becomes +inf). Throws scenario::ConfigError for other encodings.
+cv::Mat depthFromMsg(const sensor_msgs::Image& msg);
+// K of a CameraInfo (no distortion assumed). Throws scenario::ConfigError for fx or fy <= 0.
+clients::PinholeCamera fromMsg(const sensor_msgs::CameraInfo& msg);
+
+// What perfect perception reports about one entity, as the clients may use it: class and
+// attributes (never its id or role).
+clients::Observation toObservation(const hameritt::PerceivedEntity& e);
+
+// A claim: "I see `target` at `position`" from the frame stamped `stamp`.
+hameritt::Detection makeDetection(const std::string& client,
+                                  const scenario::TargetDescription& target,
+                                  const geometry::Vec3& position, double confidence,
+                                  const ros::Time& stamp);
+
+// The mission state in an /adk/state message of any type (see clients::readMissionState).
+std::optional<clients::MissionStateReading> readMissionState(const topic_tools::ShapeShifter& msg);
+
+}  // namespace hameritt::ros_wrappers

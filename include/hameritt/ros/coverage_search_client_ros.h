@@ -1,0 +1,87 @@
+#pragma once
+// The baseline maneuver client: a prior-weighted coverage search (clients::planSearch) of the
+// mission's areas of interest and route bands, flown through the planner's waypoint follower one
+// leg at a time; it hovers when the ADK says the mission is over, at the mission's time limit, or
+// once the objective's targets have been detected. In maneuver-only mode it also turns the ADK's
+// perfect perception into claims (the paper's maneuver-only training thread).
+
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <topic_tools/shape_shifter.h>
+
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+
+#include "hameritt/Detection.h"
+#include "hameritt/FollowProgress.h"
+#include "hameritt/Mission.h"
+#include "hameritt/PerceptionReport.h"
+#include "hameritt/clients/claims.h"
+#include "hameritt/clients/context_filter.h"
+#include "hameritt/clients/coverage.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::ros_wrappers {
+
+// Topics (relative names): sub mission (hameritt/Mission, latched), uav/odom, planner/progress,
+// adk/state (any type), perception/detections; pub planner/waypoints (nav_msgs/Path), ~plan
+// (nav_msgs/Path, latched: every waypoint of the current plan); in maneuver-only mode sub
+// adk/perfect_perception and pub perception/detections.
+//
+// Parameters (private): ~sim_config (required; only its public part is read:
+// clients::loadPublicSimConfig), ~camera ("down"), ~altitude (0: highest that keeps a car's width
+// at ~min_car_pixels, 25), ~overlap (0.2), ~koz_margin (3 m), ~max_leg_waypoints (12),
+// ~cover_zero_cells (false), ~repeat (true: sweep again when everything open has been swept),
+// ~stop_on_detection (true), ~claim_from_perfect_perception (false), ~use_context (true: claims
+// must pass the context filter), ~claim_radius (4 m), ~claim_hold (30 s), ~mission_start_time
+// (0: sim time of mission time 0), ~rate_hz (2).
+class CoverageSearchClientRos {
+ public:
+  // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
+  CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+ private:
+  void onMission(const hameritt::Mission::ConstPtr& msg);
+  void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
+  void onProgress(const hameritt::FollowProgress::ConstPtr& msg);
+  void onState(const topic_tools::ShapeShifter::ConstPtr& msg);
+  void onDetection(const hameritt::Detection::ConstPtr& msg);
+  void onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg);
+  void onTick(const ros::TimerEvent&);
+
+  double missionTime() const;
+  void replan(const std::string& why);
+  // Sends the current leg when it is due; ends the search when the plan is spent.
+  void sendIfDue();
+  void legFailed(const hameritt::FollowProgress& msg);
+  // Hovers where the UAV is and stops searching.
+  void stop(const std::string& why);
+  void publishPlan();
+
+  scenario::SimConfig sim_;  // public part only
+  std::unique_ptr<scenario::World> world_;
+  clients::CoverageSettings settings_;
+  std::optional<scenario::Mission> mission_;
+  std::unique_ptr<clients::ContextFilter> filter_;
+  bool repeat_ = true, stop_on_detection_ = true, claim_ = false, use_context_ = true;
+  double mission_start_ = 0.0;
+
+  std::optional<nav_msgs::Odometry> odom_;
+  clients::SearchPlan plan_;
+  std::size_t leg_ = 0;
+  std::set<std::string> covered_;
+  bool planned_ = false, sent_ = false, acked_ = false, stopped_ = false, exhausted_ = false;
+  int failures_ = 0;
+  double retry_at_ = 0.0;
+  clients::ClaimLedger claims_;
+  clients::ClaimLedger detections_;
+
+  ros::Publisher waypoints_pub_, plan_pub_, detection_pub_;
+  ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_;
+  ros::Timer timer_;
+};
+
+}  // namespace hameritt::ros_wrappers

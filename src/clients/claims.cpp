@@ -1,0 +1,37 @@
+#include "hameritt/clients/claims.h"
+
+#include <cmath>
+
+#include "hameritt/scenario/error.h"
+
+namespace hameritt::clients {
+
+ClaimLedger::ClaimLedger(double radius, double hold) : radius_(radius), hold_(hold) {
+  if (!(radius >= 0) || !std::isfinite(radius)) {
+    throw scenario::ConfigError("claims.radius: expected metres >= 0, got " +
+                                scenario::formatNumber(radius));
+  }
+  if (std::isnan(hold)) throw scenario::ConfigError("claims.hold: expected seconds, got nan");
+}
+
+bool ClaimLedger::isRepeat(const geometry::Vec3& p, double t) const {
+  for (const auto& c : claims_) {
+    const bool near = (c.p - p).head<2>().norm() <= radius_;
+    const bool fresh = hold_ <= 0 || t - c.t < hold_;
+    if (near && fresh) return true;
+  }
+  return false;
+}
+
+bool ClaimLedger::claim(const geometry::Vec3& p, double t) {
+  if (isRepeat(p, t)) return false;
+  claims_.push_back({p, t});
+  bool known = false;
+  for (const auto& q : places_) known |= (q - p).head<2>().norm() <= radius_;
+  if (!known) places_.push_back(p);
+  return true;
+}
+
+std::size_t ClaimLedger::locations() const { return places_.size(); }
+
+}  // namespace hameritt::clients

@@ -1,0 +1,125 @@
+#include "hameritt/ros/client_conversions.h"
+
+#include <cstring>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "hameritt/scenario/error.h"
+
+namespace hameritt::ros_wrappers {
+
+namespace {
+
+void checkSize(const sensor_msgs::Image& msg, int bytes_per_pixel) {
+  if (msg.width == 0 || msg.height == 0 ||
+      msg.step < msg.width * static_cast<unsigned>(bytes_per_pixel) ||
+      msg.data.size() < static_cast<std::size_t>(msg.step) * msg.height) {
+    throw scenario::ConfigError("image: " + std::to_string(msg.width) + "x" +
+                                std::to_string(msg.height) + " " + msg.encoding + ", step " +
+                                std::to_string(msg.step) + ", " + std::to_string(msg.data.size()) +
+                                " bytes: inconsistent size");
+  }
+  if (msg.is_bigendian && bytes_per_pixel > 1 && msg.encoding != "rgb8" && msg.encoding != "bgr8") {
+    throw scenario::ConfigError("image: big-endian " + msg.encoding + " is not supported");
+  }
+}
+
+}  // namespace
+
+cv::Mat rgbFromMsg(const sensor_msgs::Image& msg) {
+  if (msg.encoding != "rgb8" && msg.encoding != "bgr8") {
+    throw scenario::ConfigError("image: expected rgb8 or bgr8, got '" + msg.encoding + "'");
+  }
+  checkSize(msg, 3);
+  const cv::Mat view(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_8UC3,
+                     const_cast<std::uint8_t*>(msg.data.data()), msg.step);
+  cv::Mat out;
+  if (msg.encoding == "bgr8") {
+    cv::cvtColor(view, out, cv::COLOR_BGR2RGB);
+  } else {
+    out = view.clone();
+  }
+  return out;
+}
+
+cv::Mat depthFromMsg(const sensor_msgs::Image& msg) {
+  const float inf = std::numeric_limits<float>::infinity();
+  if (msg.encoding == "32FC1") {
+    checkSize(msg, 4);
+    return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_32FC1,
+                   const_cast<std::uint8_t*>(msg.data.data()), msg.step)
+        .clone();
+  }
+  if (msg.encoding == "16UC1") {
+    checkSize(msg, 2);
+    cv::Mat out(static_cast<int>(msg.height), static_cast<int>(msg.width), CV_32FC1);
+    for (int v = 0; v < out.rows; ++v) {
+      const auto* row = reinterpret_cast<const std::uint16_t*>(msg.data.data() + v * msg.step);
+      float* o = out.ptr<float>(v);
+      for (int u = 0; u < out.cols; ++u) o[u] = row[u] == 0 ? inf : 0.001f * row[u];
+    }
+    return out;
+  }
+  throw scenario::ConfigError("depth image: expected 32FC1 or 16UC1, got '" + msg.encoding + "'");
+}
+
+clients::PinholeCamera fromMsg(const sensor_msgs::CameraInfo& msg) {
+  clients::PinholeCamera c;
+  c.width = static_cast<int>(msg.width);
+  c.height = static_cast<int>(msg.height);
+  c.fx = msg.K[0];
+  c.cx = msg.K[2];
+  c.fy = msg.K[4];
+  c.cy = msg.K[5];
+  if (!(c.fx > 0 && c.fy > 0)) {
+    throw scenario::ConfigError("camera_info: K: expected fx, fy > 0, got " +
+                                scenario::formatNumber(c.fx) + ", " + scenario::formatNumber(c.fy));
+  }
+  return c;
+}
+
+clients::Observation toObservation(const hameritt::PerceivedEntity& e) {
+  clients::Observation o;
+  o.entity_class = e.entity_class;
+  for (const auto& kv : e.attributes) o.attributes.emplace_back(kv.key, kv.value);
+  return o;
+}
+
+hameritt::Detection makeDetection(const std::string& client,
+                                  const scenario::TargetDescription& target,
+                                  const geometry::Vec3& position, double confidence,
+                                  const ros::Time& stamp) {
+  hameritt::Detection d;
+  d.header.stamp = stamp;
+  d.header.frame_id = "map";
+  d.client = client;
+  d.description = clients::describe(target);
+  d.entity_class = target.cls;
+  const std::pair<const char*, const std::string*> fields[] = {
+      {"vehicle_class", &target.vehicle_class},
+      {"make", &target.make},
+      {"model", &target.model},
+      {"color", &target.color}};
+  for (const auto& [key, value] : fields) {
+    if (value->empty()) continue;
+    hameritt::KeyValue kv;
+    kv.key = key;
+    kv.value = *value;
+    d.attributes.push_back(kv);
+  }
+  d.position.x = position.x();
+  d.position.y = position.y();
+  d.position.z = position.z();
+  d.confidence = static_cast<float>(confidence);
+  return d;
+}
+
+std::optional<clients::MissionStateReading> readMissionState(const topic_tools::ShapeShifter& msg) {
+  std::vector<std::uint8_t> bytes(msg.size());
+  ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+  msg.write(out);
+  return clients::readMissionState(msg.getMessageDefinition(), bytes.data(), bytes.size());
+}
+
+}  // namespace hameritt::ros_wrappers

@@ -1,0 +1,326 @@
+#include "hameritt/ros/coverage_search_client_ros.h"
+
+#include <nav_msgs/Path.h>
+
+#include <algorithm>
+
+#include "hameritt/clients/public_config.h"
+#include "hameritt/ros/client_conversions.h"
+#include "hameritt/ros/mission_conversions.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/sim_config_io.h"
+
+namespace hameritt::ros_wrappers {
+
+namespace {
+
+constexpr const char* kClientName = "coverage_search_client";
+
+geometry_msgs::PoseStamped poseAt(const geometry::Vec3& p, const ros::Time& stamp) {
+  geometry_msgs::PoseStamped m;
+  m.header.stamp = stamp;
+  m.header.frame_id = "map";
+  m.pose.position.x = p.x();
+  m.pose.position.y = p.y();
+  m.pose.position.z = p.z();
+  m.pose.orientation.w = 1.0;
+  return m;
+}
+
+}  // namespace
+
+CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string sim_path, camera = "down";
+  if (!pnh.getParam("sim_config", sim_path)) {
+    throw scenario::ConfigError("~sim_config: required parameter (path of a sim_config.json)");
+  }
+  double altitude = 0.0, min_car_pixels = 25.0, overlap = 0.2, koz_margin = 3.0, rate = 2.0;
+  double claim_radius = 4.0, claim_hold = 30.0;
+  int max_leg = 12;
+  bool cover_zero = false;
+  pnh.param("camera", camera, camera);
+  pnh.param("altitude", altitude, altitude);
+  pnh.param("min_car_pixels", min_car_pixels, min_car_pixels);
+  pnh.param("overlap", overlap, overlap);
+  pnh.param("koz_margin", koz_margin, koz_margin);
+  pnh.param("max_leg_waypoints", max_leg, max_leg);
+  pnh.param("cover_zero_cells", cover_zero, cover_zero);
+  pnh.param("repeat", repeat_, repeat_);
+  pnh.param("stop_on_detection", stop_on_detection_, stop_on_detection_);
+  pnh.param("claim_from_perfect_perception", claim_, claim_);
+  pnh.param("use_context", use_context_, use_context_);
+  pnh.param("claim_radius", claim_radius, claim_radius);
+  pnh.param("claim_hold", claim_hold, claim_hold);
+  pnh.param("mission_start_time", mission_start_, mission_start_);
+  pnh.param("rate_hz", rate, rate);
+  if (!(rate > 0 && rate <= 100)) throw scenario::ConfigError("~rate_hz: expected (0, 100]");
+
+  // The honesty rule: the map and the UAV's own specification, never the scenario's entities.
+  sim_ = clients::loadPublicSimConfig(sim_path);
+  settings_ = clients::coverageSettingsFor(sim_.uav, camera, altitude, min_car_pixels);
+  settings_.overlap = overlap;
+  settings_.koz_margin = koz_margin;
+  settings_.max_leg_waypoints = max_leg;
+  settings_.cover_zero_cells = cover_zero;
+  settings_.validate();
+  claims_ = clients::ClaimLedger(claim_radius, claim_hold);
+  detections_ = clients::ClaimLedger(claim_radius, 0.0);
+  if (claim_ && use_context_) {
+    world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
+  }
+
+  waypoints_pub_ = nh.advertise<nav_msgs::Path>("planner/waypoints", 1, true);
+  plan_pub_ = pnh.advertise<nav_msgs::Path>("plan", 1, true);
+  mission_sub_ = nh.subscribe("mission", 1, &CoverageSearchClientRos::onMission, this);
+  odom_sub_ = nh.subscribe("uav/odom", 10, &CoverageSearchClientRos::onOdometry, this);
+  progress_sub_ = nh.subscribe("planner/progress", 50, &CoverageSearchClientRos::onProgress, this);
+  state_sub_ = nh.subscribe("adk/state", 10, &CoverageSearchClientRos::onState, this);
+  detection_sub_ =
+      nh.subscribe("perception/detections", 50, &CoverageSearchClientRos::onDetection, this);
+  if (claim_) {
+    detection_pub_ = nh.advertise<hameritt::Detection>("perception/detections", 50);
+    perfect_sub_ = nh.subscribe("adk/perfect_perception", 20,
+                                &CoverageSearchClientRos::onPerfectPerception, this);
+  }
+  timer_ = nh.createTimer(ros::Duration(1.0 / rate), &CoverageSearchClientRos::onTick, this);
+  ROS_INFO("%s: %s camera, altitude %.1f m, swath %.1f m, lines %.1f m apart%s", kClientName,
+           camera.c_str(), settings_.altitude, settings_.footprint.across,
+           settings_.footprint.across * (1 - settings_.overlap),
+           claim_ ? ", claiming from perfect perception" : "");
+}
+
+double CoverageSearchClientRos::missionTime() const {
+  return ros::Time::now().toSec() - mission_start_;
+}
+
+void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) {
+  scenario::Mission m;
+  try {
+    m = fromMsg(*msg);
+  } catch (const std::exception& e) {
+    ROS_ERROR("%s: ignoring the mission: %s", kClientName, e.what());
+    return;
+  }
+  if (m.scenario_id != sim_.scenario_id) {
+    ROS_ERROR("%s: ignoring mission %s: the sim_config is for %s", kClientName,
+              m.scenario_id.c_str(), sim_.scenario_id.c_str());
+    return;
+  }
+  if (mission_ && mission_->scenario_id == m.scenario_id) return;  // the same, again
+  mission_ = std::move(m);
+  filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get());
+  covered_.clear();
+  planned_ = stopped_ = exhausted_ = false;
+  ROS_INFO("%s: mission %s: %s", kClientName, mission_->scenario_id.c_str(),
+           mission_->objective.text.c_str());
+  if (odom_) replan("mission received");
+}
+
+void CoverageSearchClientRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  odom_ = *msg;
+  if (mission_ && !planned_ && !stopped_) replan("start");
+}
+
+void CoverageSearchClientRos::replan(const std::string& why) {
+  const auto& p = odom_->pose.pose.position;
+  clients::SearchProgress progress{geometry::Vec3(p.x, p.y, p.z), missionTime(), covered_};
+  try {
+    plan_ = clients::planSearch(*mission_, settings_, progress);
+  } catch (const std::exception& e) {
+    ROS_ERROR("%s: planning the search failed: %s", kClientName, e.what());
+    plan_ = {};
+  }
+  leg_ = 0;
+  sent_ = acked_ = false;
+  failures_ = 0;
+  planned_ = true;
+  std::size_t waypoints = 0;
+  for (const auto& leg : plan_.legs) waypoints += leg.waypoints.size();
+  ROS_INFO("%s: %s: %zu legs, %zu waypoints, %zu cells left out", kClientName, why.c_str(),
+           plan_.legs.size(), waypoints, plan_.skipped.size());
+  for (const auto& s : plan_.skipped) ROS_DEBUG("%s: left out %s", kClientName, s.c_str());
+  publishPlan();
+  sendIfDue();
+}
+
+void CoverageSearchClientRos::sendIfDue() {
+  if (stopped_ || !planned_ || sent_ || !mission_) return;
+  if (leg_ >= plan_.legs.size()) {
+    if (exhausted_) return;
+    if (repeat_ && !covered_.empty()) {
+      covered_.clear();
+      replan("every open cell swept, sweeping again");
+      return;
+    }
+    exhausted_ = true;
+    ROS_INFO("%s: nothing left to search now: hovering", kClientName);
+    if (odom_ && odom_->pose.pose.position.z > 1.0) {
+      nav_msgs::Path path;
+      path.header.stamp = ros::Time::now();
+      path.header.frame_id = "map";
+      const auto& p = odom_->pose.pose.position;
+      path.poses.push_back(poseAt(geometry::Vec3(p.x, p.y, p.z), path.header.stamp));
+      waypoints_pub_.publish(path);
+    }
+    return;
+  }
+  const clients::SearchLeg& leg = plan_.legs[leg_];
+  const double t = missionTime();
+  if (t < leg.not_before || t < retry_at_) return;
+  nav_msgs::Path path;
+  path.header.stamp = ros::Time::now();
+  path.header.frame_id = "map";
+  for (const auto& w : leg.waypoints) path.poses.push_back(poseAt(w.position, path.header.stamp));
+  waypoints_pub_.publish(path);
+  sent_ = true;
+  acked_ = false;
+  ROS_INFO("%s: leg %zu/%zu: %s %s (p %.3f), %zu waypoints", kClientName, leg_ + 1,
+           plan_.legs.size(), leg.kind == clients::LegKind::kStage ? "waiting at" : "sweeping",
+           leg.cell_id.c_str(), leg.probability, leg.waypoints.size());
+}
+
+void CoverageSearchClientRos::onProgress(const hameritt::FollowProgress::ConstPtr& msg) {
+  if (!sent_ || stopped_ || leg_ >= plan_.legs.size()) return;
+  const clients::SearchLeg& leg = plan_.legs[leg_];
+  if (!acked_) {
+    // The follower's first answer to this leg: it plans as soon as the waypoints arrive.
+    const bool answer = msg->state == "following" || msg->state == "failed";
+    if (!answer || msg->waypoints != leg.waypoints.size()) return;
+    acked_ = true;
+  }
+  if (msg->state == "failed") {
+    legFailed(*msg);
+  } else if (msg->state == "done") {
+    sent_ = false;
+    failures_ = 0;
+    const bool cell_done = leg.kind == clients::LegKind::kCover && leg.completes_cell;
+    const std::string cell = leg.cell_id;
+    if (cell_done) covered_.insert(cell);
+    ++leg_;
+    if (cell_done) {
+      replan(cell + " swept");
+    } else {
+      sendIfDue();
+    }
+  }
+}
+
+void CoverageSearchClientRos::legFailed(const hameritt::FollowProgress& msg) {
+  clients::SearchLeg& leg = plan_.legs[leg_];
+  ++failures_;
+  sent_ = false;
+  ROS_WARN("%s: the follower failed on leg %zu (%s) at waypoint %u: %s", kClientName, leg_ + 1,
+           leg.cell_id.c_str(), msg.waypoint, msg.message.c_str());
+  // Waypoints already reached are done; the failing one is retried once, then dropped.
+  const std::size_t reached = std::min<std::size_t>(msg.waypoint, leg.waypoints.size());
+  const std::size_t drop = failures_ >= 2 ? std::min(reached + 1, leg.waypoints.size()) : reached;
+  leg.waypoints.erase(leg.waypoints.begin(), leg.waypoints.begin() + static_cast<long>(drop));
+  if (failures_ >= 2) failures_ = 0;
+  retry_at_ = missionTime() + 1.0;
+  if (leg.waypoints.empty()) {
+    if (leg.kind == clients::LegKind::kCover && leg.completes_cell) covered_.insert(leg.cell_id);
+    ++leg_;
+  }
+  sendIfDue();
+}
+
+void CoverageSearchClientRos::onState(const topic_tools::ShapeShifter::ConstPtr& msg) {
+  const auto reading = readMissionState(*msg);
+  if (!reading) {
+    ROS_WARN_ONCE("%s: adk/state (%s) has no state field this client can read", kClientName,
+                  msg->getDataType().c_str());
+    return;
+  }
+  if (reading->ended) stop("the ADK says the mission is over (" + reading->state + ")");
+}
+
+void CoverageSearchClientRos::onDetection(const hameritt::Detection::ConstPtr& msg) {
+  if (!mission_ || !stop_on_detection_ || stopped_) return;
+  clients::Observation seen;
+  seen.entity_class = msg->entity_class;
+  for (const auto& kv : msg->attributes) seen.attributes.emplace_back(kv.key, kv.value);
+  bool wanted = false;
+  for (const auto& t : mission_->objective.targets) wanted |= clients::matchesDescription(seen, t);
+  if (!wanted) return;
+  const geometry::Vec3 p(msg->position.x, msg->position.y, msg->position.z);
+  detections_.claim(p, msg->header.stamp.toSec());
+  const std::size_t wanted_places = std::max<std::size_t>(1, mission_->objective.targets.size());
+  if (detections_.locations() >= wanted_places) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "%s detected %s at (%.1f, %.1f)", msg->client.c_str(),
+                  msg->description.c_str(), p.x(), p.y());
+    stop(buf);
+  }
+}
+
+void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg) {
+  if (!mission_ || !filter_) return;
+  const double t = msg->header.stamp.toSec() - mission_start_;
+  for (const auto& e : msg->entities) {
+    // Class and attributes only: the entity's id and role are ground truth a client never uses.
+    const auto targets = filter_->targetsMatching(toObservation(e));
+    if (targets.empty()) continue;
+    const scenario::TargetDescription& target = *targets.front();
+    const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
+    clients::ContextVerdict v;
+    v.accepted = true;
+    if (use_context_) {
+      clients::CandidatePose c;
+      c.position = p;
+      c.yaw = e.yaw;
+      c.yaw_ambiguous = false;
+      c.size = clients::nominalSize(target);
+      v = filter_->check(c, t, target);
+    }
+    if (!v.accepted) {
+      ROS_INFO_THROTTLE(5.0, "%s: a %s at (%.1f, %.1f) does not fit the context: %s", kClientName,
+                        clients::describe(target).c_str(), p.x(), p.y(), v.reason.c_str());
+      continue;
+    }
+    if (!claims_.claim(p, t)) continue;
+    const double confidence =
+        clients::claimConfidence(1.0, v.relations_checked, v.relations_skipped);
+    detection_pub_.publish(makeDetection(kClientName, target, p, confidence, msg->header.stamp));
+    ROS_INFO("%s: claim: %s at (%.1f, %.1f), confidence %.2f (%s)", kClientName,
+             clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
+  }
+}
+
+void CoverageSearchClientRos::onTick(const ros::TimerEvent&) {
+  if (!mission_ || stopped_) return;
+  if (mission_->time_limit > 0 && missionTime() > mission_->time_limit) {
+    stop("the mission's time limit has passed");
+    return;
+  }
+  sendIfDue();
+}
+
+void CoverageSearchClientRos::stop(const std::string& why) {
+  if (stopped_) return;
+  stopped_ = true;
+  ROS_INFO("%s: stopping the search: %s", kClientName, why.c_str());
+  nav_msgs::Path path;
+  path.header.stamp = ros::Time::now();
+  path.header.frame_id = "map";
+  // Hover where the UAV is (an empty list when it is still on the ground: stay there).
+  if (odom_ && odom_->pose.pose.position.z > 1.0) {
+    const auto& p = odom_->pose.pose.position;
+    const double z = std::clamp(p.z, sim_.uav.altitude_min + 1.5, sim_.uav.altitude_max - 1.5);
+    path.poses.push_back(poseAt(geometry::Vec3(p.x, p.y, z), path.header.stamp));
+  }
+  waypoints_pub_.publish(path);
+}
+
+void CoverageSearchClientRos::publishPlan() {
+  nav_msgs::Path path;
+  path.header.stamp = ros::Time::now();
+  path.header.frame_id = "map";
+  for (const auto& leg : plan_.legs) {
+    for (const auto& w : leg.waypoints) {
+      path.poses.push_back(poseAt(w.position, ros::Time(std::max(0.0, w.eta + mission_start_))));
+    }
+  }
+  plan_pub_.publish(path);
+}
+
+}  // namespace hameritt::ros_wrappers

@@ -1,0 +1,208 @@
+// Context filter: description matching, the region gate, scene-relation checks against the
+// public map, and the claim ledger; on the shipped scenario, whose confusers must all be told
+// apart from its target by the context alone.
+#include "hameritt/clients/context_filter.h"
+
+#include <gtest/gtest.h>
+
+#include "hameritt/clients/claims.h"
+#include "hameritt/clients/public_config.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/mission_io.h"
+#include "hameritt/scenario/sim_config_io.h"
+
+namespace hameritt::clients {
+namespace {
+
+using geometry::Vec2;
+using geometry::Vec3;
+
+const char* kMission = "scenarios/default/mission.json";
+const char* kSimConfig = "scenarios/default/sim_config.json";
+
+class ContextFilterTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    mission_ = new scenario::Mission(scenario::loadMission(kMission));
+    world_ = new scenario::World(
+        scenario::generateCheckedWorld(loadPublicSimConfig(kSimConfig), kSimConfig));
+    // Ground truth, for the test's judgement only.
+    truth_ = new scenario::SimConfig(scenario::loadSimConfig(kSimConfig));
+  }
+  static void TearDownTestSuite() {
+    delete truth_;
+    delete world_;
+    delete mission_;
+  }
+
+  // A candidate at an entity's true pose, the heading known only up to pi (as from an image).
+  static CandidatePose at(const std::string& id) {
+    for (const auto& e : truth_->entities) {
+      if (e.entity.id != id) continue;
+      CandidatePose c;
+      c.position = e.entity.position();
+      c.yaw = e.entity.yaw() + geometry::kPi;
+      c.size = e.entity.box.size;
+      return c;
+    }
+    ADD_FAILURE() << id;
+    return {};
+  }
+
+  static const scenario::TargetDescription& target() { return mission_->objective.targets.front(); }
+
+  static scenario::Mission* mission_;
+  static scenario::World* world_;
+  static scenario::SimConfig* truth_;
+};
+scenario::Mission* ContextFilterTest::mission_ = nullptr;
+scenario::World* ContextFilterTest::world_ = nullptr;
+scenario::SimConfig* ContextFilterTest::truth_ = nullptr;
+
+TEST_F(ContextFilterTest, DescriptionsMatchAttributesCaseInsensitively) {
+  const Observation rav4{
+      "car", {{"vehicle_class", "suv"}, {"make", "Toyota"}, {"model", "RAV4"}, {"color", "White"}}};
+  EXPECT_TRUE(matchesDescription(rav4, target()));
+  Observation red = rav4;
+  red.attributes.back().second = "red";
+  EXPECT_FALSE(matchesDescription(red, target()));
+  EXPECT_FALSE(matchesDescription({"pedestrian", rav4.attributes}, target()));
+  scenario::TargetDescription any_white;
+  any_white.color = "white";
+  EXPECT_TRUE(matchesDescription(rav4, any_white));  // empty fields are wildcards
+  const ContextFilter filter(*mission_, world_);
+  EXPECT_EQ(filter.targetsMatching(rav4).size(), 1u);
+  EXPECT_TRUE(filter.targetsMatching(red).empty());
+  EXPECT_EQ(describe(target()), "white Toyota RAV4 (suv)");
+  EXPECT_TRUE(nominalSize(target()).isApprox(Vec3(4.6, 1.855, 1.685)));
+  scenario::TargetDescription some_sedan;
+  some_sedan.vehicle_class = "sedan";
+  EXPECT_NEAR(nominalSize(some_sedan).x(), 4.99, 0.05);
+}
+
+TEST_F(ContextFilterTest, TheTargetPassesInsideItsWindowOnly) {
+  const ContextFilter filter(*mission_, world_);
+  const ContextVerdict v = filter.check(at("car_706"), 100.0, target());
+  EXPECT_TRUE(v.accepted) << v.reason;
+  EXPECT_EQ(v.region_id, "aoi_1");
+  EXPECT_EQ(v.target_id, "car_706");
+  EXPECT_EQ(v.relations_checked, 6);  // PART_OF block, ON_TOP_OF, NOT_ON_TOP_OF, ORTHOGONAL_TO,
+  EXPECT_EQ(v.relations_skipped, 0);  // NEXT_TO, NOT_NEXT_TO: all on the public map
+  EXPECT_FALSE(filter.check(at("car_706"), 40.0, target()).accepted);   // before net 48
+  EXPECT_FALSE(filter.check(at("car_706"), 200.0, target()).accepted);  // after nlt 192
+  // A position estimate off by half a metre still passes.
+  CandidatePose off = at("car_706");
+  off.position += Vec3(0.4, -0.3, 0);
+  off.yaw += 0.08;
+  EXPECT_TRUE(filter.check(off, 100.0, target()).accepted);
+}
+
+TEST_F(ContextFilterTest, EveryConfuserOfTheScenarioIsRejected) {
+  const ContextFilter filter(*mission_, world_);
+  int confusers = 0;
+  for (const auto& e : truth_->entities) {
+    if (e.role != "confuser") continue;
+    ++confusers;
+    for (double t : {60.0, 150.0, 180.0, 300.0}) {
+      const ContextVerdict v = filter.check(at(e.entity.id), t, target());
+      EXPECT_FALSE(v.accepted) << e.entity.id << " at t=" << t << ": " << v.reason;
+    }
+  }
+  EXPECT_EQ(confusers, 4);
+}
+
+TEST_F(ContextFilterTest, RelationsThatCannotBeCheckedAreSkipped) {
+  scenario::Mission m = *mission_;
+  // Without the map nothing can be checked: the region gate alone decides.
+  {
+    const ContextFilter no_map(m, nullptr);
+    const ContextVerdict v = no_map.check(at("car_722"), 100.0, target());
+    EXPECT_TRUE(v.accepted);
+    EXPECT_EQ(v.relations_checked, 0);
+    EXPECT_EQ(v.relations_skipped, 6);
+  }
+  // A relation to a scenario entity (not on the map), an EVENTUALLY_ relation and a convoy group.
+  scenario::SceneRelation ped;
+  ped.related_id = "pedestrian_3";
+  ped.related_class = "pedestrian";
+  ped.op = scenario::RelationOp::kNextTo;
+  ped.target_id = "car_706";
+  scenario::SceneRelation later = ped;
+  later.related_id = "tree_638";
+  later.related_class = "tree";
+  later.eventually = true;
+  later.distance = 40.0;
+  scenario::SceneRelation convoy = ped;
+  convoy.related_id = "convoy_1";
+  convoy.related_class = "group";
+  convoy.op = scenario::RelationOp::kPartOf;
+  m.relations = {ped, later, convoy};
+  const ContextFilter filter(m, world_);
+  const ContextVerdict v = filter.check(at("car_706"), 100.0, target());
+  EXPECT_TRUE(v.accepted) << v.reason;
+  EXPECT_EQ(v.relations_skipped, 3);
+  // A moving target's relations (route search) describe t = 0 only: skipped.
+  scenario::Mission route = *mission_;
+  route.cls = scenario::ScenarioClass::kRouteSearch;
+  const ContextVerdict r = ContextFilter(route, world_).check(at("car_722"), 100.0, target());
+  EXPECT_TRUE(r.accepted) << r.reason;
+  EXPECT_EQ(r.relations_checked, 0);
+}
+
+TEST_F(ContextFilterTest, DirectionalRelationsUseTheBearingEvidence) {
+  // tree_638 is on the target's right (bearing 279.8): a RIGHT_OF relation holds for the target
+  // with either heading (ambiguous), a LEFT_OF at the same place holds only ambiguously and fails
+  // once the heading is known.
+  scenario::Mission m = *mission_;
+  scenario::SceneRelation right;
+  for (const auto& r : m.relations) {
+    if (r.op == scenario::RelationOp::kOrthogonalTo) right = r;
+  }
+  right.op = scenario::RelationOp::kRightOf;
+  scenario::SceneRelation left = right;
+  left.op = scenario::RelationOp::kLeftOf;
+  left.bearing_deg = geometry::wrapDeg360(right.bearing_deg + 180.0);
+  m.relations = {right};
+  CandidatePose known = at("car_706");
+  known.yaw -= geometry::kPi;  // the true heading
+  known.yaw_ambiguous = false;
+  EXPECT_TRUE(ContextFilter(m, world_).check(known, 100.0, target()).accepted);
+  m.relations = {left};
+  EXPECT_FALSE(ContextFilter(m, world_).check(known, 100.0, target()).accepted);
+  known.yaw_ambiguous = true;
+  EXPECT_TRUE(ContextFilter(m, world_).check(known, 100.0, target()).accepted);
+  ContextSettings bad;
+  bad.bearing_tolerance_deg = 200;
+  EXPECT_THROW(ContextFilter(m, world_, bad), scenario::ConfigError);
+}
+
+TEST(ClaimLedger, OneClaimPerPlaceUntilTheHoldExpires) {
+  ClaimLedger ledger(4.0, 30.0);
+  EXPECT_TRUE(ledger.claim(Vec3(0, 0, 0), 10.0));
+  EXPECT_FALSE(ledger.claim(Vec3(3, 0, 0), 12.0));
+  EXPECT_TRUE(ledger.isRepeat(Vec3(0, 3.9, 0), 39.0));
+  EXPECT_TRUE(ledger.claim(Vec3(5, 0, 0), 12.0));  // another place
+  EXPECT_TRUE(ledger.claim(Vec3(0, 0, 0), 40.0));  // the hold has expired
+  EXPECT_EQ(ledger.locations(), 2u);
+  ClaimLedger forever(4.0, 0.0);
+  EXPECT_TRUE(forever.claim(Vec3(0, 0, 0), 0.0));
+  EXPECT_FALSE(forever.claim(Vec3(0, 0, 0), 1e6));
+  EXPECT_THROW(ClaimLedger(-1.0, 1.0), scenario::ConfigError);
+}
+
+TEST(PublicSimConfig, HoldsTheMapAndTheUavButNoEntityOrGroundTruthPath) {
+  const scenario::SimConfig pub = loadPublicSimConfig(kSimConfig);
+  const scenario::SimConfig full = scenario::loadSimConfig(kSimConfig);
+  EXPECT_TRUE(pub.entities.empty());
+  EXPECT_TRUE(pub.groups.empty());
+  EXPECT_FALSE(pub.uav.perception_path.has_value());
+  ASSERT_FALSE(full.entities.empty());
+  EXPECT_EQ(pub.world_fingerprint, full.world_fingerprint);
+  EXPECT_EQ(pub.uav.cameras.size(), full.uav.cameras.size());
+  EXPECT_EQ(pub.uav.altitude_max, full.uav.altitude_max);
+  EXPECT_THROW(loadPublicSimConfig("no/such/sim_config.json"), scenario::ConfigError);
+  EXPECT_THROW(loadPublicSimConfig(kMission), scenario::ConfigError);
+}
+
+}  // namespace
+}  // namespace hameritt::clients

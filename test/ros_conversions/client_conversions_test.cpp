@@ -1,0 +1,140 @@
+// ROS message conversions of the baseline clients: the mission message both ways (every shipped
+// and test mission survives toMsg -> fromMsg byte for byte as mission.json), camera images and
+// intrinsics, claims, and the ADK state read from a message of any type. No ROS master needed.
+#include "hameritt/ros/client_conversions.h"
+
+#include <gtest/gtest.h>
+#include <std_msgs/String.h>
+
+#include <cmath>
+
+#include "hameritt/ros/mission_conversions.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/mission_io.h"
+#include "hameritt/scenario/scenario_io.h"
+
+namespace hameritt::ros_wrappers {
+namespace {
+
+TEST(MissionConversions, RoundTripKeepsEveryField) {
+  for (const char* file : {"scenarios/default/mission.json", "test/data/replan_mission.json"}) {
+    const scenario::Mission m = scenario::loadMission(file);
+    const hameritt::Mission msg = toMsg(m);
+    EXPECT_EQ(msg.scenario_class, scenario::toString(m.cls));
+    EXPECT_EQ(msg.areas_of_interest.size(), m.aois.size());
+    EXPECT_EQ(scenario::missionJson(fromMsg(msg)), scenario::missionJson(m)) << file;
+  }
+  // A route mission with an EVENTUALLY_ relation and an integer attribute.
+  scenario::Mission m = scenario::loadMission("scenarios/default/mission.json");
+  m.cls = scenario::ScenarioClass::kRouteSearch;
+  scenario::RouteOfInterest r;
+  r.id = "route_1";
+  r.polyline = {{0, 0}, {100, 0}};
+  r.streets = {"street_1"};
+  r.band_width = 40;
+  r.band = geometry::bufferPolyline(r.polyline, 40);
+  m.routes.push_back(r);
+  m.relations.back().eventually = true;
+  m.relations.back().time = 12.5;
+  const scenario::Mission back = fromMsg(toMsg(m));
+  ASSERT_EQ(back.routes.size(), 1u);
+  EXPECT_EQ(back.routes[0].band.vertices(), r.band.vertices());
+  EXPECT_TRUE(back.relations.back().eventually);
+  EXPECT_EQ(back.relations.back().time, 12.5);
+  EXPECT_EQ(back.relations.back().related_attributes.integer("storeys", -1), 2);
+}
+
+TEST(MissionConversions, BadMessagesAreConfigErrors) {
+  hameritt::Mission msg = toMsg(scenario::loadMission("scenarios/default/mission.json"));
+  msg.relations[1].op = "EVENTUALLY_ON_TOP_OF";  // the prefixed spelling is understood
+  EXPECT_TRUE(fromMsg(msg).relations[1].eventually);
+  msg.relations[1].op = "BESIDE";
+  EXPECT_THROW(fromMsg(msg), scenario::ConfigError);
+  msg = toMsg(scenario::loadMission("scenarios/default/mission.json"));
+  msg.scenario_class = "treasure_hunt";
+  EXPECT_THROW(fromMsg(msg), scenario::ConfigError);
+  msg = toMsg(scenario::loadMission("scenarios/default/mission.json"));
+  msg.keep_out_zones[0].polygon.resize(2);
+  EXPECT_THROW(fromMsg(msg), scenario::ConfigError);
+}
+
+TEST(ClientConversions, ImagesDepthAndIntrinsics) {
+  sensor_msgs::Image img;
+  img.width = 2;
+  img.height = 1;
+  img.encoding = "bgr8";
+  img.step = 8;  // padded rows
+  img.data = {1, 2, 3, 4, 5, 6, 0, 0};
+  cv::Mat rgb = rgbFromMsg(img);
+  EXPECT_EQ(rgb.at<cv::Vec3b>(0, 0), cv::Vec3b(3, 2, 1));
+  EXPECT_EQ(rgb.at<cv::Vec3b>(0, 1), cv::Vec3b(6, 5, 4));
+  img.encoding = "mono8";
+  EXPECT_THROW(rgbFromMsg(img), scenario::ConfigError);
+
+  sensor_msgs::Image depth;
+  depth.width = 2;
+  depth.height = 1;
+  depth.encoding = "16UC1";
+  depth.step = 4;
+  depth.data = {0xe8, 0x03, 0, 0};  // 1000 mm, none
+  const cv::Mat d = depthFromMsg(depth);
+  EXPECT_FLOAT_EQ(d.at<float>(0, 0), 1.0f);
+  EXPECT_TRUE(std::isinf(d.at<float>(0, 1)));
+  depth.data.resize(2);
+  EXPECT_THROW(depthFromMsg(depth), scenario::ConfigError);
+
+  sensor_msgs::CameraInfo info;
+  info.width = 640;
+  info.height = 480;
+  info.K = {500, 0, 319.5, 0, 501, 239.5, 0, 0, 1};
+  const clients::PinholeCamera c = fromMsg(info);
+  EXPECT_EQ(c.fx, 500);
+  EXPECT_EQ(c.fy, 501);
+  EXPECT_EQ(c.cx, 319.5);
+  EXPECT_EQ(c.cy, 239.5);
+  info.K[0] = 0;
+  EXPECT_THROW(fromMsg(info), scenario::ConfigError);
+}
+
+TEST(ClientConversions, ClaimsAndObservations) {
+  const scenario::Mission m = scenario::loadMission("scenarios/default/mission.json");
+  const auto& target = m.objective.targets.front();
+  const hameritt::Detection d =
+      makeDetection("me", target, geometry::Vec3(1, 2, 0), 0.75, ros::Time(12.5));
+  EXPECT_EQ(d.header.stamp.toSec(), 12.5);
+  EXPECT_EQ(d.header.frame_id, "map");
+  EXPECT_EQ(d.description, "white Toyota RAV4 (suv)");
+  EXPECT_EQ(d.entity_class, "car");
+  ASSERT_EQ(d.attributes.size(), 4u);
+  EXPECT_EQ(d.attributes[3].key, "color");
+  EXPECT_EQ(d.attributes[3].value, "white");
+  EXPECT_FLOAT_EQ(d.confidence, 0.75f);
+
+  hameritt::PerceivedEntity e;
+  e.entity_id = "car_706";
+  e.role = "target";
+  e.entity_class = "car";
+  for (const auto& a : d.attributes) e.attributes.push_back(a);
+  const clients::Observation o = toObservation(e);
+  EXPECT_TRUE(clients::matchesDescription(o, target));
+}
+
+TEST(ClientConversions, MissionStateFromAnyMessageType) {
+  std_msgs::String s;
+  s.data = "mission_ended";
+  std::vector<std::uint8_t> buf(ros::serialization::serializationLength(s));
+  ros::serialization::OStream out(buf.data(), static_cast<std::uint32_t>(buf.size()));
+  ros::serialization::serialize(out, s);
+  topic_tools::ShapeShifter shifter;
+  shifter.morph(ros::message_traits::md5sum(s), ros::message_traits::datatype(s),
+                ros::message_traits::definition(s), "0");
+  ros::serialization::IStream in(buf.data(), static_cast<std::uint32_t>(buf.size()));
+  shifter.read(in);
+  const auto r = readMissionState(shifter);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->state, "mission_ended");
+  EXPECT_TRUE(r->ended);
+}
+
+}  // namespace
+}  // namespace hameritt::ros_wrappers
