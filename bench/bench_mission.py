@@ -63,7 +63,7 @@ def main():
     mpath = os.path.join(out, "metrics.json")
     if os.path.exists(mpath):
         metrics = json.load(open(mpath))
-    sim_seconds = metrics.get("mission_time", args.sim_seconds)
+    sim_seconds = metrics.get("end_time", args.sim_seconds)
 
     with open(os.path.join(args.scenario, "sim_config.json")) as f:
         cfg = json.load(f)

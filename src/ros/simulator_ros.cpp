@@ -120,6 +120,21 @@ void SimulatorRos::publishStaticFrames() {
   static_tf_.sendTransform(frames);
 }
 
+void SimulatorRos::publishGroundTruth() {
+  ros::Time stamp;
+  stamp.fromSec(sim_->uav().t);
+  hameritt::EntityStateArray truth;
+  truth.header.stamp = stamp;
+  truth.header.frame_id = kMapFrame;
+  std::vector<geometry_msgs::TransformStamped> tfs;
+  for (const auto& e : sim_->scenarioEntities()) {
+    truth.entities.push_back(toMsg(e, stamp));
+    if (e.role != "static") tfs.push_back(toEntityTransform(e, stamp));
+  }
+  truth_pub_.publish(truth);
+  if (!tfs.empty()) tf_.sendTransform(tfs);
+}
+
 void SimulatorRos::publishState(bool force_ground_truth) {
   const sim::UavState& s = sim_->uav();
   ros::Time stamp;
@@ -129,18 +144,8 @@ void SimulatorRos::publishState(bool force_ground_truth) {
   clock_pub_.publish(clock);
   odom_pub_.publish(toOdometryMsg(s, stamp));
   imu_pub_.publish(toImuMsg(s, stamp));
-  std::vector<geometry_msgs::TransformStamped> tfs{toBaseTransform(s, stamp)};
-  if (force_ground_truth || step_count_ % steps_per_ground_truth_ == 0) {
-    hameritt::EntityStateArray truth;
-    truth.header.stamp = stamp;
-    truth.header.frame_id = kMapFrame;
-    for (const auto& e : sim_->scenarioEntities()) {
-      truth.entities.push_back(toMsg(e, stamp));
-      if (e.role != "static") tfs.push_back(toEntityTransform(e, stamp));
-    }
-    truth_pub_.publish(truth);
-  }
-  tf_.sendTransform(tfs);
+  tf_.sendTransform(toBaseTransform(s, stamp));
+  if (force_ground_truth) publishGroundTruth();
   if (s.crashed && !crash_reported_) {
     crash_reported_ = true;
     hameritt::CrashEvent ev;
@@ -162,6 +167,8 @@ void SimulatorRos::advance(int steps) {
     ++step_count_;
     if (cameras_) cameras_->afterStep(step_count_, sim_->uav());
     if (step_count_ % steps_per_publish_ == 0) publishState(false);
+    // Ground truth on its own schedule (its rate need not be a multiple of the publish rate).
+    if (step_count_ % steps_per_ground_truth_ == 0) publishGroundTruth();
   }
 }
 
@@ -177,8 +184,14 @@ void SimulatorRos::waitForSubscribers() {
   for (const auto& t : wait_for_) {
     if (subscribers(t) < 0) ROS_WARN("simulator: ~wait_for: %s is not a topic of this node; ignored", t.c_str());
   }
+  // Nodes that wait for a valid (non-zero) sim time before subscribing, such as rosbag record,
+  // would otherwise wait for us while we wait for them: announce t = 1 ns (the first step is
+  // still at t = dt, so the clock stays monotonic).
+  rosgraph_msgs::Clock tick;
+  tick.clock = ros::Time(0, 1);
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait_timeout_);
   while (ros::ok()) {
+    clock_pub_.publish(tick);
     std::string missing;
     for (const auto& t : wait_for_) {
       if (subscribers(t) == 0) missing += (missing.empty() ? "" : ", ") + t;

@@ -24,14 +24,17 @@ import rosbag
 out, src, limit = sys.argv[1], sys.argv[2], float(sys.argv[3])
 fails = []
 m = json.load(open(os.path.join(out, "metrics.json")))
-for key in ["scenario_id", "outcome", "mission_time", "koz_violations", "path_length", "flight_time",
-            "energy_wh", "aoi_coverage", "false_detections_confuser", "time_to_first_correct_detection"]:
+for key in ["scenario_id", "outcome", "end_time", "targets", "detections", "keep_out_zones", "flight",
+            "coverage", "time_to_first_correct_detection"]:
     if key not in m:
         fails.append("metrics.json lacks %s" % key)
-if m.get("outcome") not in ("success", "timeout"):
+if m.get("outcome") not in ("succeeded", "timeout"):
     fails.append("outcome %r" % m.get("outcome"))
-if m.get("path_length", 0) <= 1.0:
-    fails.append("the UAV did not fly (path_length %r)" % m.get("path_length"))
+flight = m.get("flight", {})
+if flight.get("path_length", 0) <= 20.0 or flight.get("energy", 0) <= 0:
+    fails.append("the UAV did not fly (flight %r)" % flight)
+if m.get("keep_out_zones", {}).get("violation_count", -1) != 0:
+    fails.append("keep-out violations: %r" % m.get("keep_out_zones"))
 bag_path = os.path.join(out, "mission.bag")
 if not os.path.exists(bag_path):
     fails.append("no mission.bag (left: %s)" % os.listdir(out))
@@ -39,7 +42,7 @@ else:
     bag = rosbag.Bag(bag_path)
     topics = {t: v.message_count for t, v in bag.get_type_and_topic_info().topics.items()}
     cfg = json.load(open(os.path.join(src, "scenarios/default/sim_config.json")))
-    t_end = min(limit, m.get("mission_time", limit))
+    t_end = min(limit, m.get("end_time", limit))
     need = {"/uav/odom": 200 * t_end, "/tf": 200 * t_end, "/mission": 1, "/ground_truth/entities": 15 * t_end}
     for cam in cfg["uav"]["payload"]["cameras"]:
         n = math.floor(t_end * cam["rate_hz"] + 1e-9)
@@ -59,7 +62,9 @@ else:
             fails.append("bad depth image: %s %dx%d %d bytes" % (msg.encoding, msg.width, msg.height, len(msg.data)))
         break
     bag.close()
-print(json.dumps({k: m.get(k) for k in ["outcome", "mission_time", "path_length", "aoi_coverage"]}))
+print(json.dumps({"outcome": m.get("outcome"), "end_time": m.get("end_time"),
+                  "path_length": m.get("flight", {}).get("path_length"),
+                  "coverage": m.get("coverage", {}).get("prior_weighted")}))
 if fails:
     print("FAIL:\n  " + "\n  ".join(fails)); sys.exit(1)
 print("PASS: mission ran end to end; metrics.json and the bag are complete")

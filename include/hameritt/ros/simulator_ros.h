@@ -44,6 +44,7 @@ class SimulatorRos {
   void waitForSubscribers();
   int subscribers(const std::string& topic) const;
   void publishState(bool force_ground_truth);
+  void publishGroundTruth();
   void publishStaticFrames();
   void onVelocity(const geometry_msgs::Twist::ConstPtr& msg);
   void onPose(const geometry_msgs::PoseStamped::ConstPtr& msg);
