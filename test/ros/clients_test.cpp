@@ -114,7 +114,7 @@ TEST(Clients, CoverageSearchReachesTheFirstAreaAndSweepsItThroughThePlanner) {
   // Until 100 s of mission time: aoi_1 opens at 48 s and lies ~500 m away.
   const auto& aoi = o.mission_.aois.front();
   ASSERT_EQ(aoi.id, "aoi_1");
-  o.spinUntil([&] { return !o.flight.empty() && o.flight.back().t >= 100.0; }, 75.0);
+  o.spinUntil([&] { return !o.flight.empty() && o.flight.back().t >= 100.0; }, 100.0);
   ASSERT_FALSE(o.flight.empty());
   EXPECT_GE(o.flight.back().t, 100.0) << "sim time did not get far enough";
 
