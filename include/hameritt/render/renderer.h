@@ -50,6 +50,11 @@ Intrinsics intrinsicsFromHfov(int width, int height, double hfov_deg);
 Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Eigen::Vector3d& mount_xyz,
                               const Eigen::Vector3d& mount_rpy);
 
+// Pixel (u, v) where a world point appears in a camera at world_T_optical with intrinsics k
+// (u = fx X / Z + cx, v = fy Y / Z + cy in the optical frame); false when Z <= 0.
+bool projectPoint(const Intrinsics& k, const Eigen::Isometry3d& world_T_optical,
+                  const Eigen::Vector3d& p_world, Eigen::Vector2d* uv);
+
 struct RenderRequest {
   Intrinsics intrinsics;
   Eigen::Isometry3d world_T_optical = Eigen::Isometry3d::Identity();
