@@ -147,7 +147,7 @@ constexpr ParticleLayer kSnowLayers[] = {
 
 struct Uniforms {
   GLint view_proj, camera, canopy_center, near_clip, far_clip, sun_dir, sun_color, sky_ambient,
-      ground_ambient, snow, wet, haze_color, haze_k;
+      ground_ambient, snow, wet, haze_color, haze_k, world_R_optical, intrinsics;
 };
 
 }  // namespace
@@ -207,7 +207,7 @@ struct Renderer::Impl {
          loc("u_near"),        loc("u_far"),            loc("u_sun_dir"),
          loc("u_sun_color"),   loc("u_sky_ambient"),    loc("u_ground_ambient"),
          loc("u_snow"),        loc("u_wet"),            loc("u_haze_color"),
-         loc("u_haze_k")};
+         loc("u_haze_k"),      loc("u_world_R_optical"), loc("u_intrinsics")};
 
     // All meshes in one vertex and one element buffer.
     std::vector<Vertex> vertices;
@@ -601,6 +601,11 @@ struct Renderer::Impl {
     glProgramUniform1f(p, u.wet, l.wetness);
     glProgramUniform3fv(p, u.haze_color, 1, l.haze_color.data());
     glProgramUniform1f(p, u.haze_k, l.haze_k);
+    const Eigen::Matrix3f rot = r.world_T_optical.linear().cast<float>();
+    glProgramUniformMatrix3fv(p, u.world_R_optical, 1, GL_FALSE, rot.data());
+    const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
+                           static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
+    glProgramUniform4fv(p, u.intrinsics, 1, intr);
   }
 
   // Draws model m's instances [base, base + count) of the bound instance-index buffer: one
