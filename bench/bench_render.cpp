@@ -1,9 +1,10 @@
 // Renderer throughput on the shipped default scenario: both payload cameras (front and down,
 // 640 x 480) rendered at UAV poses along the scenario's perception path, everything read back
 // (RGB, depth, labels split into semantic and instance, boxes with occlusion). Prints frame
-// sets per second (one frame set = every payload camera once), then the time per stage from a
-// second run that waits for the GL at the end of each stage, the GL renderer, and the triangles
-// and instances drawn per frame.
+// sets per second (one frame set = every payload camera once) rendered as one batch
+// (Renderer::render(vector)) and as one render() call per camera, the CPU time per frame set,
+// then the time per stage from a run that waits for the GL at the end of each stage, the GL
+// renderer, and the triangles and instances drawn per frame.
 //
 // Usage: bench_render [frame_sets] [--backend auto|surfaceless|device]
 
@@ -15,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include "hameritt/render/renderer.h"
 #include "hameritt/scenario/sim_config_io.h"
 
@@ -24,6 +27,14 @@ namespace scenario = hameritt::scenario;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// CPU time of the process (all threads), seconds.
+double cpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 struct Stages {
   double cull = 0, draw = 0, post = 0, readback = 0, boxes = 0;
@@ -93,61 +104,59 @@ int main(int argc, char** argv) {
 
   std::vector<render::FrameSet> out(cfg.uav.cameras.size());
   const int warmup = 5;
-  for (int pass = 0; pass < 2; ++pass) {
+  const char* kModes[] = {"batched: render(vector) per frame set", "one render() per camera",
+                          "stage timing"};
+  for (int mode = 0; mode < 3; ++mode) {
     render::RendererOptions opt;
     opt.backend = backend;
-    opt.stage_timing = pass == 1;
+    opt.stage_timing = mode == 2;
     const auto c0 = Clock::now();
     render::Renderer r(world, cfg, opt);
     const double setup_ms = std::chrono::duration<double, std::milli>(Clock::now() - c0).count();
-    if (pass == 0) {
+    if (mode == 0) {
       std::printf("GL_RENDERER: %s (EGL %s), renderer set-up %.0f ms\n", r.glRenderer().c_str(),
                   r.eglBackend().c_str(), setup_ms);
     }
-    for (int i = 0; i < warmup; ++i) {
-      const auto reqs = frameSet(cfg, i * 7, frames);
-      for (std::size_t c = 0; c < reqs.size(); ++c) r.render(reqs[c], &out[c]);
-    }
-    std::vector<Stages> per_camera(cfg.uav.cameras.size());
-    const auto t0 = Clock::now();
-    for (int i = 0; i < frames; ++i) {
-      const auto reqs = frameSet(cfg, i, frames);
+    auto run = [&](const std::vector<render::RenderRequest>& reqs, std::vector<Stages>* st) {
+      if (mode == 0) {
+        r.render(reqs, &out);
+        return;
+      }
       for (std::size_t c = 0; c < reqs.size(); ++c) {
         r.render(reqs[c], &out[c]);
+        if (st == nullptr) continue;
         const auto& s = r.lastStats();
-        Stages& st = per_camera[c];
-        st.cull += s.cull_upload_ms;
-        st.draw += s.draw_ms;
-        st.post += s.post_ms;
-        st.readback += s.readback_ms;
-        st.boxes += s.boxes_ms;
-        st.triangles += static_cast<double>(s.triangles);
-        st.instances += static_cast<double>(s.instances);
-        st.boxes_count += static_cast<double>(out[c].boxes.size());
+        Stages& x = (*st)[c];
+        x.cull += s.cull_upload_ms;
+        x.draw += s.draw_ms;
+        x.post += s.post_ms;
+        x.readback += s.readback_ms;
+        x.boxes += s.boxes_ms;
+        x.triangles += static_cast<double>(s.triangles);
+        x.instances += static_cast<double>(s.instances);
+        x.boxes_count += static_cast<double>(out[c].boxes.size());
       }
-    }
+    };
+    for (int i = 0; i < warmup; ++i) run(frameSet(cfg, i * 7, frames), nullptr);
+    std::vector<Stages> per_camera(cfg.uav.cameras.size());
+    const double cpu0 = cpuSeconds();
+    const auto t0 = Clock::now();
+    for (int i = 0; i < frames; ++i) run(frameSet(cfg, i, frames), &per_camera);
     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-    if (pass == 0) {
-      std::printf("\n%d frame sets in %.2f s: %.1f frame sets/s (%.1f ms per frame set)\n", frames,
-                  wall, frames / wall, 1e3 * wall / frames);
-      for (std::size_t c = 0; c < per_camera.size(); ++c) {
-        const Stages& st = per_camera[c];
-        std::printf("  %-6s %7.0f triangles, %5.0f instances, %4.1f boxes per frame\n",
-                    cfg.uav.cameras[c].name.c_str(), st.triangles / frames, st.instances / frames,
-                    st.boxes_count / frames);
-      }
-    } else {
-      std::printf("\nstage breakdown (GL finished at each stage end; %.1f frame sets/s in this "
-                  "mode), ms per frame:\n",
-                  frames / wall);
-      std::printf("  %-6s %12s %8s %8s %10s %8s %8s\n", "camera", "cull/upload", "draw", "post",
-                  "readback", "boxes", "total");
+    const double cpu = cpuSeconds() - cpu0;
+    std::printf("\n%s: %d frame sets in %.2f s: %.1f frame sets/s (%.1f ms wall, %.1f ms CPU "
+                "per frame set)\n",
+                kModes[mode], frames, wall, frames / wall, 1e3 * wall / frames, 1e3 * cpu / frames);
+    if (mode == 2) {
+      std::printf("  per frame (ms):  %12s %8s %8s %10s %8s %8s | %9s %9s %6s\n", "cull/upload",
+                  "draw", "post", "readback", "boxes", "total", "triangles", "instances", "boxes");
       for (std::size_t c = 0; c < per_camera.size(); ++c) {
         const Stages& st = per_camera[c];
         const double total = st.cull + st.draw + st.post + st.readback + st.boxes;
-        std::printf("  %-6s %12.2f %8.2f %8.2f %10.2f %8.2f %8.2f\n",
+        std::printf("  %-16s %12.2f %8.2f %8.2f %10.2f %8.2f %8.2f | %9.0f %9.0f %6.1f\n",
                     cfg.uav.cameras[c].name.c_str(), st.cull / frames, st.draw / frames,
-                    st.post / frames, st.readback / frames, st.boxes / frames, total / frames);
+                    st.post / frames, st.readback / frames, st.boxes / frames, total / frames,
+                    st.triangles / frames, st.instances / frames, st.boxes_count / frames);
       }
     }
   }

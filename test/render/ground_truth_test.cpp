@@ -368,6 +368,41 @@ TEST(RenderGroundTruth, SameRequestGivesTheSameFrameByteForByte) {
   }
 }
 
+TEST(RenderGroundTruth, BatchOfRequestsEqualsOneRenderEach) {
+  Renderer& r = defaultRenderer();
+  const auto& cfg = defaultSimConfig();
+  std::vector<RenderRequest> reqs;
+  for (double t : {30.0, 60.0}) {
+    const auto p = scenario::sampleTrajectory(cfg.uav.perception_path->trajectory, t);
+    for (int c = 0; c < 2; ++c) {
+      RenderRequest q = cameraRequest(cfg.uav.cameras[static_cast<std::size_t>(c)],
+                                      uavPose(p.x, p.y, p.z, p.yaw), t);
+      q.camera_index = c;
+      q.frame_index = static_cast<std::uint64_t>(t);
+      reqs.push_back(q);
+    }
+  }
+  reqs[1].hidden_entities = {"car_706"};
+  reqs[2].intrinsics = intrinsicsFromHfov(200, 100, 80);  // another size in the same batch
+  std::vector<FrameSet> batch;
+  r.render(reqs, &batch);
+  ASSERT_EQ(batch.size(), reqs.size());
+  for (std::size_t i = 0; i < reqs.size(); ++i) {
+    const FrameSet one = r.render(reqs[i]);
+    EXPECT_EQ(batch[i].rgb, one.rgb) << i;
+    EXPECT_EQ(std::memcmp(batch[i].depth.data(), one.depth.data(), one.depth.size() * sizeof(float)), 0) << i;
+    EXPECT_EQ(batch[i].instance, one.instance) << i;
+    ASSERT_EQ(batch[i].boxes.size(), one.boxes.size()) << i;
+    for (std::size_t k = 0; k < one.boxes.size(); ++k) {
+      EXPECT_EQ(batch[i].boxes[k].instance, one.boxes[k].instance);
+      EXPECT_EQ(batch[i].boxes[k].visible_pixels, one.boxes[k].visible_pixels);
+      EXPECT_EQ(batch[i].boxes[k].total_pixels, one.boxes[k].total_pixels);
+    }
+    EXPECT_EQ(batch[i].time, reqs[i].time);
+  }
+  EXPECT_EQ(std::count(batch[1].instance.begin(), batch[1].instance.end(), r.instanceOf("car_706")), 0);
+}
+
 TEST(RenderGroundTruth, SceneTrianglesCarryValidInstances) {
   Renderer& r = defaultRenderer();
   const SceneTriangles& t = caster().triangles();

@@ -112,7 +112,8 @@ struct RendererOptions {
   bool stage_timing = false;
 };
 
-// What the last render() did and where its time went (milliseconds of wall time).
+// What the last render() call did and where its time went (milliseconds of wall time; summed
+// over the requests of a batch).
 struct RenderStats {
   double cull_upload_ms = 0;  // frustum culling, instance upload
   double draw_ms = 0;         // geometry pass (with stage_timing: until the GL has finished it)
@@ -144,6 +145,10 @@ class Renderer {
   // Renders one frame set and reads it back; `out`'s buffers are reused.
   void render(const RenderRequest& request, FrameSet* out);
   FrameSet render(const RenderRequest& request);
+  // Renders several requests (e.g. every camera of one instant) into out[i], the same as one
+  // render() each, faster: the GL rasterizes one request while the CPU prepares the next and
+  // applies the camera effects of another. `out`'s buffers are reused.
+  void render(const std::vector<RenderRequest>& requests, std::vector<FrameSet>* out);
 
   // Makes the EGL context current on the calling thread (render() from another thread; render()
   // also does it when needed). The thread that had it must call releaseCurrent() first.
