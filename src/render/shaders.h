@@ -83,6 +83,8 @@ uniform vec3 u_ground_ambient;
 uniform float u_snow;
 uniform float u_wet;
 uniform vec3 u_camera;
+uniform vec3 u_air_color;  // aerial perspective: clear air fades far surfaces to the horizon
+uniform float u_air_k;
 uniform mat3 u_world_R_optical;
 uniform vec4 u_intrinsics;  // fx, fy, cx, cy
 
@@ -149,7 +151,9 @@ void main() {
   float ndl = max(dot(n, u_sun_dir), 0.0);
   vec3 hemi = mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
   vec3 c = albedo * (u_sun_color * ndl + hemi);
-  c = haze(c, depth * length(ray));
+  float distance = depth * length(ray);
+  c = mix(u_air_color, c, exp(-u_air_k * distance));
+  c = haze(c, distance);
   o_color = vec4(toDisplay(c), 1.0);
   o_depth = depth;
   o_label = v_ids.y;
