@@ -130,9 +130,8 @@ struct Plane {
 // The render targets of one image size.
 struct Targets {
   int width = 0, height = 0;
-  GLuint fbo = 0, color = 0, depth = 0, labels = 0, zbuffer = 0;
+  GLuint fbo = 0, color = 0, depth_labels = 0, zbuffer = 0;
   GLuint particle_fbo = 0;  // the colour target alone, for blending particles onto it
-  GLuint occlusion_fbo = 0;
 };
 
 // A layer of weather particles (sizes in pixels at 640 px image width).
@@ -174,7 +173,6 @@ struct Frame {
   std::vector<GpuInstance> upload;
   std::vector<std::uint8_t> color;    // read-back colour before the camera effects
   std::vector<std::pair<int, BoxAcc>> touched;  // instances of interest in the mask
-  std::vector<GLuint> queries;
   RenderStats stats;
 };
 
@@ -204,7 +202,6 @@ struct Renderer::Impl {
     for (auto& f : frames) {
       for (auto& t : f->target_cache) deleteTargets(&t);
       glDeleteBuffers(1, &f->instance_buffer);
-      if (!f->queries.empty()) glDeleteQueries(static_cast<GLsizei>(f->queries.size()), f->queries.data());
     }
     glDeleteProgram(geometry_program);
     glDeleteProgram(sky_program);
@@ -382,9 +379,10 @@ struct Renderer::Impl {
     while (frames.size() <= i) {
       auto f = std::make_unique<Frame>();
       glCreateBuffers(1, &f->instance_buffer);
+      // The culled instances, then the groups of entities drawn alone for their boxes.
       glNamedBufferStorage(f->instance_buffer,
-                           static_cast<GLsizeiptr>(records.size() * sizeof(GpuInstance)), nullptr,
-                           GL_DYNAMIC_STORAGE_BIT);
+                           static_cast<GLsizeiptr>(2 * records.size() * sizeof(GpuInstance)),
+                           nullptr, GL_DYNAMIC_STORAGE_BIT);
       f->slot.assign(records.size(), -1);
       f->upload.reserve(records.size());
       f->uploaded.reserve(records.size());
@@ -413,29 +411,21 @@ struct Renderer::Impl {
     t.height = h;
     glCreateTextures(GL_TEXTURE_2D, 1, &t.color);
     glTextureStorage2D(t.color, 1, GL_RGBA8, w, h);
-    glCreateTextures(GL_TEXTURE_2D, 1, &t.depth);
-    glTextureStorage2D(t.depth, 1, GL_R32F, w, h);
-    glCreateTextures(GL_TEXTURE_2D, 1, &t.labels);
-    glTextureStorage2D(t.labels, 1, GL_R32UI, w, h);
+    // Depth (float bits) and label in one target: one store per pixel less than two targets.
+    glCreateTextures(GL_TEXTURE_2D, 1, &t.depth_labels);
+    glTextureStorage2D(t.depth_labels, 1, GL_RG32UI, w, h);
     glCreateRenderbuffers(1, &t.zbuffer);
     glNamedRenderbufferStorage(t.zbuffer, GL_DEPTH_COMPONENT32F, w, h);
     glCreateFramebuffers(1, &t.fbo);
     glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT0, t.color, 0);
-    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT1, t.depth, 0);
-    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT2, t.labels, 0);
+    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT1, t.depth_labels, 0);
     glNamedFramebufferRenderbuffer(t.fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.zbuffer);
-    const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-    glNamedFramebufferDrawBuffers(t.fbo, 3, bufs);
+    const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(t.fbo, 2, bufs);
     glCreateFramebuffers(1, &t.particle_fbo);
     glNamedFramebufferTexture(t.particle_fbo, GL_COLOR_ATTACHMENT0, t.color, 0);
     glNamedFramebufferDrawBuffer(t.particle_fbo, GL_COLOR_ATTACHMENT0);
-    // Occlusion counting reuses the depth buffer once the geometry pass has been read back.
-    glCreateFramebuffers(1, &t.occlusion_fbo);
-    glNamedFramebufferRenderbuffer(t.occlusion_fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                                   t.zbuffer);
-    glNamedFramebufferDrawBuffer(t.occlusion_fbo, GL_NONE);
-    glNamedFramebufferReadBuffer(t.occlusion_fbo, GL_NONE);
-    for (GLuint fb : {t.fbo, t.particle_fbo, t.occlusion_fbo}) {
+    for (GLuint fb : {t.fbo, t.particle_fbo}) {
       if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         deleteTargets(&t);
         throw RenderError("GL: incomplete framebuffer for " + std::to_string(w) + " x " +
@@ -448,11 +438,11 @@ struct Renderer::Impl {
   }
 
   static void deleteTargets(Targets* t) {
-    GLuint tex[] = {t->color, t->depth, t->labels};
-    glDeleteTextures(3, tex);
+    GLuint tex[] = {t->color, t->depth_labels};
+    glDeleteTextures(2, tex);
     glDeleteRenderbuffers(1, &t->zbuffer);
-    GLuint fbos[] = {t->fbo, t->particle_fbo, t->occlusion_fbo};
-    glDeleteFramebuffers(3, fbos);
+    GLuint fbos[] = {t->fbo, t->particle_fbo};
+    glDeleteFramebuffers(2, fbos);
     *t = Targets{};
   }
 
@@ -702,12 +692,7 @@ struct Renderer::Impl {
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
-    const float black[4] = {0, 0, 0, 1};
-    const float inf[4] = {std::numeric_limits<float>::infinity(), 0, 0, 0};
-    const GLuint none[4] = {0, 0, 0, 0};
-    glClearNamedFramebufferfv(t.fbo, GL_COLOR, 0, black);
-    glClearNamedFramebufferfv(t.fbo, GL_COLOR, 1, inf);
-    glClearNamedFramebufferuiv(t.fbo, GL_COLOR, 2, none);
+    // Only the depth buffer is cleared: the sky pass writes every pixel that no geometry covers.
     const float zero = 0.0f;
     glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &zero);
 
@@ -837,7 +822,7 @@ struct Renderer::Impl {
     out->depth.resize(n);
     out->semantic.resize(n);
     out->instance.resize(n);
-    label_scratch.resize(n);
+    label_scratch.resize(2 * n);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     std::uint8_t* color = out->rgb.data();
@@ -847,24 +832,24 @@ struct Renderer::Impl {
     }
     glReadPixels(0, 0, t.width, t.height, GL_RGB, GL_UNSIGNED_BYTE, color);
     glReadBuffer(GL_COLOR_ATTACHMENT1);
-    glReadPixels(0, 0, t.width, t.height, GL_RED, GL_FLOAT, out->depth.data());
-    glReadBuffer(GL_COLOR_ATTACHMENT2);
-    glReadPixels(0, 0, t.width, t.height, GL_RED_INTEGER, GL_UNSIGNED_INT, label_scratch.data());
+    glReadPixels(0, 0, t.width, t.height, GL_RG_INTEGER, GL_UNSIGNED_INT, label_scratch.data());
     checkGl("read back");
   }
 
-  // Splits the labels and grows the boxes of the instances of interest in the same pass.
+  // Splits depth and labels and grows the boxes of the instances of interest in the same pass.
   void splitLabels(Frame& f) {
     FrameSet* out = f.out;
     const int width = f.targets->width;
     touched.clear();
-    const std::size_t n = label_scratch.size();
+    const std::size_t n = label_scratch.size() / 2;
     const std::uint32_t* src = label_scratch.data();
+    float* depth = out->depth.data();
     std::uint8_t* sem = out->semantic.data();
     std::uint16_t* ins = out->instance.data();
     const std::size_t n_ids = interest.size();
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t v = src[i];
+      std::memcpy(&depth[i], &src[2 * i], sizeof(float));
+      const std::uint32_t v = src[2 * i + 1];
       const std::uint32_t id = v & 0xFFFFu;
       sem[i] = static_cast<std::uint8_t>(v >> 16);
       ins[i] = static_cast<std::uint16_t>(id);
@@ -921,59 +906,104 @@ struct Renderer::Impl {
     return {x0, y0, x1 - x0, y1 - y0};
   }
 
-  // total_pixels: each entity with a visible pixel is drawn alone (scissored to its projected
-  // rectangle): a depth pass, then a GL_EQUAL pass counted by an occlusion query. Same program,
-  // same vertices, same rasterization as the geometry pass, so visible <= total exactly.
-  void submitBoxQueries(Frame& f) {
+  // total_pixels: the entities with a visible pixel are drawn again without the rest of the
+  // scene, in groups whose projected rectangles do not overlap (so that no member can cover
+  // another), and their labels are counted inside their rectangles. Same program, instance data
+  // and rasterization as the geometry pass, so the visible pixels are a subset of these.
+  void boxes(Frame& f) {
+    FrameSet* out = f.out;
+    out->boxes.clear();
     if (f.touched.empty()) return;
     const Targets& t = *f.targets;
-    if (f.queries.size() < f.touched.size()) {
-      const std::size_t old = f.queries.size();
-      f.queries.resize(f.touched.size());
-      glCreateQueries(GL_SAMPLES_PASSED, static_cast<GLsizei>(f.touched.size() - old),
-                      f.queries.data() + old);
+    // Greedy grouping by rectangle overlap.
+    const std::size_t n = f.touched.size();
+    box_rect.resize(n);
+    box_group.assign(n, -1);
+    box_total.assign(n, 0);
+    int groups = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+      box_rect[a] = projectedRect(f, scene.instances()[rec].model, f.slot[rec]);
+      for (int g = 0; g <= groups && box_group[a] < 0; ++g) {
+        bool free = true;
+        for (std::size_t b = 0; b < a && free; ++b) {
+          if (box_group[b] != g) continue;
+          const auto& p = box_rect[a];
+          const auto& q = box_rect[b];
+          free = p[0] + p[2] <= q[0] || q[0] + q[2] <= p[0] || p[1] + p[3] <= q[1] || q[1] + q[3] <= p[1];
+        }
+        if (free) box_group[a] = g;
+      }
+      groups = std::max(groups, box_group[a] + 1);
     }
     setFrameUniforms(f);
-    glBindFramebuffer(GL_FRAMEBUFFER, t.occlusion_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glViewport(0, 0, t.width, t.height);
     glUseProgram(geometry_program);
     glBindVertexArray(vao);
     glVertexArrayVertexBuffer(vao, 1, f.instance_buffer, 0, sizeof(GpuInstance));
-    glEnable(GL_SCISSOR_TEST);
-    glEnable(GL_DEPTH_TEST);
-    const float zero = 0.0f;
-    RenderStats scratch;
-    for (std::size_t q = 0; q < f.touched.size(); ++q) {
-      const int id = f.touched[q].first;
-      const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(id)]);
-      const int model = scene.instances()[rec].model;
-      const int slot = f.slot[rec];  // drawn, so uploaded this frame
-      const auto rect = projectedRect(f, model, slot);
-      glScissor(rect[0], rect[1], rect[2], rect[3]);
-      glDepthMask(GL_TRUE);
-      glClearNamedFramebufferfv(t.occlusion_fbo, GL_DEPTH, 0, &zero);
-      glDepthFunc(GL_GREATER);
-      drawModel(model, static_cast<GLuint>(slot), 1, &scratch);
-      glDepthMask(GL_FALSE);
-      glDepthFunc(GL_EQUAL);
-      glBeginQuery(GL_SAMPLES_PASSED, f.queries[q]);
-      drawModel(model, static_cast<GLuint>(slot), 1, &scratch);
-      glEndQuery(GL_SAMPLES_PASSED);
-    }
     glDisable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
-    f.stats.draw_calls += scratch.draw_calls;
-  }
-
-  void collectBoxes(Frame& f) {
-    FrameSet* out = f.out;
-    out->boxes.clear();
-    out->boxes.reserve(f.touched.size());
-    for (std::size_t q = 0; q < f.touched.size(); ++q) {
-      const auto& [id, acc] = f.touched[q];
-      GLuint total = 0;
-      glGetQueryObjectuiv(f.queries[q], GL_QUERY_RESULT, &total);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    const GLuint none[4] = {0, 0, 0, 0};
+    const float zero = 0.0f;
+    const int models = static_cast<int>(scene.models().size());
+    for (int g = 0; g < groups; ++g) {
+      // The group's instances, by model, after the frame's culled ones.
+      box_upload.clear();
+      group_base.assign(static_cast<std::size_t>(models), 0);
+      group_count.assign(static_cast<std::size_t>(models), 0);
+      int x0 = t.width, y0 = t.height, x1 = 0, y1 = 0;
+      for (int m = 0; m < models; ++m) {
+        group_base[static_cast<std::size_t>(m)] = static_cast<GLuint>(f.upload.size() + box_upload.size());
+        for (std::size_t a = 0; a < n; ++a) {
+          if (box_group[a] != g) continue;
+          const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+          if (scene.instances()[rec].model != m) continue;
+          box_upload.push_back(f.upload[static_cast<std::size_t>(f.slot[rec])]);
+          ++group_count[static_cast<std::size_t>(m)];
+          const auto& r = box_rect[a];
+          x0 = std::min(x0, r[0]);
+          y0 = std::min(y0, r[1]);
+          x1 = std::max(x1, r[0] + r[2]);
+          y1 = std::max(y1, r[1] + r[3]);
+        }
+      }
+      glNamedBufferSubData(f.instance_buffer,
+                           static_cast<GLintptr>(f.upload.size() * sizeof(GpuInstance)),
+                           static_cast<GLsizeiptr>(box_upload.size() * sizeof(GpuInstance)),
+                           box_upload.data());
+      glClearNamedFramebufferuiv(t.fbo, GL_COLOR, 1, none);
+      glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &zero);
+      RenderStats counted;  // RenderStats::triangles counts the geometry pass only
+      for (int m = 0; m < models; ++m) {
+        const GLsizei c = group_count[static_cast<std::size_t>(m)];
+        if (c > 0) drawModel(m, group_base[static_cast<std::size_t>(m)], c, &counted);
+      }
+      f.stats.draw_calls += counted.draw_calls;
+      // Count each member's label inside its own rectangle.
+      if (x1 <= x0 || y1 <= y0) continue;
+      const int w = x1 - x0, h = y1 - y0;
+      box_labels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+      glReadPixels(x0, y0, w, h, GL_GREEN_INTEGER, GL_UNSIGNED_INT, box_labels.data());
+      for (std::size_t a = 0; a < n; ++a) {
+        if (box_group[a] != g) continue;
+        const auto id = static_cast<std::uint32_t>(f.touched[a].first);
+        const auto& r = box_rect[a];
+        int count = 0;
+        for (int y = r[1]; y < r[1] + r[3]; ++y) {
+          const std::uint32_t* row = box_labels.data() + static_cast<std::size_t>(y - y0) * static_cast<std::size_t>(w);
+          for (int x = r[0]; x < r[0] + r[2]; ++x) count += (row[x - x0] & 0xFFFFu) == id ? 1 : 0;
+        }
+        box_total[a] = count;
+      }
+    }
+    out->boxes.reserve(n);
+    for (std::size_t a = 0; a < n; ++a) {
+      const auto& [id, acc] = f.touched[a];
       const int rec = instance_record[static_cast<std::size_t>(id)];
       const SceneInstance& si = scene.instances()[static_cast<std::size_t>(rec)];
       BoundingBox b;
@@ -990,19 +1020,19 @@ struct Renderer::Impl {
       b.x_max = acc.x_max;
       b.y_max = acc.y_max;
       b.visible_pixels = acc.count;
-      // The counted coverage holds the visible pixels; max() only guards a driver that breaks
-      // the invariance the GL promises.
-      b.total_pixels = std::max(static_cast<int>(total), acc.count);
+      // The coverage holds the visible pixels; max() only guards a driver that breaks the
+      // invariance the GL promises.
+      b.total_pixels = std::max(box_total[a], acc.count);
       b.occlusion = 1.0 - static_cast<double>(b.visible_pixels) / b.total_pixels;
       out->boxes.push_back(std::move(b));
     }
     checkGl("boxes");
   }
 
-  // Renders the requests in three phases so that the CPU and the GL overlap: every geometry
-  // pass is submitted first (the GL rasterizes one while the next is culled and its vertices
-  // processed), then each frame is read back and its box queries submitted, then the camera
-  // effects run on the CPU while the GL counts the boxes.
+  // Renders the requests in phases so that the CPU and the GL overlap: every geometry pass is
+  // submitted first (the GL rasterizes one while the next is culled and its vertices
+  // processed), then each frame is read back, then the camera effects of each run on the CPU
+  // (while the GL still works on later frames), then the boxes.
   void render(const std::vector<const RenderRequest*>& requests, const std::vector<FrameSet*>& outs) {
     egl.makeCurrent();
     for (const RenderRequest* r : requests) validate(*r);
@@ -1043,20 +1073,17 @@ struct Renderer::Impl {
       readBack(f);
       splitLabels(f);
       stage_end(&t0, &f.stats.readback_ms);
-      submitBoxQueries(f);
-      glFlush();
-      stage_end(&t0, &f.stats.boxes_ms);
-    }
-    stats = RenderStats{};
-    for (std::size_t i = 0; i < requests.size(); ++i) {
-      Frame& f = *frames[i];
-      auto t0 = Clock::now();
       if (f.effects.any()) {
         applyCameraEffects(f.color.data(), f.targets->width, f.targets->height, f.effects,
                            f.out->rgb.data(), &effects_scratch);
       }
       stage_end(&t0, &f.stats.post_ms);
-      collectBoxes(f);
+    }
+    stats = RenderStats{};
+    for (std::size_t i = 0; i < requests.size(); ++i) {
+      Frame& f = *frames[i];
+      auto t0 = Clock::now();
+      boxes(f);
       stage_end(&t0, &f.stats.boxes_ms);
       FrameSet* out = f.out;
       out->time = f.request->time;
@@ -1122,6 +1149,12 @@ struct Renderer::Impl {
   std::vector<int> touched;
   std::vector<std::uint32_t> label_scratch;
   CameraEffectsScratch effects_scratch;
+  std::vector<std::array<int, 4>> box_rect;
+  std::vector<int> box_group, box_total;
+  std::vector<GpuInstance> box_upload;
+  std::vector<GLuint> group_base;
+  std::vector<GLsizei> group_count;
+  std::vector<std::uint32_t> box_labels;
 };
 
 Renderer::Renderer(const scenario::World& world, const scenario::SimConfig& config,

@@ -1,6 +1,6 @@
 #pragma once
-// GLSL 4.50 sources of the renderer's three programs: the geometry pass (lit colour, linear
-// depth, labels into three targets), the sky (pixels no geometry covered) and the weather
+// GLSL 4.50 sources of the renderer's three programs: the geometry pass (lit colour, and linear
+// depth with the label in one two-channel integer target), the sky (pixels no geometry covered) and the weather
 // particles blended onto the colour. Motion blur and sensor noise follow on the CPU
 // (camera_effects.h).
 
@@ -71,8 +71,7 @@ flat in vec4 v_frame;
 flat in vec2 v_extent;
 
 layout(location = 0) out vec4 o_color;
-layout(location = 1) out float o_depth;
-layout(location = 2) out uint o_label;
+layout(location = 1) out uvec2 o_depth_label;  // depth (float bits), semantic << 16 | instance
 
 uniform float u_near;
 uniform float u_far;
@@ -155,13 +154,13 @@ void main() {
   c = mix(u_air_color, c, exp(-u_air_k * distance));
   c = haze(c, distance);
   o_color = vec4(toDisplay(c), 1.0);
-  o_depth = depth;
-  o_label = v_ids.y;
+  o_depth_label = uvec2(floatBitsToUint(depth), v_ids.y);
 }
 )GLSL";
 
 // A full-screen triangle at the far plane (window depth 0), drawn with GL_EQUAL after the
-// geometry, so it shades only the pixels nothing covered.
+// geometry, so it shades only the pixels nothing covered (and every one of them: the colour
+// and depth-label targets need no clearing).
 inline constexpr const char* kFullscreenVertex = R"GLSL(
 #version 450 core
 void main() {
@@ -172,8 +171,7 @@ void main() {
 
 inline constexpr const char* kSkyFragment = R"GLSL(
 layout(location = 0) out vec4 o_color;
-layout(location = 1) out float o_depth;
-layout(location = 2) out uint o_label;
+layout(location = 1) out uvec2 o_depth_label;
 
 uniform mat3 u_world_R_optical;
 uniform vec4 u_intrinsics;  // fx, fy, cx, cy
@@ -195,8 +193,7 @@ void main() {
   c += u_glow * (0.35 * pow(s, 8.0) + 2.0 * pow(s, 600.0));
   c = haze(c, u_far);
   o_color = vec4(toDisplay(c), 1.0);
-  o_depth = uintBitsToFloat(0x7F800000u);  // +inf: nothing hit
-  o_label = 0u;
+  o_depth_label = uvec2(0x7F800000u, 0u);  // depth +inf: nothing hit; label 0
 }
 )GLSL";
 

@@ -120,9 +120,9 @@ struct RenderStats {
   double post_ms = 0;         // weather particles, blur, noise
   double readback_ms = 0;     // colour, depth and labels read back and split
   double boxes_ms = 0;        // boxes from the instance mask, occlusion queries
-  std::size_t instances = 0;  // instances drawn
+  std::size_t instances = 0;  // instances drawn in the geometry pass
   std::size_t triangles = 0;  // triangles submitted to the geometry pass
-  std::size_t draw_calls = 0;
+  std::size_t draw_calls = 0; // all passes
 };
 
 // World triangles for ray-cast checks (what the renderer draws, in world coordinates).
