@@ -23,6 +23,9 @@ HAMERITT_PACKAGES=(
   libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev libompl-dev
   python3-jsonschema python3-rospy python3-nav-msgs python3-rosgraph-msgs
   python3-geometry-msgs python3-std-msgs python3-actionlib-msgs
+  # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
+  # assimp for the meshes.
+  libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
 )
 
 install_deps() {

@@ -45,4 +45,12 @@ Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Eigen
   return world_T_base * base_T_link * link_T_optical;
 }
 
+bool projectPoint(const Intrinsics& k, const Eigen::Isometry3d& world_T_optical,
+                  const Eigen::Vector3d& p_world, Eigen::Vector2d* uv) {
+  const Eigen::Vector3d q = world_T_optical.inverse() * p_world;
+  if (!(q.z() > 0.0)) return false;
+  *uv = Eigen::Vector2d(k.fx * q.x() / q.z() + k.cx, k.fy * q.y() / q.z() + k.cy);
+  return true;
+}
+
 }  // namespace hameritt::render

@@ -75,6 +75,8 @@ Lighting lightingFor(const scenario::Environment& env, bool weather) {
   l.sky_horizon = mix(night_h, mix(dusk_h, day_h, day), twilight);
   l.sun_glow = sun_up * mix(Eigen::Vector3f(0.9f, 0.45f, 0.15f),
                             Eigen::Vector3f(0.5f, 0.45f, 0.35f), day);
+  l.air_color = l.sky_horizon;
+  l.air_k = 3.0f / 8000.0f;
   if (!weather) return l;
 
   // Clouds come with rain and snowfall: less direct sun, a greyer sky.
@@ -90,6 +92,7 @@ Lighting lightingFor(const scenario::Environment& env, bool weather) {
     l.sky_zenith = mix(l.sky_zenith, Eigen::Vector3f::Constant(0.8f * grey_h + 0.2f * grey_z),
                        0.8f * overcast);
     l.sky_horizon = mix(l.sky_horizon, Eigen::Vector3f::Constant(grey_h), 0.8f * overcast);
+    l.air_color = l.sky_horizon;
     l.sky_ambient = mix(l.sky_ambient, Eigen::Vector3f::Constant(luminance(l.sky_ambient)),
                         0.6f * overcast);
   }

@@ -27,7 +27,11 @@ struct Lighting {
   Eigen::Vector3f sky_zenith{0, 0, 0};
   Eigen::Vector3f sky_horizon{0, 0, 0};
   Eigen::Vector3f sun_glow{0, 0, 0};        // sky brightening around the sun
-  // Exponential extinction: colour = mix(haze_color, colour, exp(-haze_k * distance)).
+  // Aerial perspective of clear air (visibility about 8 km): surfaces fade towards the colour
+  // of the horizon sky; weather or not, it is part of the scene.
+  Eigen::Vector3f air_color{0, 0, 0};
+  float air_k = 0;
+  // Weather: exponential extinction, colour = mix(haze_color, colour, exp(-haze_k * distance)).
   Eigen::Vector3f haze_color{0, 0, 0};
   float haze_k = 0;
   float snow_cover = 0;  // [0, 1]

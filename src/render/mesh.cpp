@@ -113,10 +113,12 @@ Mesh loadObjMesh(const std::string& path, bool normalized) {
     if (!probe) throw RenderError(path + ": model file missing or unreadable");
   }
   Assimp::Importer importer;
-  // Keep the file's per-face normals; generate flat ones only where a face has none.
+  // Keep the file's per-face normals (generate flat ones only where a face has none); corners
+  // with the same position and normal become one vertex, shaded once per instance.
   const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_GenNormals | aiProcess_SortByPType |
-                aiProcess_ValidateDataStructure | aiProcess_FindInvalidData);
+      path, aiProcess_Triangulate | aiProcess_GenNormals | aiProcess_JoinIdenticalVertices |
+                aiProcess_SortByPType | aiProcess_ValidateDataStructure |
+                aiProcess_FindInvalidData);
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode) {
     throw RenderError(path + ": malformed model: " + importer.GetErrorString());
   }

@@ -130,9 +130,8 @@ struct Plane {
 // The render targets of one image size.
 struct Targets {
   int width = 0, height = 0;
-  GLuint fbo = 0, color = 0, depth = 0, labels = 0, zbuffer = 0;
+  GLuint fbo = 0, color = 0, depth_labels = 0, zbuffer = 0;
   GLuint particle_fbo = 0;  // the colour target alone, for blending particles onto it
-  GLuint occlusion_fbo = 0;
 };
 
 // A layer of weather particles (sizes in pixels at 640 px image width).
@@ -147,7 +146,34 @@ constexpr ParticleLayer kSnowLayers[] = {
 
 struct Uniforms {
   GLint view_proj, camera, canopy_center, near_clip, far_clip, sun_dir, sun_color, sky_ambient,
-      ground_ambient, snow, wet, haze_color, haze_k;
+      ground_ambient, snow, wet, haze_color, haze_k, world_R_optical, intrinsics, air_color, air_k;
+};
+
+// Pixel bounds and count of one instance in the mask.
+struct BoxAcc {
+  int x_min = 0, y_min = 0, x_max = 0, y_max = 0, count = 0;
+};
+
+// One request of a batch between its phases, in a slot that keeps its buffers and targets from
+// call to call (no allocation per frame once warm).
+struct Frame {
+  const RenderRequest* request = nullptr;
+  FrameSet* out = nullptr;
+  Targets* targets = nullptr;
+  std::vector<Targets> target_cache;  // by image size
+  GLuint instance_buffer = 0;         // the culled instances of this frame
+  Lighting lighting;
+  CameraEffects effects;
+  float view_proj[16] = {};
+  Eigen::Vector3d camera{0, 0, 0};
+  std::vector<GLuint> base_instance;  // per model: first instance in the upload
+  std::vector<GLsizei> count;         // per model: instances drawn
+  std::vector<int> slot;              // per record: its index in the upload, or -1
+  std::vector<std::uint32_t> uploaded;
+  std::vector<GpuInstance> upload;
+  std::vector<std::uint8_t> color;    // read-back colour before the camera effects
+  std::vector<std::pair<int, BoxAcc>> touched;  // instances of interest in the mask
+  RenderStats stats;
 };
 
 }  // namespace
@@ -173,15 +199,17 @@ struct Renderer::Impl {
     } catch (const RenderError&) {
       return;  // another thread holds the context: the GL objects go with it
     }
-    for (auto& t : targets) deleteTargets(&t);
+    for (auto& f : frames) {
+      for (auto& t : f->target_cache) deleteTargets(&t);
+      glDeleteBuffers(1, &f->instance_buffer);
+    }
     glDeleteProgram(geometry_program);
     glDeleteProgram(sky_program);
     glDeleteProgram(particle_program);
-    GLuint buffers[] = {vertex_buffer, element_buffer, instance_buffer};
-    glDeleteBuffers(3, buffers);
+    GLuint buffers[] = {vertex_buffer, element_buffer};
+    glDeleteBuffers(2, buffers);
     glDeleteVertexArrays(1, &vao);
     glDeleteVertexArrays(1, &empty_vao);
-    if (!queries.empty()) glDeleteQueries(static_cast<GLsizei>(queries.size()), queries.data());
   }
 
   // ------------------------------------------------------------------------------ set-up
@@ -195,11 +223,11 @@ struct Renderer::Impl {
       throw RenderError("GL: OpenGL 4.5 core is required, got " + gl_version + " (" + gl_renderer +
                         ")");
     }
-    const std::string common = std::string("#version 450 core\n") + shaders::kCommon;
+    const std::string version = "#version 450 core\n";
+    const std::string common = version + shaders::kCommon;
     geometry_program = linkProgram(shaders::kGeometryVertex, common + shaders::kGeometryFragment,
                                    "geometry");
     sky_program = linkProgram(shaders::kFullscreenVertex, common + shaders::kSkyFragment, "sky");
-    const std::string version = "#version 450 core\n";
     particle_program = linkProgram(version + shaders::kHash + shaders::kParticleVertex,
                                    version + shaders::kParticleFragment, "particles");
     auto loc = [this](const char* n) { return glGetUniformLocation(geometry_program, n); };
@@ -207,7 +235,16 @@ struct Renderer::Impl {
          loc("u_near"),        loc("u_far"),            loc("u_sun_dir"),
          loc("u_sun_color"),   loc("u_sky_ambient"),    loc("u_ground_ambient"),
          loc("u_snow"),        loc("u_wet"),            loc("u_haze_color"),
-         loc("u_haze_k")};
+         loc("u_haze_k"),      loc("u_world_R_optical"), loc("u_intrinsics"),
+         loc("u_air_color"),   loc("u_air_k")};
+    auto sky = [this](const char* n) { return glGetUniformLocation(sky_program, n); };
+    sky_loc = {sky("u_world_R_optical"), sky("u_intrinsics"), sky("u_zenith"),
+               sky("u_horizon"),         sky("u_sun_dir"),    sky("u_glow"),
+               sky("u_far"),             sky("u_haze_color"), sky("u_haze_k")};
+    auto part = [this](const char* n) { return glGetUniformLocation(particle_program, n); };
+    particle_loc = {part("u_key"),    part("u_size"),       part("u_cells_x"), part("u_cell"),
+                    part("u_length"), part("u_radius"),     part("u_density"), part("u_layer"),
+                    part("u_fall"),   part("u_intrinsics"), part("u_alpha"),   part("u_brightness")};
 
     // All meshes in one vertex and one element buffer.
     std::vector<Vertex> vertices;
@@ -231,15 +268,9 @@ struct Renderer::Impl {
     records.resize(n + 1);
     for (std::size_t i = 0; i < n; ++i) records[i] = scene.instances()[i].record;
     uav_record = static_cast<std::uint32_t>(n);
-    glCreateBuffers(1, &instance_buffer);
-    glNamedBufferStorage(instance_buffer,
-                         static_cast<GLsizeiptr>(records.size() * sizeof(GpuInstance)), nullptr,
-                         GL_DYNAMIC_STORAGE_BIT);
-    slot.assign(records.size(), -1);
 
     glCreateVertexArrays(1, &vao);
     glVertexArrayVertexBuffer(vao, 0, vertex_buffer, 0, sizeof(Vertex));
-    glVertexArrayVertexBuffer(vao, 1, instance_buffer, 0, sizeof(GpuInstance));
     glVertexArrayBindingDivisor(vao, 1, 1);
     glVertexArrayElementBuffer(vao, element_buffer);
     for (GLuint a = 0; a < 10; ++a) glEnableVertexArrayAttrib(vao, a);
@@ -309,7 +340,6 @@ struct Renderer::Impl {
       hi = hi.cwiseMax(si.center.head<2>().cast<double>());
     }
     if (lo.x() > hi.x()) lo = hi = Eigen::Vector2d::Zero();
-    grid_origin = lo;
     grid_nx = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / kCellSize)) + 1);
     grid_ny = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / kCellSize)) + 1);
     const int cells = grid_nx * grid_ny;
@@ -329,31 +359,40 @@ struct Renderer::Impl {
       }
       const int cx = std::clamp(static_cast<int>((si.center.x() - lo.x()) / kCellSize), 0, grid_nx - 1);
       const int cy = std::clamp(static_cast<int>((si.center.y() - lo.y()) / kCellSize), 0, grid_ny - 1);
-      const int c = cy * grid_nx + cx;
-      per[static_cast<std::size_t>(c * models + si.model)].push_back(static_cast<std::uint32_t>(i));
-      cell_lo[static_cast<std::size_t>(c)] =
-          cell_lo[static_cast<std::size_t>(c)].cwiseMin(si.center - Eigen::Vector3f::Constant(si.radius));
-      cell_hi[static_cast<std::size_t>(c)] =
-          cell_hi[static_cast<std::size_t>(c)].cwiseMax(si.center + Eigen::Vector3f::Constant(si.radius));
+      const auto c = static_cast<std::size_t>(cy * grid_nx + cx);
+      per[c * static_cast<std::size_t>(models) + static_cast<std::size_t>(si.model)].push_back(
+          static_cast<std::uint32_t>(i));
+      cell_lo[c] = cell_lo[c].cwiseMin(si.center - Eigen::Vector3f::Constant(si.radius));
+      cell_hi[c] = cell_hi[c].cwiseMax(si.center + Eigen::Vector3f::Constant(si.radius));
     }
     cell_range.assign(static_cast<std::size_t>(cells * models), {0, 0});
-    for (int c = 0; c < cells; ++c) {
-      for (int m = 0; m < models; ++m) {
-        auto& v = per[static_cast<std::size_t>(c * models + m)];
-        const auto begin = static_cast<std::uint32_t>(cell_items.size());
-        cell_items.insert(cell_items.end(), v.begin(), v.end());
-        cell_range[static_cast<std::size_t>(c * models + m)] = {
-            begin, static_cast<std::uint32_t>(cell_items.size())};
-      }
+    for (std::size_t k = 0; k < per.size(); ++k) {
+      const auto begin = static_cast<std::uint32_t>(cell_items.size());
+      cell_items.insert(cell_items.end(), per[k].begin(), per[k].end());
+      cell_range[k] = {begin, static_cast<std::uint32_t>(cell_items.size())};
     }
     visible.resize(static_cast<std::size_t>(models));
     cell_order.reserve(static_cast<std::size_t>(cells));
-    upload.reserve(records.size());
-    uploaded.reserve(records.size());
   }
 
-  Targets& targetsFor(int w, int h) {
-    for (auto& t : targets) {
+  Frame& frameSlot(std::size_t i) {
+    while (frames.size() <= i) {
+      auto f = std::make_unique<Frame>();
+      glCreateBuffers(1, &f->instance_buffer);
+      // The culled instances, then the groups of entities drawn alone for their boxes.
+      glNamedBufferStorage(f->instance_buffer,
+                           static_cast<GLsizeiptr>(2 * records.size() * sizeof(GpuInstance)),
+                           nullptr, GL_DYNAMIC_STORAGE_BIT);
+      f->slot.assign(records.size(), -1);
+      f->upload.reserve(records.size());
+      f->uploaded.reserve(records.size());
+      frames.push_back(std::move(f));
+    }
+    return *frames[i];
+  }
+
+  Targets& targetsFor(Frame& f, int w, int h) {
+    for (auto& t : f.target_cache) {
       if (t.width == w && t.height == h) return t;
     }
     GLint max_size = 0;
@@ -363,55 +402,47 @@ struct Renderer::Impl {
                         std::to_string(h) + " exceeds the GL limit of " + std::to_string(max_size));
     }
     // Keep a few sizes; drop the oldest beyond that.
-    if (targets.size() >= 4) {
-      deleteTargets(&targets.front());
-      targets.erase(targets.begin());
+    if (f.target_cache.size() >= 4) {
+      deleteTargets(&f.target_cache.front());
+      f.target_cache.erase(f.target_cache.begin());
     }
     Targets t;
     t.width = w;
     t.height = h;
     glCreateTextures(GL_TEXTURE_2D, 1, &t.color);
     glTextureStorage2D(t.color, 1, GL_RGBA8, w, h);
-    glCreateTextures(GL_TEXTURE_2D, 1, &t.depth);
-    glTextureStorage2D(t.depth, 1, GL_R32F, w, h);
-    glCreateTextures(GL_TEXTURE_2D, 1, &t.labels);
-    glTextureStorage2D(t.labels, 1, GL_R32UI, w, h);
+    // Depth (float bits) and label in one target: one store per pixel less than two targets.
+    glCreateTextures(GL_TEXTURE_2D, 1, &t.depth_labels);
+    glTextureStorage2D(t.depth_labels, 1, GL_RG32UI, w, h);
     glCreateRenderbuffers(1, &t.zbuffer);
     glNamedRenderbufferStorage(t.zbuffer, GL_DEPTH_COMPONENT32F, w, h);
     glCreateFramebuffers(1, &t.fbo);
     glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT0, t.color, 0);
-    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT1, t.depth, 0);
-    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT2, t.labels, 0);
+    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT1, t.depth_labels, 0);
     glNamedFramebufferRenderbuffer(t.fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t.zbuffer);
-    const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-    glNamedFramebufferDrawBuffers(t.fbo, 3, bufs);
+    const GLenum bufs[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(t.fbo, 2, bufs);
     glCreateFramebuffers(1, &t.particle_fbo);
     glNamedFramebufferTexture(t.particle_fbo, GL_COLOR_ATTACHMENT0, t.color, 0);
     glNamedFramebufferDrawBuffer(t.particle_fbo, GL_COLOR_ATTACHMENT0);
-    // Occlusion counting reuses the depth buffer once the geometry pass has been read back.
-    glCreateFramebuffers(1, &t.occlusion_fbo);
-    glNamedFramebufferRenderbuffer(t.occlusion_fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                                   t.zbuffer);
-    glNamedFramebufferDrawBuffer(t.occlusion_fbo, GL_NONE);
-    glNamedFramebufferReadBuffer(t.occlusion_fbo, GL_NONE);
-    for (GLuint f : {t.fbo, t.particle_fbo, t.occlusion_fbo}) {
-      if (glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    for (GLuint fb : {t.fbo, t.particle_fbo}) {
+      if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         deleteTargets(&t);
         throw RenderError("GL: incomplete framebuffer for " + std::to_string(w) + " x " +
                           std::to_string(h));
       }
     }
     checkGl("render targets");
-    targets.push_back(t);
-    return targets.back();
+    f.target_cache.push_back(t);
+    return f.target_cache.back();
   }
 
   static void deleteTargets(Targets* t) {
-    GLuint tex[] = {t->color, t->depth, t->labels};
-    glDeleteTextures(3, tex);
+    GLuint tex[] = {t->color, t->depth_labels};
+    glDeleteTextures(2, tex);
     glDeleteRenderbuffers(1, &t->zbuffer);
-    GLuint fbos[] = {t->fbo, t->particle_fbo, t->occlusion_fbo};
-    glDeleteFramebuffers(3, fbos);
+    GLuint fbos[] = {t->fbo, t->particle_fbo};
+    glDeleteFramebuffers(2, fbos);
     *t = Targets{};
   }
 
@@ -448,11 +479,16 @@ struct Renderer::Impl {
     if (!r.blur_direction.allFinite()) {
       throw RenderError("RenderRequest.blur_direction: not finite");
     }
+    for (const std::string& id : r.hidden_entities) {
+      if (by_id.find(id) == by_id.end()) {
+        throw RenderError("RenderRequest.hidden_entities: unknown entity '" + id + "'");
+      }
+    }
   }
 
   // Column-major float 4x4 of projection * [R^T | 0] (camera-relative world to clip), and the
   // same with the translation for the frustum planes (double).
-  void projection(const RenderRequest& r, float view_proj[16], Eigen::Matrix4d* full) {
+  static void projection(const RenderRequest& r, float view_proj[16], Eigen::Matrix4d* full) {
     const Intrinsics& k = r.intrinsics;
     const double n = r.near_clip, f = r.far_clip, w = k.width, h = k.height;
     // Pixel centre (u, v) -> window (u + 0.5, v + 0.5): row 0 of the image is window row 0,
@@ -514,17 +550,30 @@ struct Renderer::Impl {
     return dist <= 0 || focal * radius >= kMinProjectedRadiusPx * dist;
   }
 
-  void cullAndUpload(const RenderRequest& r) {
+  void setHidden(const std::vector<std::string>& ids) {
+    for (std::uint32_t i : hidden_list) hidden[i] = 0;
+    hidden_list.clear();
+    for (const std::string& id : ids) {
+      auto [b, e] = by_id.equal_range(id);
+      for (auto it = b; it != e; ++it) {
+        const auto rec = static_cast<std::uint32_t>(instance_record[static_cast<std::size_t>(it->second)]);
+        hidden[rec] = 1;
+        hidden_list.push_back(rec);
+      }
+    }
+  }
+
+  // Frustum culling (cells, then spheres) and the upload of the visible instances, grouped by
+  // model in draw order.
+  void cullAndUpload(const RenderRequest& r, Frame& f) {
     const int models = static_cast<int>(scene.models().size());
     for (auto& v : visible) v.clear();
-    // Movers: posed at the frame time; their records are rewritten in place.
-    if (!movers.empty()) {
-      for (std::uint32_t i : movers) {
-        Eigen::Vector3f c;
-        float radius;
-        scene.pose(i, r.time, &records[i], &c, &radius);
-        mover_sphere[i] = {c, radius};
-      }
+    // Movers: posed at the frame time.
+    for (std::uint32_t i : movers) {
+      Eigen::Vector3f c;
+      float radius;
+      scene.pose(i, r.time, &records[i], &c, &radius);
+      mover_sphere[i] = {c, radius};
     }
     if (r.draw_uav) records[uav_record] = scene.uavRecord(r.world_T_uav);
     // Cells: inside, cut or outside; visited near to far.
@@ -566,30 +615,35 @@ struct Renderer::Impl {
     }
     if (r.draw_uav) visible[static_cast<std::size_t>(scene.procedural().uav)].push_back(uav_record);
     // One upload of the visible instances, in draw order.
-    for (std::uint32_t i : uploaded) slot[i] = -1;
-    uploaded.clear();
-    upload.clear();
-    model_base_instance.assign(static_cast<std::size_t>(models), 0);
+    for (std::uint32_t i : f.uploaded) f.slot[i] = -1;
+    f.uploaded.clear();
+    f.upload.clear();
+    f.base_instance.assign(static_cast<std::size_t>(models), 0);
+    f.count.assign(static_cast<std::size_t>(models), 0);
     for (int m : draw_order) {
-      model_base_instance[static_cast<std::size_t>(m)] = static_cast<GLuint>(upload.size());
+      f.base_instance[static_cast<std::size_t>(m)] = static_cast<GLuint>(f.upload.size());
+      f.count[static_cast<std::size_t>(m)] =
+          static_cast<GLsizei>(visible[static_cast<std::size_t>(m)].size());
       for (std::uint32_t i : visible[static_cast<std::size_t>(m)]) {
-        slot[i] = static_cast<int>(upload.size());
-        uploaded.push_back(i);
-        upload.push_back(gpuInstance(records[i]));
+        f.slot[i] = static_cast<int>(f.upload.size());
+        f.uploaded.push_back(i);
+        f.upload.push_back(gpuInstance(records[i]));
       }
     }
-    if (!upload.empty()) {
-      glNamedBufferSubData(instance_buffer, 0,
-                           static_cast<GLsizeiptr>(upload.size() * sizeof(GpuInstance)),
-                           upload.data());
+    if (!f.upload.empty()) {
+      glNamedBufferSubData(f.instance_buffer, 0,
+                           static_cast<GLsizeiptr>(f.upload.size() * sizeof(GpuInstance)),
+                           f.upload.data());
     }
-    stats.instances = upload.size();
+    f.stats.instances = f.upload.size();
   }
 
-  void setFrameUniforms(const RenderRequest& r, const Lighting& l, const float view_proj[16]) {
+  void setFrameUniforms(const Frame& f) {
+    const RenderRequest& r = *f.request;
+    const Lighting& l = f.lighting;
     const GLuint p = geometry_program;
-    glProgramUniformMatrix4fv(p, u.view_proj, 1, GL_FALSE, view_proj);
-    const Eigen::Vector3f cam = camera.cast<float>();
+    glProgramUniformMatrix4fv(p, u.view_proj, 1, GL_FALSE, f.view_proj);
+    const Eigen::Vector3f cam = f.camera.cast<float>();
     glProgramUniform3fv(p, u.camera, 1, cam.data());
     glProgramUniform1f(p, u.near_clip, static_cast<float>(r.near_clip));
     glProgramUniform1f(p, u.far_clip, static_cast<float>(r.far_clip));
@@ -601,11 +655,18 @@ struct Renderer::Impl {
     glProgramUniform1f(p, u.wet, l.wetness);
     glProgramUniform3fv(p, u.haze_color, 1, l.haze_color.data());
     glProgramUniform1f(p, u.haze_k, l.haze_k);
+    glProgramUniform3fv(p, u.air_color, 1, l.air_color.data());
+    glProgramUniform1f(p, u.air_k, l.air_k);
+    const Eigen::Matrix3f rot = r.world_T_optical.linear().cast<float>();
+    glProgramUniformMatrix3fv(p, u.world_R_optical, 1, GL_FALSE, rot.data());
+    const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
+                           static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
+    glProgramUniform4fv(p, u.intrinsics, 1, intr);
   }
 
-  // Draws model m's instances [base, base + count) of the bound instance-index buffer: one
-  // call per model, the materials are in the vertices.
-  void drawModel(int m, GLuint base, GLsizei count) {
+  // Draws model m's instances [base, base + count) of the bound instance buffer: one call per
+  // model, the materials are in the vertices.
+  void drawModel(int m, GLuint base, GLsizei count, RenderStats* stats) {
     const Mesh& mesh = scene.models()[static_cast<std::size_t>(m)];
     const std::uint32_t n = scene.drawnIndexCount(m);
     if (n == 0) return;
@@ -617,32 +678,31 @@ struct Renderer::Impl {
         reinterpret_cast<const void*>(model_first_element[static_cast<std::size_t>(m)] *
                                       sizeof(std::uint32_t)),
         count, model_base_vertex[static_cast<std::size_t>(m)], base);
-    stats.triangles += static_cast<std::size_t>(n / 3) * static_cast<std::size_t>(count);
-    ++stats.draw_calls;
+    stats->triangles += static_cast<std::size_t>(n / 3) * static_cast<std::size_t>(count);
+    ++stats->draw_calls;
   }
 
-  void geometryPass(const RenderRequest& r, const Lighting& l, const Targets& t) {
+  void geometryPass(Frame& f) {
+    const RenderRequest& r = *f.request;
+    const Lighting& l = f.lighting;
+    const Targets& t = *f.targets;
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glViewport(0, 0, t.width, t.height);
     glDisable(GL_SCISSOR_TEST);
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    const float black[4] = {0, 0, 0, 1};
-    const float inf[4] = {std::numeric_limits<float>::infinity(), 0, 0, 0};
-    const GLuint none[4] = {0, 0, 0, 0};
-    glClearNamedFramebufferfv(t.fbo, GL_COLOR, 0, black);
-    glClearNamedFramebufferfv(t.fbo, GL_COLOR, 1, inf);
-    glClearNamedFramebufferuiv(t.fbo, GL_COLOR, 2, none);
+    // Only the depth buffer is cleared: the sky pass writes every pixel that no geometry covers.
     const float zero = 0.0f;
     glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &zero);
 
+    setFrameUniforms(f);
     glUseProgram(geometry_program);
     glBindVertexArray(vao);
+    glVertexArrayVertexBuffer(vao, 1, f.instance_buffer, 0, sizeof(GpuInstance));
     for (int m : draw_order) {
-      const auto count = static_cast<GLsizei>(visible[static_cast<std::size_t>(m)].size());
-      if (count > 0) drawModel(m, model_base_instance[static_cast<std::size_t>(m)], count);
+      const GLsizei count = f.count[static_cast<std::size_t>(m)];
+      if (count > 0) drawModel(m, f.base_instance[static_cast<std::size_t>(m)], count, &f.stats);
     }
 
     // Sky where nothing was drawn (window depth still 0).
@@ -683,7 +743,9 @@ struct Renderer::Impl {
   }
 
   // Rain streaks and snow flakes blended onto the colour target (weather on, intensity > 0).
-  void particlePass(const RenderRequest& r, const Lighting& l, const Targets& t) {
+  void particlePass(const Frame& f) {
+    const RenderRequest& r = *f.request;
+    const Targets& t = *f.targets;
     const float rain = r.weather ? static_cast<float>(std::clamp(config.environment.rain, 0.0, 1.0)) : 0.0f;
     const float snow = r.weather ? static_cast<float>(std::clamp(config.environment.snow, 0.0, 1.0)) : 0.0f;
     if (rain <= 0.0f && snow <= 0.0f) return;
@@ -699,7 +761,7 @@ struct Renderer::Impl {
                            static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
     glProgramUniform4fv(p, particle_loc.intrinsics, 1, intr);
     // Particles are lit by the diffuse light.
-    const Eigen::Vector3f light = l.sky_ambient + 0.3f * l.sun_color;
+    const Eigen::Vector3f light = f.lighting.sky_ambient + 0.3f * f.lighting.sun_color;
     const float lum = 0.2126f * light.x() + 0.7152f * light.y() + 0.0722f * light.z();
     glProgramUniform1f(p, particle_loc.brightness, std::clamp(0.25f + 0.9f * lum, 0.2f, 0.95f));
 
@@ -737,55 +799,57 @@ struct Renderer::Impl {
   }
 
   // Motion blur and sensor noise of this request (applied on the CPU after the read-back).
-  void cameraEffects(const RenderRequest& r) {
+  void cameraEffects(Frame& f) const {
+    const RenderRequest& r = *f.request;
     const auto& pert = config.perturbations;
-    effects.blur = r.noise ? motionBlurKernel(r.blur_direction.x(), r.blur_direction.y(),
-                                              pert.motion_blur_px)
-                           : std::vector<BlurTap>{};
-    effects.noise_std = r.noise ? static_cast<float>(pert.gaussian_noise_std) : 0.0f;
-    effects.salt = r.noise ? static_cast<float>(pert.salt_pepper_probability) : 0.0f;
+    f.effects.blur = r.noise ? motionBlurKernel(r.blur_direction.x(), r.blur_direction.y(),
+                                                pert.motion_blur_px)
+                             : std::vector<BlurTap>{};
+    f.effects.noise_std = r.noise ? static_cast<float>(pert.gaussian_noise_std) : 0.0f;
+    f.effects.salt = r.noise ? static_cast<float>(pert.salt_pepper_probability) : 0.0f;
     GLuint key[4];
     frameKey(r, key);
-    effects.key[0] = key[2];
-    effects.key[1] = key[3];
+    f.effects.key[0] = key[2];
+    f.effects.key[1] = key[3];
   }
 
-  void readBack(const Targets& t, FrameSet* out) {
+  // Colour (into the frame's buffer when the camera effects follow), depth and labels.
+  void readBack(Frame& f) {
+    const Targets& t = *f.targets;
+    FrameSet* out = f.out;
     const std::size_t n = static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height);
     out->rgb.resize(3 * n);
     out->depth.resize(n);
     out->semantic.resize(n);
     out->instance.resize(n);
-    label_scratch.resize(n);
+    label_scratch.resize(2 * n);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     std::uint8_t* color = out->rgb.data();
-    if (effects.any()) {
-      color_scratch.resize(3 * n);
-      color = color_scratch.data();
+    if (f.effects.any()) {
+      f.color.resize(3 * n);
+      color = f.color.data();
     }
     glReadPixels(0, 0, t.width, t.height, GL_RGB, GL_UNSIGNED_BYTE, color);
     glReadBuffer(GL_COLOR_ATTACHMENT1);
-    glReadPixels(0, 0, t.width, t.height, GL_RED, GL_FLOAT, out->depth.data());
-    glReadBuffer(GL_COLOR_ATTACHMENT2);
-    glReadPixels(0, 0, t.width, t.height, GL_RED_INTEGER, GL_UNSIGNED_INT, label_scratch.data());
+    glReadPixels(0, 0, t.width, t.height, GL_RG_INTEGER, GL_UNSIGNED_INT, label_scratch.data());
     checkGl("read back");
   }
 
-  struct BoxAcc {
-    int x_min = 0, y_min = 0, x_max = 0, y_max = 0, count = 0;
-  };
-
-  // Splits the labels and grows the boxes of the instances of interest in the same pass.
-  void splitLabels(int width, FrameSet* out) {
+  // Splits depth and labels and grows the boxes of the instances of interest in the same pass.
+  void splitLabels(Frame& f) {
+    FrameSet* out = f.out;
+    const int width = f.targets->width;
     touched.clear();
-    const std::size_t n = label_scratch.size();
+    const std::size_t n = label_scratch.size() / 2;
     const std::uint32_t* src = label_scratch.data();
+    float* depth = out->depth.data();
     std::uint8_t* sem = out->semantic.data();
     std::uint16_t* ins = out->instance.data();
     const std::size_t n_ids = interest.size();
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t v = src[i];
+      std::memcpy(&depth[i], &src[2 * i], sizeof(float));
+      const std::uint32_t v = src[2 * i + 1];
       const std::uint32_t id = v & 0xFFFFu;
       sem[i] = static_cast<std::uint8_t>(v >> 16);
       ins[i] = static_cast<std::uint16_t>(id);
@@ -805,14 +869,19 @@ struct Renderer::Impl {
       }
     }
     std::sort(touched.begin(), touched.end());
+    f.touched.clear();
+    for (int id : touched) {
+      f.touched.emplace_back(id, box_acc[static_cast<std::size_t>(id)]);
+      box_acc[static_cast<std::size_t>(id)] = BoxAcc{};
+    }
   }
 
-  // Pixel rectangle that surely contains instance i's projection, or the whole image.
-  std::array<int, 4> projectedRect(const RenderRequest& r, std::uint32_t rec) const {
+  // Pixel rectangle that surely contains the projection of the instance uploaded at `slot`.
+  std::array<int, 4> projectedRect(const Frame& f, int model, int slot) const {
+    const RenderRequest& r = *f.request;
     const Intrinsics& k = r.intrinsics;
-    const SceneInstance& si = scene.instances()[rec];
-    const Mesh& mesh = scene.models()[static_cast<std::size_t>(si.model)];
-    const InstanceRecord& ir = records[rec];
+    const Mesh& mesh = scene.models()[static_cast<std::size_t>(model)];
+    const GpuInstance& gi = f.upload[static_cast<std::size_t>(slot)];
     const Eigen::Isometry3d optical_T_world = r.world_T_optical.inverse();
     double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
     for (int c = 0; c < 8; ++c) {
@@ -820,7 +889,7 @@ struct Renderer::Impl {
                               (c & 4) ? mesh.max.z() : mesh.min.z());
       Eigen::Vector3d w;
       for (int a = 0; a < 3; ++a) {
-        w[a] = ir.row[a][0] * p.x() + ir.row[a][1] * p.y() + ir.row[a][2] * p.z() + ir.row[a][3];
+        w[a] = gi.row[a][0] * p.x() + gi.row[a][1] * p.y() + gi.row[a][2] * p.z() + gi.row[a][3];
       }
       const Eigen::Vector3d q = optical_T_world * w;
       if (q.z() < r.near_clip) return {0, 0, k.width, k.height};
@@ -837,50 +906,104 @@ struct Renderer::Impl {
     return {x0, y0, x1 - x0, y1 - y0};
   }
 
-  // total_pixels: each entity with a visible pixel is drawn alone (scissored to its projected
-  // rectangle): a depth pass, then a GL_EQUAL pass counted by an occlusion query. Same program,
-  // same vertices, same rasterization as the geometry pass, so visible <= total exactly.
-  void boxes(const RenderRequest& r, const Targets& t, FrameSet* out) {
+  // total_pixels: the entities with a visible pixel are drawn again without the rest of the
+  // scene, in groups whose projected rectangles do not overlap (so that no member can cover
+  // another), and their labels are counted inside their rectangles. Same program, instance data
+  // and rasterization as the geometry pass, so the visible pixels are a subset of these.
+  void boxes(Frame& f) {
+    FrameSet* out = f.out;
     out->boxes.clear();
-    if (touched.empty()) return;
-    if (queries.size() < touched.size()) {
-      const std::size_t old = queries.size();
-      queries.resize(touched.size());
-      glCreateQueries(GL_SAMPLES_PASSED, static_cast<GLsizei>(touched.size() - old), queries.data() + old);
+    if (f.touched.empty()) return;
+    const Targets& t = *f.targets;
+    // Greedy grouping by rectangle overlap.
+    const std::size_t n = f.touched.size();
+    box_rect.resize(n);
+    box_group.assign(n, -1);
+    box_total.assign(n, 0);
+    int groups = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+      box_rect[a] = projectedRect(f, scene.instances()[rec].model, f.slot[rec]);
+      for (int g = 0; g <= groups && box_group[a] < 0; ++g) {
+        bool free = true;
+        for (std::size_t b = 0; b < a && free; ++b) {
+          if (box_group[b] != g) continue;
+          const auto& p = box_rect[a];
+          const auto& q = box_rect[b];
+          free = p[0] + p[2] <= q[0] || q[0] + q[2] <= p[0] || p[1] + p[3] <= q[1] || q[1] + q[3] <= p[1];
+        }
+        if (free) box_group[a] = g;
+      }
+      groups = std::max(groups, box_group[a] + 1);
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, t.occlusion_fbo);
+    setFrameUniforms(f);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glViewport(0, 0, t.width, t.height);
     glUseProgram(geometry_program);
     glBindVertexArray(vao);
-    glEnable(GL_SCISSOR_TEST);
-    glEnable(GL_DEPTH_TEST);
-    const float zero = 0.0f;
-    for (std::size_t q = 0; q < touched.size(); ++q) {
-      const int id = touched[q];
-      const auto rec = static_cast<std::uint32_t>(instance_record[static_cast<std::size_t>(id)]);
-      const auto rect = projectedRect(r, rec);
-      glScissor(rect[0], rect[1], rect[2], rect[3]);
-      glDepthMask(GL_TRUE);
-      glClearNamedFramebufferfv(t.occlusion_fbo, GL_DEPTH, 0, &zero);
-      glDepthFunc(GL_GREATER);
-      const int model = scene.instances()[rec].model;
-      const auto base = static_cast<GLuint>(slot[rec]);  // drawn, so uploaded this frame
-      drawModel(model, base, 1);
-      glDepthMask(GL_FALSE);
-      glDepthFunc(GL_EQUAL);
-      glBeginQuery(GL_SAMPLES_PASSED, queries[q]);
-      drawModel(model, base, 1);
-      glEndQuery(GL_SAMPLES_PASSED);
-    }
+    glVertexArrayVertexBuffer(vao, 1, f.instance_buffer, 0, sizeof(GpuInstance));
     glDisable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
-    out->boxes.reserve(touched.size());
-    for (std::size_t q = 0; q < touched.size(); ++q) {
-      const int id = touched[q];
-      BoxAcc& acc = box_acc[static_cast<std::size_t>(id)];
-      GLuint total = 0;
-      glGetQueryObjectuiv(queries[q], GL_QUERY_RESULT, &total);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    const GLuint none[4] = {0, 0, 0, 0};
+    const float zero = 0.0f;
+    const int models = static_cast<int>(scene.models().size());
+    for (int g = 0; g < groups; ++g) {
+      // The group's instances, by model, after the frame's culled ones.
+      box_upload.clear();
+      group_base.assign(static_cast<std::size_t>(models), 0);
+      group_count.assign(static_cast<std::size_t>(models), 0);
+      int x0 = t.width, y0 = t.height, x1 = 0, y1 = 0;
+      for (int m = 0; m < models; ++m) {
+        group_base[static_cast<std::size_t>(m)] = static_cast<GLuint>(f.upload.size() + box_upload.size());
+        for (std::size_t a = 0; a < n; ++a) {
+          if (box_group[a] != g) continue;
+          const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+          if (scene.instances()[rec].model != m) continue;
+          box_upload.push_back(f.upload[static_cast<std::size_t>(f.slot[rec])]);
+          ++group_count[static_cast<std::size_t>(m)];
+          const auto& r = box_rect[a];
+          x0 = std::min(x0, r[0]);
+          y0 = std::min(y0, r[1]);
+          x1 = std::max(x1, r[0] + r[2]);
+          y1 = std::max(y1, r[1] + r[3]);
+        }
+      }
+      glNamedBufferSubData(f.instance_buffer,
+                           static_cast<GLintptr>(f.upload.size() * sizeof(GpuInstance)),
+                           static_cast<GLsizeiptr>(box_upload.size() * sizeof(GpuInstance)),
+                           box_upload.data());
+      glClearNamedFramebufferuiv(t.fbo, GL_COLOR, 1, none);
+      glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &zero);
+      RenderStats counted;  // RenderStats::triangles counts the geometry pass only
+      for (int m = 0; m < models; ++m) {
+        const GLsizei c = group_count[static_cast<std::size_t>(m)];
+        if (c > 0) drawModel(m, group_base[static_cast<std::size_t>(m)], c, &counted);
+      }
+      f.stats.draw_calls += counted.draw_calls;
+      // Count each member's label inside its own rectangle.
+      if (x1 <= x0 || y1 <= y0) continue;
+      const int w = x1 - x0, h = y1 - y0;
+      box_labels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+      glReadPixels(x0, y0, w, h, GL_GREEN_INTEGER, GL_UNSIGNED_INT, box_labels.data());
+      for (std::size_t a = 0; a < n; ++a) {
+        if (box_group[a] != g) continue;
+        const auto id = static_cast<std::uint32_t>(f.touched[a].first);
+        const auto& r = box_rect[a];
+        int count = 0;
+        for (int y = r[1]; y < r[1] + r[3]; ++y) {
+          const std::uint32_t* row = box_labels.data() + static_cast<std::size_t>(y - y0) * static_cast<std::size_t>(w);
+          for (int x = r[0]; x < r[0] + r[2]; ++x) count += (row[x - x0] & 0xFFFFu) == id ? 1 : 0;
+        }
+        box_total[a] = count;
+      }
+    }
+    out->boxes.reserve(n);
+    for (std::size_t a = 0; a < n; ++a) {
+      const auto& [id, acc] = f.touched[a];
       const int rec = instance_record[static_cast<std::size_t>(id)];
       const SceneInstance& si = scene.instances()[static_cast<std::size_t>(rec)];
       BoundingBox b;
@@ -897,73 +1020,88 @@ struct Renderer::Impl {
       b.x_max = acc.x_max;
       b.y_max = acc.y_max;
       b.visible_pixels = acc.count;
-      // The counted coverage holds the visible pixels; max() only guards a driver that breaks
-      // the invariance the GL promises.
-      b.total_pixels = std::max(static_cast<int>(total), acc.count);
+      // The coverage holds the visible pixels; max() only guards a driver that breaks the
+      // invariance the GL promises.
+      b.total_pixels = std::max(box_total[a], acc.count);
       b.occlusion = 1.0 - static_cast<double>(b.visible_pixels) / b.total_pixels;
       out->boxes.push_back(std::move(b));
-      acc = BoxAcc{};
     }
     checkGl("boxes");
   }
 
-  void setHidden(const std::vector<std::string>& ids) {
-    for (std::uint32_t i : hidden_list) hidden[i] = 0;
-    hidden_list.clear();
-    for (const std::string& id : ids) {
-      auto [b, e] = by_id.equal_range(id);
-      if (b == e) throw RenderError("RenderRequest.hidden_entities: unknown entity '" + id + "'");
-      for (auto it = b; it != e; ++it) {
-        const auto rec = static_cast<std::uint32_t>(instance_record[static_cast<std::size_t>(it->second)]);
-        hidden[rec] = 1;
-        hidden_list.push_back(rec);
-      }
-    }
-  }
-
-  void render(const RenderRequest& r, FrameSet* out) {
+  // Renders the requests in phases so that the CPU and the GL overlap: every geometry pass is
+  // submitted first (the GL rasterizes one while the next is culled and its vertices
+  // processed), then each frame is read back, then the camera effects of each run on the CPU
+  // (while the GL still works on later frames), then the boxes.
+  void render(const std::vector<const RenderRequest*>& requests, const std::vector<FrameSet*>& outs) {
     egl.makeCurrent();
-    validate(r);
-    setHidden(r.hidden_entities);
-    stats = RenderStats{};
-    auto stage_end = [this](Clock::time_point* t0, double* ms) {
-      if (options.stage_timing) glFinish();
+    for (const RenderRequest* r : requests) validate(*r);
+    const bool timing = options.stage_timing;
+    auto stage_end = [timing](Clock::time_point* t0, double* ms) {
+      if (timing) glFinish();
       *ms += msSince(*t0);
       *t0 = Clock::now();
     };
-    auto t0 = Clock::now();
-    Targets& t = targetsFor(r.intrinsics.width, r.intrinsics.height);
-    camera = r.world_T_optical.translation();
-    focal = std::max(r.intrinsics.fx, r.intrinsics.fy);
-    float view_proj[16];
-    Eigen::Matrix4d full;
-    projection(r, view_proj, &full);
-    frustumPlanes(full);
-    cullAndUpload(r);
-    const Lighting l = lightingFor(config.environment, r.weather);
-    setFrameUniforms(r, l, view_proj);
-    cameraEffects(r);
-    stage_end(&t0, &stats.cull_upload_ms);
-
-    geometryPass(r, l, t);
-    stage_end(&t0, &stats.draw_ms);
-    particlePass(r, l, t);
-    stage_end(&t0, &stats.post_ms);
-    readBack(t, out);
-    splitLabels(t.width, out);
-    stage_end(&t0, &stats.readback_ms);
-    if (effects.any()) {
-      applyCameraEffects(color_scratch.data(), t.width, t.height, effects, out->rgb.data(),
-                         &effects_scratch);
-      stage_end(&t0, &stats.post_ms);
+    for (std::size_t i = 0; i < requests.size(); ++i) {
+      Frame& f = frameSlot(i);
+      const RenderRequest& r = *requests[i];
+      f.request = &r;
+      f.out = outs[i];
+      f.stats = RenderStats{};
+      auto t0 = Clock::now();
+      f.targets = &targetsFor(f, r.intrinsics.width, r.intrinsics.height);
+      setHidden(r.hidden_entities);
+      camera = r.world_T_optical.translation();
+      f.camera = camera;
+      focal = std::max(r.intrinsics.fx, r.intrinsics.fy);
+      Eigen::Matrix4d full;
+      projection(r, f.view_proj, &full);
+      frustumPlanes(full);
+      cullAndUpload(r, f);
+      f.lighting = lightingFor(config.environment, r.weather);
+      cameraEffects(f);
+      stage_end(&t0, &f.stats.cull_upload_ms);
+      geometryPass(f);
+      stage_end(&t0, &f.stats.draw_ms);
+      particlePass(f);
+      glFlush();
+      stage_end(&t0, &f.stats.post_ms);
     }
-    boxes(r, t, out);
-    stage_end(&t0, &stats.boxes_ms);
-
-    out->time = r.time;
-    out->intrinsics = r.intrinsics;
-    out->world_T_optical = r.world_T_optical;
+    for (std::size_t i = 0; i < requests.size(); ++i) {
+      Frame& f = *frames[i];
+      auto t0 = Clock::now();
+      readBack(f);
+      splitLabels(f);
+      stage_end(&t0, &f.stats.readback_ms);
+      if (f.effects.any()) {
+        applyCameraEffects(f.color.data(), f.targets->width, f.targets->height, f.effects,
+                           f.out->rgb.data(), &effects_scratch);
+      }
+      stage_end(&t0, &f.stats.post_ms);
+    }
+    stats = RenderStats{};
+    for (std::size_t i = 0; i < requests.size(); ++i) {
+      Frame& f = *frames[i];
+      auto t0 = Clock::now();
+      boxes(f);
+      stage_end(&t0, &f.stats.boxes_ms);
+      FrameSet* out = f.out;
+      out->time = f.request->time;
+      out->intrinsics = f.request->intrinsics;
+      out->world_T_optical = f.request->world_T_optical;
+      stats.cull_upload_ms += f.stats.cull_upload_ms;
+      stats.draw_ms += f.stats.draw_ms;
+      stats.post_ms += f.stats.post_ms;
+      stats.readback_ms += f.stats.readback_ms;
+      stats.boxes_ms += f.stats.boxes_ms;
+      stats.instances += f.stats.instances;
+      stats.triangles += f.stats.triangles;
+      stats.draw_calls += f.stats.draw_calls;
+      f.request = nullptr;
+      f.out = nullptr;
+    }
   }
+
   const scenario::SimConfig config;  // a copy: the scene poses movers from it
   RendererOptions options;
   Scene scene;
@@ -977,25 +1115,19 @@ struct Renderer::Impl {
   struct {
     GLint world_R_optical, intrinsics, zenith, horizon, sun_dir, glow, far_clip, haze_color, haze_k;
   } sky_loc{};
-
   struct {
     GLint key, size, cells_x, cell, length, radius, density, layer, fall, intrinsics, alpha,
         brightness;
   } particle_loc{};
-  CameraEffects effects;
-  std::vector<std::uint8_t> color_scratch;
-  CameraEffectsScratch effects_scratch;
-  GLuint vao = 0, empty_vao = 0, vertex_buffer = 0, element_buffer = 0, instance_buffer = 0;
+  GLuint vao = 0, empty_vao = 0, vertex_buffer = 0, element_buffer = 0;
   std::vector<GLint> model_base_vertex;
   std::vector<std::size_t> model_first_element;
-  std::vector<GLuint> model_base_instance;
   std::vector<int> draw_order;
   std::vector<InstanceRecord> records;
   std::uint32_t uav_record = 0;
-  std::vector<Targets> targets;
+  std::vector<std::unique_ptr<Frame>> frames;  // one slot per request of a batch
 
   // Culling.
-  Eigen::Vector2d grid_origin{0, 0};
   int grid_nx = 1, grid_ny = 1;
   std::vector<Eigen::Vector3f> cell_lo, cell_hi;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> cell_range;  // [cell * models + model]
@@ -1007,42 +1139,49 @@ struct Renderer::Impl {
   double focal = 1.0;
   std::vector<std::pair<double, int>> cell_order;
   std::vector<std::vector<std::uint32_t>> visible;  // per model
-  std::vector<GpuInstance> upload;
-  std::vector<int> slot;  // per record: its index in this frame's upload, or -1
-  std::vector<std::uint32_t> uploaded;  // records in this frame's upload
-  std::vector<std::uint8_t> hidden;  // per record
+  std::vector<std::uint8_t> hidden;                 // per record
   std::vector<std::uint32_t> hidden_list;
 
-  // Labels and boxes.
-  std::vector<std::uint8_t> interest;   // per instance id
-  std::vector<int> instance_record;     // instance id -> record
-  std::vector<BoxAcc> box_acc;          // per instance id
+  // Labels, boxes, camera effects.
+  std::vector<std::uint8_t> interest;  // per instance id
+  std::vector<int> instance_record;    // instance id -> record
+  std::vector<BoxAcc> box_acc;         // per instance id
   std::vector<int> touched;
   std::vector<std::uint32_t> label_scratch;
-  std::vector<GLuint> queries;
+  CameraEffectsScratch effects_scratch;
+  std::vector<std::array<int, 4>> box_rect;
+  std::vector<int> box_group, box_total;
+  std::vector<GpuInstance> box_upload;
+  std::vector<GLuint> group_base;
+  std::vector<GLsizei> group_count;
+  std::vector<std::uint32_t> box_labels;
 };
 
 Renderer::Renderer(const scenario::World& world, const scenario::SimConfig& config,
                    const RendererOptions& options)
-    : impl_(std::make_unique<Impl>(world, config, options)) {
-  auto& i = *impl_;
-  auto sky = [&i](const char* n) { return glGetUniformLocation(i.sky_program, n); };
-  i.sky_loc = {sky("u_world_R_optical"), sky("u_intrinsics"), sky("u_zenith"),  sky("u_horizon"),    sky("u_sun_dir"),
-               sky("u_glow"),       sky("u_far"),     sky("u_haze_color"), sky("u_haze_k")};
-  auto part = [&i](const char* n) { return glGetUniformLocation(i.particle_program, n); };
-  i.particle_loc = {part("u_key"),    part("u_size"),      part("u_cells_x"), part("u_cell"),
-                    part("u_length"), part("u_radius"),    part("u_density"), part("u_layer"),
-                    part("u_fall"),   part("u_intrinsics"), part("u_alpha"),  part("u_brightness")};
-}
+    : impl_(std::make_unique<Impl>(world, config, options)) {}
 
 Renderer::~Renderer() = default;
 
-void Renderer::render(const RenderRequest& request, FrameSet* out) { impl_->render(request, out); }
+void Renderer::render(const RenderRequest& request, FrameSet* out) {
+  impl_->render({&request}, {out});
+}
 
 FrameSet Renderer::render(const RenderRequest& request) {
   FrameSet f;
-  impl_->render(request, &f);
+  impl_->render({&request}, {&f});
   return f;
+}
+
+void Renderer::render(const std::vector<RenderRequest>& requests, std::vector<FrameSet>* out) {
+  out->resize(requests.size());
+  std::vector<const RenderRequest*> r;
+  std::vector<FrameSet*> o;
+  for (std::size_t i = 0; i < requests.size(); ++i) {
+    r.push_back(&requests[i]);
+    o.push_back(&(*out)[i]);
+  }
+  impl_->render(r, o);
 }
 
 void Renderer::makeCurrent() { impl_->egl.makeCurrent(); }

@@ -63,7 +63,7 @@ Mesh groundMesh(const geometry::Aabb2& bounds) {
       quads.push_back({{{xa, ya, 0}, {xb, ya, 0}, {xb, yb, 0}, {xa, yb, 0}}});
     }
   }
-  return flatMesh("ground", MaterialKind::kLawn, srgbToLinear(92, 122, 58), quads);
+  return flatMesh("ground", MaterialKind::kLawn, srgbToLinear(82, 106, 54), quads);
 }
 
 // The sidewalk rings: a strip of the given width centred on each block's closed ring (convex),

@@ -1,6 +1,6 @@
 #pragma once
-// GLSL 4.50 sources of the renderer's three programs: the geometry pass (lit colour, linear
-// depth, labels into three targets), the sky (pixels no geometry covered) and the weather
+// GLSL 4.50 sources of the renderer's three programs: the geometry pass (lit colour, and linear
+// depth with the label in one two-channel integer target), the sky (pixels no geometry covered) and the weather
 // particles blended onto the colour. Motion blur and sensor noise follow on the CPU
 // (camera_effects.h).
 
@@ -25,10 +25,13 @@ uniform mat4 u_view_proj;  // projection * world-to-optical rotation, camera-rel
 uniform vec3 u_camera;     // optical centre in the world
 uniform vec3 u_canopy_center;  // foliage vertices scale about it by the canopy factor
 
-out vec3 v_rel;     // world position - camera position
-out vec3 v_normal;  // world normal (not normalized)
-out vec4 v_street;  // mesh-local x, y in metres; instance length, width (street markings)
-flat out uvec3 v_ids;  // colour, label, material
+// Everything the fragment shader needs is constant per triangle (the meshes have per-face
+// normals), so nothing is interpolated but the position: the fragment rebuilds its world
+// position from the pixel and the depth.
+flat out vec3 v_normal;  // world normal (not normalized)
+flat out uvec3 v_ids;    // colour, label, material
+flat out vec4 v_frame;   // instance origin x, y and unit heading x, y (street markings)
+flat out vec2 v_extent;  // instance length and width
 invariant gl_Position;
 
 void main() {
@@ -38,11 +41,10 @@ void main() {
   vec3 world = vec3(dot(i_row0, p4), dot(i_row1, p4), dot(i_row2, p4));
   v_normal = vec3(dot(i_normal0.xyz, a_normal), dot(i_normal1.xyz, a_normal),
                   dot(i_normal2.xyz, a_normal));
-  v_rel = world - u_camera;
-  vec2 extent = vec2(i_normal1.w, i_normal2.w);
-  v_street = vec4(a_position.xy * extent, extent);
+  v_extent = vec2(i_normal1.w, i_normal2.w);
+  v_frame = vec4(i_row0.w, i_row1.w, vec2(i_row0.x, i_row1.x) / max(v_extent.x, 1e-6));
   v_ids = uvec3(i_ids, a_material);
-  gl_Position = u_view_proj * vec4(v_rel, 1.0);
+  gl_Position = u_view_proj * vec4(world - u_camera, 1.0);
 }
 )GLSL";
 
@@ -63,14 +65,13 @@ vec3 haze(vec3 c, float distance) {
 )GLSL";
 
 inline constexpr const char* kGeometryFragment = R"GLSL(
-in vec3 v_rel;
-in vec3 v_normal;
-in vec4 v_street;
+flat in vec3 v_normal;
 flat in uvec3 v_ids;
+flat in vec4 v_frame;
+flat in vec2 v_extent;
 
 layout(location = 0) out vec4 o_color;
-layout(location = 1) out float o_depth;
-layout(location = 2) out uint o_label;
+layout(location = 1) out uvec2 o_depth_label;  // depth (float bits), semantic << 16 | instance
 
 uniform float u_near;
 uniform float u_far;
@@ -81,6 +82,10 @@ uniform vec3 u_ground_ambient;
 uniform float u_snow;
 uniform float u_wet;
 uniform vec3 u_camera;
+uniform vec3 u_air_color;  // aerial perspective: clear air fades far surfaces to the horizon
+uniform float u_air_k;
+uniform mat3 u_world_R_optical;
+uniform vec4 u_intrinsics;  // fx, fy, cx, cy
 
 vec3 unpack8(uint c) {
   return vec3(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) / 255.0;
@@ -98,6 +103,13 @@ float valueNoise(vec2 p) {
 }
 
 void main() {
+  // Distance along the optical axis from the reversed-Z window depth (exact inverse of the
+  // projection): z_w = n (f - Z) / (Z (f - n)).
+  float depth = u_near * u_far / (gl_FragCoord.z * (u_far - u_near) + u_near);
+  // The pixel's ray (optical z = 1; rows top first: window y = v + 0.5) and the world point.
+  vec3 ray = vec3((gl_FragCoord.x - 0.5 - u_intrinsics.z) / u_intrinsics.x,
+                  (gl_FragCoord.y - 0.5 - u_intrinsics.w) / u_intrinsics.y, 1.0);
+  vec3 rel = depth * (u_world_R_optical * ray);
   vec3 n = normalize(v_normal);
   uint material = v_ids.z;
   uint kind = material & 255u;
@@ -111,22 +123,23 @@ void main() {
   } else if (kind == 2u) {
     albedo *= 2.0 * unpack8(v_ids.x);
   } else if (kind == 3u) {
-    vec2 w = v_rel.xy + u_camera.xy;
+    vec2 w = rel.xy + u_camera.xy;
     float patches = valueNoise(w * (1.0 / 9.0));
     albedo *= 0.8 + 0.4 * patches;
     albedo = mix(albedo, vec3(0.26, 0.25, 0.13), 0.4 * smoothstep(0.6, 0.95, patches));
   } else if (kind == 4u) {
-    vec2 w = v_rel.xy + u_camera.xy;
+    vec2 w = rel.xy + u_camera.xy;
     albedo *= 0.85 + 0.3 * valueNoise(w * 0.9);
     // Dashed yellow centre line, not across the intersections at either end.
-    float along = v_street.x, across = v_street.y;
-    float open = 0.5 * v_street.z - v_street.w - 1.0;
+    vec2 d = w - v_frame.xy;
+    float along = dot(d, v_frame.zw), across = dot(d, vec2(-v_frame.w, v_frame.z));
+    float open = 0.5 * v_extent.x - v_extent.y - 1.0;
     if (abs(across) < 0.07 && abs(along) < open && fract(along / 6.0) < 0.5) {
       albedo = vec3(0.62, 0.45, 0.06);
     }
     snow_hold = 0.55;  // traffic clears part of it
   } else if (kind == 5u) {
-    vec2 w = v_rel.xy + u_camera.xy;
+    vec2 w = rel.xy + u_camera.xy;
     albedo *= 0.92 + 0.12 * valueNoise(w * 1.7);
   }
   if (u_wet > 0.0) albedo *= 1.0 - u_wet * (0.18 + 0.22 * max(n.z, 0.0));
@@ -137,17 +150,17 @@ void main() {
   float ndl = max(dot(n, u_sun_dir), 0.0);
   vec3 hemi = mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
   vec3 c = albedo * (u_sun_color * ndl + hemi);
-  c = haze(c, length(v_rel));
+  float distance = depth * length(ray);
+  c = mix(u_air_color, c, exp(-u_air_k * distance));
+  c = haze(c, distance);
   o_color = vec4(toDisplay(c), 1.0);
-  // Distance along the optical axis from the reversed-Z window depth (exact inverse of the
-  // projection): z_w = n (f - Z) / (Z (f - n)).
-  o_depth = u_near * u_far / (gl_FragCoord.z * (u_far - u_near) + u_near);
-  o_label = v_ids.y;
+  o_depth_label = uvec2(floatBitsToUint(depth), v_ids.y);
 }
 )GLSL";
 
 // A full-screen triangle at the far plane (window depth 0), drawn with GL_EQUAL after the
-// geometry, so it shades only the pixels nothing covered.
+// geometry, so it shades only the pixels nothing covered (and every one of them: the colour
+// and depth-label targets need no clearing).
 inline constexpr const char* kFullscreenVertex = R"GLSL(
 #version 450 core
 void main() {
@@ -158,8 +171,7 @@ void main() {
 
 inline constexpr const char* kSkyFragment = R"GLSL(
 layout(location = 0) out vec4 o_color;
-layout(location = 1) out float o_depth;
-layout(location = 2) out uint o_label;
+layout(location = 1) out uvec2 o_depth_label;
 
 uniform mat3 u_world_R_optical;
 uniform vec4 u_intrinsics;  // fx, fy, cx, cy
@@ -181,8 +193,7 @@ void main() {
   c += u_glow * (0.35 * pow(s, 8.0) + 2.0 * pow(s, 600.0));
   c = haze(c, u_far);
   o_color = vec4(toDisplay(c), 1.0);
-  o_depth = uintBitsToFloat(0x7F800000u);  // +inf: nothing hit
-  o_label = 0u;
+  o_depth_label = uvec2(0x7F800000u, 0u);  // depth +inf: nothing hit; label 0
 }
 )GLSL";
 

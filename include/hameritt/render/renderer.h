@@ -50,6 +50,11 @@ Intrinsics intrinsicsFromHfov(int width, int height, double hfov_deg);
 Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Eigen::Vector3d& mount_xyz,
                               const Eigen::Vector3d& mount_rpy);
 
+// Pixel (u, v) where a world point appears in a camera at world_T_optical with intrinsics k
+// (u = fx X / Z + cx, v = fy Y / Z + cy in the optical frame); false when Z <= 0.
+bool projectPoint(const Intrinsics& k, const Eigen::Isometry3d& world_T_optical,
+                  const Eigen::Vector3d& p_world, Eigen::Vector2d* uv);
+
 struct RenderRequest {
   Intrinsics intrinsics;
   Eigen::Isometry3d world_T_optical = Eigen::Isometry3d::Identity();
@@ -107,16 +112,17 @@ struct RendererOptions {
   bool stage_timing = false;
 };
 
-// What the last render() did and where its time went (milliseconds of wall time).
+// What the last render() call did and where its time went (milliseconds of wall time; summed
+// over the requests of a batch).
 struct RenderStats {
   double cull_upload_ms = 0;  // frustum culling, instance upload
   double draw_ms = 0;         // geometry pass (with stage_timing: until the GL has finished it)
   double post_ms = 0;         // weather particles, blur, noise
   double readback_ms = 0;     // colour, depth and labels read back and split
   double boxes_ms = 0;        // boxes from the instance mask, occlusion queries
-  std::size_t instances = 0;  // instances drawn
+  std::size_t instances = 0;  // instances drawn in the geometry pass
   std::size_t triangles = 0;  // triangles submitted to the geometry pass
-  std::size_t draw_calls = 0;
+  std::size_t draw_calls = 0; // all passes
 };
 
 // World triangles for ray-cast checks (what the renderer draws, in world coordinates).
@@ -139,6 +145,10 @@ class Renderer {
   // Renders one frame set and reads it back; `out`'s buffers are reused.
   void render(const RenderRequest& request, FrameSet* out);
   FrameSet render(const RenderRequest& request);
+  // Renders several requests (e.g. every camera of one instant) into out[i], the same as one
+  // render() each, faster: the GL rasterizes one request while the CPU prepares the next and
+  // applies the camera effects of another. `out`'s buffers are reused.
+  void render(const std::vector<RenderRequest>& requests, std::vector<FrameSet>* out);
 
   // Makes the EGL context current on the calling thread (render() from another thread; render()
   // also does it when needed). The thread that had it must call releaseCurrent() first.
