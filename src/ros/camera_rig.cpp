@@ -118,24 +118,24 @@ std::vector<std::pair<std::string, Eigen::Isometry3d>> CameraRig::opticalMounts(
 }
 
 void CameraRig::afterStep(std::int64_t step, const sim::UavState& uav) {
+  Job job;
   for (const auto& cam : cameras_) {
     if (step % cam->steps_per_frame != 0 || !cam->wanted()) continue;
-    Job job;
-    job.camera = cam->index;
-    job.frame = static_cast<std::uint64_t>(step / cam->steps_per_frame);
-    job.time = uav.t;
-    job.world_T_base = Eigen::Isometry3d::Identity();
-    job.world_T_base.linear() = uav.orientation.toRotationMatrix();
-    job.world_T_base.translation() = uav.position;
-    job.velocity = uav.velocity;
-    std::unique_lock<std::mutex> lock(mutex_);
-    cv_.wait(lock, [this] {
-      return static_cast<int>(queue_.size()) < std::max(1, options_.queue_depth) || stop_;
-    });
-    queue_.push_back(job);
-    lock.unlock();
-    cv_.notify_all();
+    job.shots.emplace_back(cam->index, static_cast<std::uint64_t>(step / cam->steps_per_frame));
   }
+  if (job.shots.empty()) return;
+  job.time = uav.t;
+  job.world_T_base = Eigen::Isometry3d::Identity();
+  job.world_T_base.linear() = uav.orientation.toRotationMatrix();
+  job.world_T_base.translation() = uav.position;
+  job.velocity = uav.velocity;
+  std::unique_lock<std::mutex> lock(mutex_);
+  cv_.wait(lock, [this] {
+    return static_cast<int>(queue_.size()) < std::max(1, options_.queue_depth) || stop_;
+  });
+  queue_.push_back(std::move(job));
+  lock.unlock();
+  cv_.notify_all();
 }
 
 void CameraRig::flush() {
@@ -181,48 +181,60 @@ void CameraRig::run() {
   cv_.notify_all();
   if (!renderer) return;
 
-  render::FrameSet fs;
+  std::vector<render::RenderRequest> requests;
+  std::vector<render::FrameSet> frames;
   while (true) {
     Job job;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       cv_.wait(lock, [this] { return !queue_.empty() || stop_; });
       if (stop_) return;
-      job = queue_.front();
+      job = std::move(queue_.front());
       queue_.pop_front();
       busy_ = true;
     }
     cv_.notify_all();
-    const Camera& cam = *cameras_[static_cast<std::size_t>(job.camera)];
-    render::RenderRequest req;
-    req.intrinsics = cam.intrinsics;
-    req.world_T_optical = render::opticalPose(job.world_T_base, cam.spec.mount_xyz, cam.spec.mount_rpy * kDeg);
-    req.time = job.time;
-    req.camera_index = cam.index;
-    req.frame_index = job.frame;
-    req.weather = options_.weather;
-    req.noise = options_.noise;
-    // Motion blur along the image-plane direction of the camera's own motion.
-    const Eigen::Vector3d v_opt = req.world_T_optical.linear().transpose() * job.velocity;
-    if (std::hypot(v_opt.x(), v_opt.y()) > 0.2) req.blur_direction = Eigen::Vector2d(v_opt.x(), v_opt.y()).normalized();
+    requests.clear();
+    for (const auto& [index, frame] : job.shots) {
+      const Camera& cam = *cameras_[static_cast<std::size_t>(index)];
+      render::RenderRequest req;
+      req.intrinsics = cam.intrinsics;
+      req.world_T_optical =
+          render::opticalPose(job.world_T_base, cam.spec.mount_xyz, cam.spec.mount_rpy * kDeg);
+      req.time = job.time;
+      req.camera_index = cam.index;
+      req.frame_index = frame;
+      req.weather = options_.weather;
+      req.noise = options_.noise;
+      // Motion blur along the image-plane direction of the camera's own motion.
+      const Eigen::Vector3d v_opt = req.world_T_optical.linear().transpose() * job.velocity;
+      if (std::hypot(v_opt.x(), v_opt.y()) > 0.2) {
+        req.blur_direction = Eigen::Vector2d(v_opt.x(), v_opt.y()).normalized();
+      }
+      requests.push_back(req);
+    }
     try {
-      renderer->render(req, &fs);
-      publish(cam, job, fs);
+      // One batch: the GL rasterizes one camera while the CPU finishes another.
+      renderer->render(requests, &frames);
+      for (std::size_t i = 0; i < job.shots.size(); ++i) {
+        const Camera& cam = *cameras_[static_cast<std::size_t>(job.shots[i].first)];
+        publish(cam, job.shots[i].second, job.time, frames[i]);
+      }
     } catch (const std::exception& e) {
-      ROS_ERROR_THROTTLE(5.0, "simulator: camera %s: %s", cam.spec.name.c_str(), e.what());
+      ROS_ERROR_THROTTLE(5.0, "simulator: cameras: %s", e.what());
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
       busy_ = false;
-      ++published_;
+      published_ += job.shots.size();
     }
     cv_.notify_all();
   }
 }
 
-void CameraRig::publish(const Camera& cam, const Job& job, const render::FrameSet& fs) {
+void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, const render::FrameSet& fs) {
   std_msgs::Header header;
-  header.stamp.fromSec(job.time);
+  header.stamp.fromSec(time);
   header.frame_id = cam.frame_id;
   const int w = fs.intrinsics.width, h = fs.intrinsics.height;
   auto image = [&](const std::string& encoding, int bytes_per_pixel, const void* data) {
@@ -238,7 +250,7 @@ void CameraRig::publish(const Camera& cam, const Job& job, const render::FrameSe
     return m;
   };
   const bool decimated =
-      cam.frames_per_decimated > 0 && job.frame % static_cast<std::uint64_t>(cam.frames_per_decimated) == 0;
+      cam.frames_per_decimated > 0 && frame % static_cast<std::uint64_t>(cam.frames_per_decimated) == 0;
   // One message per modality, shared by the full-rate and the decimated publisher.
   auto send = [&](bool on, const ros::Publisher& full, const ros::Publisher& dec, const std::string& encoding,
                   int bytes, const void* data) {

@@ -68,15 +68,15 @@ class CameraRig {
 
  private:
   struct Camera;
+  // The cameras due at one physics step, rendered as one batch.
   struct Job {
-    int camera = 0;
-    std::uint64_t frame = 0;
+    std::vector<std::pair<int, std::uint64_t>> shots;  // (camera, frame index)
     double time = 0;
     Eigen::Isometry3d world_T_base = Eigen::Isometry3d::Identity();
     Eigen::Vector3d velocity{0, 0, 0};
   };
   void run();
-  void publish(const Camera& cam, const Job& job, const render::FrameSet& fs);
+  void publish(const Camera& cam, std::uint64_t frame, double time, const render::FrameSet& fs);
 
   const scenario::World& world_;
   const scenario::SimConfig& config_;
