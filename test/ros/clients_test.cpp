@@ -95,11 +95,16 @@ TEST(Clients, CoverageSearchReachesTheFirstAreaAndSweepsItThroughThePlanner) {
   ASSERT_TRUE(ros::service::waitForService("/planner/plan_path", ros::Duration(60)));
   ASSERT_TRUE(o.spinUntil([&] { return o.wp_sub_.getNumPublishers() > 0; }, 60.0))
       << "coverage_search_client is not up";
+  // Step until the client has odometry and answers with waypoints: its odometry subscription
+  // may connect a moment after it advertises, and a paused simulator publishes nothing between
+  // steps, so a single step can go unheard on a loaded machine.
   hameritt::StepSimulation step;
   step.request.steps = 1;
-  ASSERT_TRUE(ros::service::call("/simulator/step", step));
-  ASSERT_TRUE(o.spinUntil([&] { return !o.waypoints.empty(); }, 60.0))
-      << "the client sent no waypoints";
+  for (int i = 0; i < 60 && o.waypoints.empty(); ++i) {
+    ASSERT_TRUE(ros::service::call("/simulator/step", step));
+    o.spinUntil([&] { return !o.waypoints.empty(); }, 1.0);
+  }
+  ASSERT_FALSE(o.waypoints.empty()) << "the client sent no waypoints";
   o.spinUntil(
       [&] {
         return std::any_of(o.progress.begin(), o.progress.end(), [](const auto& p) {
