@@ -4,6 +4,7 @@
 #include <cmath>
 #include <variant>
 
+#include "hameritt/ros/mission_conversions.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/scenario_io.h"
 
@@ -92,88 +93,10 @@ std::vector<hameritt::KeyValue> toKeyValues(const scenario::Attributes& a) {
 }
 
 hameritt::Mission toMsg(const scenario::Mission& m, const ros::Time& stamp) {
-  hameritt::Mission msg;
+  // One conversion for the ADK and the clients (mission_conversions.cpp); the ADK stamps it.
+  hameritt::Mission msg = toMsg(m);
   msg.header.stamp = stamp;
   msg.header.frame_id = kMap;
-  msg.scenario_id = m.scenario_id;
-  msg.scenario_class = scenario::toString(m.cls);
-  msg.seed = m.seed;
-  msg.origin_latitude = m.origin.latitude;
-  msg.origin_longitude = m.origin.longitude;
-  msg.origin_altitude = m.origin.altitude;
-  msg.time_limit = m.time_limit;
-  msg.objective.type = m.objective.type;
-  msg.objective.text = m.objective.text;
-  for (const auto& t : m.objective.targets) {
-    hameritt::TargetDescription d;
-    d.id = t.id;
-    d.entity_class = t.cls;
-    d.vehicle_class = t.vehicle_class;
-    d.make = t.make;
-    d.model = t.model;
-    d.color = t.color;
-    msg.objective.targets.push_back(d);
-  }
-  for (const auto& a : m.aois) {
-    hameritt::AreaOfInterest am;
-    am.id = a.id;
-    am.polygon = points(a.polygon.vertices());
-    am.window = toMsg(a.window);
-    msg.areas_of_interest.push_back(am);
-  }
-  for (const auto& k : m.kozs) {
-    hameritt::KeepOutZone km;
-    km.id = k.id;
-    km.purpose = k.purpose;
-    km.polygon = points(k.polygon.vertices());
-    km.has_alt_min = k.alt_min.has_value();
-    km.alt_min = k.alt_min.value_or(0.0);
-    km.has_alt_max = k.alt_max.has_value();
-    km.alt_max = k.alt_max.value_or(0.0);
-    km.window = toMsg(k.window);
-    msg.keep_out_zones.push_back(km);
-  }
-  for (const auto& p : m.priors) {
-    hameritt::AreaPrior pm;
-    pm.aoi_id = p.aoi_id;
-    pm.depth = p.depth;
-    for (const auto& c : p.cells) {
-      hameritt::PriorCell cm;
-      cm.id = c.id;
-      cm.row = c.row;
-      cm.col = c.col;
-      cm.polygon = points(c.polygon.vertices());
-      cm.probability = c.probability;
-      pm.cells.push_back(cm);
-    }
-    msg.area_priors.push_back(pm);
-  }
-  for (const auto& r : m.routes) {
-    hameritt::RouteOfInterest rm;
-    rm.id = r.id;
-    rm.polyline = points(r.polyline);
-    rm.streets = r.streets;
-    rm.band_width = r.band_width;
-    rm.band = points(r.band.vertices());
-    msg.routes.push_back(rm);
-  }
-  for (const auto& r : m.relations) {
-    hameritt::SceneRelation rm;
-    rm.target_id = r.target_id;
-    rm.op = scenario::toString(r.op, false);
-    rm.eventually = r.eventually;
-    rm.related_id = r.related_id;
-    rm.related_class = r.related_class;
-    rm.related_attributes = toKeyValues(r.related_attributes);
-    rm.distance = r.distance;
-    rm.bearing_deg = r.bearing_deg;
-    rm.dz = r.dz;
-    rm.line_of_sight = r.line_of_sight;
-    rm.has_time = r.time.has_value();
-    rm.time = r.time.value_or(0.0);
-    rm.text = scenario::relationText(r);
-    msg.relations.push_back(rm);
-  }
   return msg;
 }
 

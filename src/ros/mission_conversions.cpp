@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include "hameritt/scenario/error.h"
+#include "hameritt/scenario/scenario_io.h"
 
 namespace hameritt::ros_wrappers {
 
@@ -155,6 +156,7 @@ hameritt::Mission toMsg(const scenario::Mission& mission) {
     x.line_of_sight = r.line_of_sight;
     x.has_time = r.time.has_value();
     x.time = r.time.value_or(0.0);
+    x.text = scenario::relationText(r);
     m.relations.push_back(x);
   }
   return m;
