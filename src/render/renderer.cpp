@@ -146,7 +146,7 @@ constexpr ParticleLayer kSnowLayers[] = {
 
 struct Uniforms {
   GLint view_proj, camera, canopy_center, near_clip, far_clip, sun_dir, sun_color, sky_ambient,
-      ground_ambient, snow, wet, haze_color, haze_k, world_R_optical, intrinsics, air_color, air_k;
+      ground_ambient, snow, wet, world_R_optical, intrinsics, extinction_color, extinction_k;
 };
 
 // Pixel bounds and count of one instance in the mask.
@@ -234,9 +234,8 @@ struct Renderer::Impl {
     u = {loc("u_view_proj"),   loc("u_camera"),         loc("u_canopy_center"),
          loc("u_near"),        loc("u_far"),            loc("u_sun_dir"),
          loc("u_sun_color"),   loc("u_sky_ambient"),    loc("u_ground_ambient"),
-         loc("u_snow"),        loc("u_wet"),            loc("u_haze_color"),
-         loc("u_haze_k"),      loc("u_world_R_optical"), loc("u_intrinsics"),
-         loc("u_air_color"),   loc("u_air_k")};
+         loc("u_snow"),        loc("u_wet"),            loc("u_world_R_optical"),
+         loc("u_intrinsics"),  loc("u_extinction_color"), loc("u_extinction_k")};
     auto sky = [this](const char* n) { return glGetUniformLocation(sky_program, n); };
     sky_loc = {sky("u_world_R_optical"), sky("u_intrinsics"), sky("u_zenith"),
                sky("u_horizon"),         sky("u_sun_dir"),    sky("u_glow"),
@@ -653,10 +652,13 @@ struct Renderer::Impl {
     glProgramUniform3fv(p, u.ground_ambient, 1, l.ground_ambient.data());
     glProgramUniform1f(p, u.snow, l.snow_cover);
     glProgramUniform1f(p, u.wet, l.wetness);
-    glProgramUniform3fv(p, u.haze_color, 1, l.haze_color.data());
-    glProgramUniform1f(p, u.haze_k, l.haze_k);
-    glProgramUniform3fv(p, u.air_color, 1, l.air_color.data());
-    glProgramUniform1f(p, u.air_k, l.air_k);
+    // Clear air and weather haze as one medium: summed extinction, in-scattered colours
+    // weighted by their extinction.
+    const float k = l.air_k + l.haze_k;
+    const Eigen::Vector3f ext = k > 0 ? Eigen::Vector3f((l.air_k * l.air_color + l.haze_k * l.haze_color) / k)
+                                      : Eigen::Vector3f::Zero();
+    glProgramUniform3fv(p, u.extinction_color, 1, ext.data());
+    glProgramUniform1f(p, u.extinction_k, k);
     const Eigen::Matrix3f rot = r.world_T_optical.linear().cast<float>();
     glProgramUniformMatrix3fv(p, u.world_R_optical, 1, GL_FALSE, rot.data());
     const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
@@ -705,7 +707,8 @@ struct Renderer::Impl {
       if (count > 0) drawModel(m, f.base_instance[static_cast<std::size_t>(m)], count, &f.stats);
     }
 
-    // Sky where nothing was drawn (window depth still 0).
+    // Sky where nothing was drawn (window depth still 0), unless the lawn fills the view.
+    if (groundFillsView(r)) return;
     glUseProgram(sky_program);
     glBindVertexArray(empty_vao);
     glDisable(GL_CULL_FACE);  // the full-screen triangle's winding is mirrored too
@@ -727,6 +730,32 @@ struct Renderer::Impl {
     glEnable(GL_CULL_FACE);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
+  }
+
+  // True when every pixel's ray meets the lawn between the clip planes: the ray through a pixel
+  // has a world z component linear in (u, v), so the extreme rays pass through image corners;
+  // the rays' ground points form the image of the rectangle, inside the lawn when its corners
+  // are.
+  bool groundFillsView(const RenderRequest& r) const {
+    const Eigen::Vector3d eye = r.world_T_optical.translation();
+    if (eye.z() <= 0.0) return false;
+    const Mesh& ground = scene.models()[static_cast<std::size_t>(scene.procedural().ground)];
+    const Intrinsics& k = r.intrinsics;
+    for (int c = 0; c < 4; ++c) {
+      // Pixel edges, not centres: the rasterized area ends there.
+      const double u = (c & 1) ? k.width - 0.5 : -0.5, v = (c & 2) ? k.height - 0.5 : -0.5;
+      const Eigen::Vector3d d =
+          r.world_T_optical.linear() * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+      if (d.z() >= 0.0) return false;
+      const double z_hit = eye.z() / -d.z();  // optical z of the ground point
+      if (z_hit >= 0.99 * r.far_clip || z_hit <= 1.01 * r.near_clip) return false;
+      const Eigen::Vector3d g = eye + z_hit * d;
+      if (g.x() <= ground.min.x() || g.x() >= ground.max.x() || g.y() <= ground.min.y() ||
+          g.y() >= ground.max.y()) {
+        return false;
+      }
+    }
+    return true;
   }
 
   // Counter-based key of (scenario seed, camera index, frame index): particles use x, y; the
@@ -788,7 +817,7 @@ struct Renderer::Impl {
         glProgramUniform1f(p, particle_loc.alpha, pl.alpha);
         glProgramUniform1f(p, particle_loc.density, pl.density * intensity);
         glProgramUniform1ui(p, particle_loc.layer, first_layer + static_cast<GLuint>(k));
-        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, nx * ny);
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, nx * ny);
       }
     };
     layers(kRainLayers, rain, 1);
