@@ -9,7 +9,6 @@ namespace hameritt::render::shaders {
 // Per-instance data are instanced vertex attributes (fetched once per instance): the culled
 // records of the frame, in draw order.
 inline constexpr const char* kGeometryVertex = R"GLSL(
-#version 450 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in uint a_material;  // Kd (sqrt-encoded RGB8) << 8 | MaterialKind
@@ -32,16 +31,22 @@ uniform float u_snow;  // snow cover on upward surfaces
 uniform float u_wet;   // rain darkens surfaces
 
 // The meshes have one normal per face, so the lighting is constant per triangle: it is computed
-// here and passed flat. Nothing is interpolated but the position; the fragment shader rebuilds
-// its world point from the pixel and the depth for the surface patterns and the haze. The lit
-// colour of a pixel is base * pattern + snow (or alt where the pattern switches colour:
-// dry grass on the lawn, the centre line on a street).
+// here and passed flat. Nothing is interpolated but the position. Objects (compiled without
+// GROUND_LAYERS) get their final lit colour; the ground layers (lawn, streets, sidewalks) a
+// colour of the form base * pattern + snow (or alt where the pattern switches colour: dry grass
+// on the lawn, the centre line on a street), the pattern computed per pixel at the world point
+// that the fragment shader rebuilds from the pixel and the depth.
+#ifdef GROUND_LAYERS
 flat out vec3 v_base;   // (1 - snow cover) * light * albedo
 flat out vec3 v_alt;    // (1 - snow cover) * light * the pattern's second colour
 flat out vec3 v_snow;   // snow cover * light * snow
 flat out uvec2 v_ids;   // label, material kind
 flat out vec4 v_frame;  // instance origin x, y and unit heading x, y (street markings)
 flat out vec2 v_extent; // instance length and width
+#else
+flat out vec3 v_color;  // lit colour
+flat out uint v_label;
+#endif
 invariant gl_Position;
 
 vec3 unpack8(uint c) {
@@ -61,7 +66,7 @@ void main() {
   vec3 kd = vec3(float(a_material >> 24), float((a_material >> 16) & 255u),
                  float((a_material >> 8) & 255u)) / 255.0;
   vec3 albedo = kd * kd;  // colours are stored gamma-2 encoded
-  vec3 alt = kind == 4u ? vec3(0.62, 0.45, 0.06) : vec3(0.26, 0.25, 0.13);
+  vec3 alt = kind == 4u ? vec3(0.62, 0.45, 0.06) : vec3(0.26, 0.25, 0.13);  // dash, dry grass
   if (kind == 1u) {
     albedo = unpack8(i_ids.x);
     albedo *= albedo;
@@ -74,12 +79,18 @@ void main() {
   float cover = u_snow * (kind == 4u ? 0.55 : 1.0) * smoothstep(0.3, 0.85, n.z);
   vec3 light = u_sun_color * max(dot(n, u_sun_dir), 0.0) +
                mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
+  vec3 snow = cover * light * vec3(0.82, 0.84, 0.88);
+#ifdef GROUND_LAYERS
   v_base = (1.0 - cover) * keep * light * albedo;
   v_alt = (1.0 - cover) * keep * light * alt;
-  v_snow = cover * light * vec3(0.82, 0.84, 0.88);
+  v_snow = snow;
   v_extent = vec2(i_normal1.w, i_normal2.w);
   v_frame = vec4(i_row0.w, i_row1.w, vec2(i_row0.x, i_row1.x) / max(v_extent.x, 1e-6));
   v_ids = uvec2(i_ids.y, kind);
+#else
+  v_color = (1.0 - cover) * keep * light * albedo + snow;
+  v_label = i_ids.y;
+#endif
 }
 )GLSL";
 
@@ -100,12 +111,17 @@ vec3 haze(vec3 c, float distance) {
 )GLSL";
 
 inline constexpr const char* kGeometryFragment = R"GLSL(
+#ifdef GROUND_LAYERS
 flat in vec3 v_base;
 flat in vec3 v_alt;
 flat in vec3 v_snow;
 flat in uvec2 v_ids;
 flat in vec4 v_frame;
 flat in vec2 v_extent;
+#else
+flat in vec3 v_color;
+flat in uint v_label;
+#endif
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uvec2 o_depth_label;  // depth (float bits), semantic << 16 | instance
@@ -120,6 +136,7 @@ uniform vec4 u_intrinsics;  // fx, fy, cx, cy
 uniform vec3 u_extinction_color;
 uniform float u_extinction_k;
 
+#ifdef GROUND_LAYERS
 float hash21(vec2 p) {
   uvec2 q = uvec2(ivec2(floor(p)) + 32768) * uvec2(1597334673u, 3812015801u);
   uint n = (q.x ^ q.y) * 1597334673u;
@@ -131,6 +148,7 @@ float valueNoise(vec2 p) {
   return mix(mix(hash21(i), hash21(i + vec2(1, 0)), u.x),
              mix(hash21(i + vec2(0, 1)), hash21(i + vec2(1, 1)), u.x), u.y);
 }
+#endif
 
 void main() {
   // Distance along the optical axis from the reversed-Z window depth (exact inverse of the
@@ -139,6 +157,7 @@ void main() {
   // The pixel's ray (optical z = 1; rows top first: window y = v + 0.5).
   vec3 ray = vec3((gl_FragCoord.x - 0.5 - u_intrinsics.z) / u_intrinsics.x,
                   (gl_FragCoord.y - 0.5 - u_intrinsics.w) / u_intrinsics.y, 1.0);
+#ifdef GROUND_LAYERS
   uint kind = v_ids.y;
   vec3 c = v_base;
   if (kind >= 3u) {
@@ -162,9 +181,14 @@ void main() {
     }
   }
   c += v_snow;
+  uint label = v_ids.x;
+#else
+  vec3 c = v_color;
+  uint label = v_label;
+#endif
   c = mix(u_extinction_color, c, exp(-u_extinction_k * depth * length(ray)));
   o_color = vec4(toDisplay(c), 1.0);
-  o_depth_label = uvec2(floatBitsToUint(depth), v_ids.x);
+  o_depth_label = uvec2(floatBitsToUint(depth), label);
 }
 )GLSL";
 
