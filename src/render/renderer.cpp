@@ -33,6 +33,8 @@ double msSince(Clock::time_point t0) {
 constexpr double kMinProjectedRadiusPx = 0.5;
 // Culling grid cell (metres).
 constexpr double kCellSize = 40.0;
+// A geometry pass drawing more triangles than this is flushed half-way (see geometryPass()).
+constexpr std::size_t kSplitTriangles = 40000;
 
 GLuint compileShader(GLenum type, const std::string& source, const char* name) {
   GLuint s = glCreateShader(type);
@@ -146,7 +148,12 @@ constexpr ParticleLayer kSnowLayers[] = {
 
 struct Uniforms {
   GLint view_proj, camera, canopy_center, near_clip, far_clip, sun_dir, sun_color, sky_ambient,
-      ground_ambient, snow, wet, haze_color, haze_k, world_R_optical, intrinsics, air_color, air_k;
+      ground_ambient, snow, wet, world_R_optical, intrinsics, extinction_color, extinction_k;
+};
+
+struct GeometryProgram {
+  GLuint id = 0;
+  Uniforms u{};
 };
 
 // Pixel bounds and count of one instance in the mask.
@@ -203,7 +210,7 @@ struct Renderer::Impl {
       for (auto& t : f->target_cache) deleteTargets(&t);
       glDeleteBuffers(1, &f->instance_buffer);
     }
-    glDeleteProgram(geometry_program);
+    for (const auto& g : geometry) glDeleteProgram(g.id);
     glDeleteProgram(sky_program);
     glDeleteProgram(particle_program);
     GLuint buffers[] = {vertex_buffer, element_buffer};
@@ -224,19 +231,23 @@ struct Renderer::Impl {
                         ")");
     }
     const std::string version = "#version 450 core\n";
-    const std::string common = version + shaders::kCommon;
-    geometry_program = linkProgram(shaders::kGeometryVertex, common + shaders::kGeometryFragment,
-                                   "geometry");
-    sky_program = linkProgram(shaders::kFullscreenVertex, common + shaders::kSkyFragment, "sky");
+    // Two variants of the geometry program: objects, and the ground layers with their patterns.
+    for (int g = 0; g < 2; ++g) {
+      const std::string define = g == 1 ? "#define GROUND_LAYERS 1\n" : "";
+      geometry[g].id = linkProgram(version + define + shaders::kGeometryVertex,
+                                   version + define + shaders::kCommon + shaders::kGeometryFragment,
+                                   g == 1 ? "geometry (ground layers)" : "geometry (objects)");
+      auto loc = [this, g](const char* n) { return glGetUniformLocation(geometry[g].id, n); };
+      geometry[g].u = {loc("u_view_proj"),      loc("u_camera"),        loc("u_canopy_center"),
+                       loc("u_near"),           loc("u_far"),           loc("u_sun_dir"),
+                       loc("u_sun_color"),      loc("u_sky_ambient"),   loc("u_ground_ambient"),
+                       loc("u_snow"),           loc("u_wet"),           loc("u_world_R_optical"),
+                       loc("u_intrinsics"),     loc("u_extinction_color"), loc("u_extinction_k")};
+    }
+    sky_program = linkProgram(shaders::kFullscreenVertex,
+                              version + shaders::kCommon + shaders::kSkyFragment, "sky");
     particle_program = linkProgram(version + shaders::kHash + shaders::kParticleVertex,
                                    version + shaders::kParticleFragment, "particles");
-    auto loc = [this](const char* n) { return glGetUniformLocation(geometry_program, n); };
-    u = {loc("u_view_proj"),   loc("u_camera"),         loc("u_canopy_center"),
-         loc("u_near"),        loc("u_far"),            loc("u_sun_dir"),
-         loc("u_sun_color"),   loc("u_sky_ambient"),    loc("u_ground_ambient"),
-         loc("u_snow"),        loc("u_wet"),            loc("u_haze_color"),
-         loc("u_haze_k"),      loc("u_world_R_optical"), loc("u_intrinsics"),
-         loc("u_air_color"),   loc("u_air_k")};
     auto sky = [this](const char* n) { return glGetUniformLocation(sky_program, n); };
     sky_loc = {sky("u_world_R_optical"), sky("u_intrinsics"), sky("u_zenith"),
                sky("u_horizon"),         sky("u_sun_dir"),    sky("u_glow"),
@@ -641,27 +652,40 @@ struct Renderer::Impl {
   void setFrameUniforms(const Frame& f) {
     const RenderRequest& r = *f.request;
     const Lighting& l = f.lighting;
-    const GLuint p = geometry_program;
-    glProgramUniformMatrix4fv(p, u.view_proj, 1, GL_FALSE, f.view_proj);
+    // Clear air and weather haze as one medium: summed extinction, in-scattered colours
+    // weighted by their extinction.
+    const float k = l.air_k + l.haze_k;
+    const Eigen::Vector3f ext = k > 0 ? Eigen::Vector3f((l.air_k * l.air_color + l.haze_k * l.haze_color) / k)
+                                      : Eigen::Vector3f::Zero();
     const Eigen::Vector3f cam = f.camera.cast<float>();
-    glProgramUniform3fv(p, u.camera, 1, cam.data());
-    glProgramUniform1f(p, u.near_clip, static_cast<float>(r.near_clip));
-    glProgramUniform1f(p, u.far_clip, static_cast<float>(r.far_clip));
-    glProgramUniform3fv(p, u.sun_dir, 1, l.sun_dir.data());
-    glProgramUniform3fv(p, u.sun_color, 1, l.sun_color.data());
-    glProgramUniform3fv(p, u.sky_ambient, 1, l.sky_ambient.data());
-    glProgramUniform3fv(p, u.ground_ambient, 1, l.ground_ambient.data());
-    glProgramUniform1f(p, u.snow, l.snow_cover);
-    glProgramUniform1f(p, u.wet, l.wetness);
-    glProgramUniform3fv(p, u.haze_color, 1, l.haze_color.data());
-    glProgramUniform1f(p, u.haze_k, l.haze_k);
-    glProgramUniform3fv(p, u.air_color, 1, l.air_color.data());
-    glProgramUniform1f(p, u.air_k, l.air_k);
     const Eigen::Matrix3f rot = r.world_T_optical.linear().cast<float>();
-    glProgramUniformMatrix3fv(p, u.world_R_optical, 1, GL_FALSE, rot.data());
     const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
                            static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
-    glProgramUniform4fv(p, u.intrinsics, 1, intr);
+    for (const auto& g : geometry) {
+      const GLuint p = g.id;
+      const Uniforms& u = g.u;
+      glProgramUniformMatrix4fv(p, u.view_proj, 1, GL_FALSE, f.view_proj);
+      glProgramUniform3fv(p, u.camera, 1, cam.data());
+      glProgramUniform1f(p, u.near_clip, static_cast<float>(r.near_clip));
+      glProgramUniform1f(p, u.far_clip, static_cast<float>(r.far_clip));
+      glProgramUniform3fv(p, u.sun_dir, 1, l.sun_dir.data());
+      glProgramUniform3fv(p, u.sun_color, 1, l.sun_color.data());
+      glProgramUniform3fv(p, u.sky_ambient, 1, l.sky_ambient.data());
+      glProgramUniform3fv(p, u.ground_ambient, 1, l.ground_ambient.data());
+      glProgramUniform1f(p, u.snow, l.snow_cover);
+      glProgramUniform1f(p, u.wet, l.wetness);
+      glProgramUniform3fv(p, u.extinction_color, 1, ext.data());
+      glProgramUniform1f(p, u.extinction_k, k);
+      glProgramUniformMatrix3fv(p, u.world_R_optical, 1, GL_FALSE, rot.data());
+      glProgramUniform4fv(p, u.intrinsics, 1, intr);
+    }
+  }
+
+  // The geometry program variant of model m.
+  const GeometryProgram& programFor(int m) const {
+    const auto& p = scene.procedural();
+    const bool ground = m == p.ground || m == p.sidewalks || m == p.street;
+    return geometry[ground ? 1 : 0];
   }
 
   // Draws model m's instances [base, base + count) of the bound instance buffer: one call per
@@ -670,8 +694,13 @@ struct Renderer::Impl {
     const Mesh& mesh = scene.models()[static_cast<std::size_t>(m)];
     const std::uint32_t n = scene.drawnIndexCount(m);
     if (n == 0) return;
+    const GeometryProgram& program = programFor(m);
+    if (program.id != bound_program) {
+      glUseProgram(program.id);
+      bound_program = program.id;
+    }
     if (mesh.foliage_first < n) {
-      glProgramUniform3fv(geometry_program, u.canopy_center, 1, mesh.canopy_center.data());
+      glProgramUniform3fv(program.id, program.u.canopy_center, 1, mesh.canopy_center.data());
     }
     glDrawElementsInstancedBaseVertexBaseInstance(
         GL_TRIANGLES, static_cast<GLsizei>(n), GL_UNSIGNED_INT,
@@ -682,7 +711,9 @@ struct Renderer::Impl {
     ++stats->draw_calls;
   }
 
-  void geometryPass(Frame& f) {
+  // `triangles`: what the frame will draw; a heavy frame is handed to the rasterizer in two
+  // halves, so that the GL rasterizes the first while the CPU processes the second's vertices.
+  void geometryPass(Frame& f, std::size_t triangles) {
     const RenderRequest& r = *f.request;
     const Lighting& l = f.lighting;
     const Targets& t = *f.targets;
@@ -697,15 +728,22 @@ struct Renderer::Impl {
     glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &zero);
 
     setFrameUniforms(f);
-    glUseProgram(geometry_program);
+    bound_program = 0;
     glBindVertexArray(vao);
     glVertexArrayVertexBuffer(vao, 1, f.instance_buffer, 0, sizeof(GpuInstance));
+    const std::size_t split = triangles > kSplitTriangles ? triangles / 2 : triangles + 1;
+    bool flushed = false;
     for (int m : draw_order) {
       const GLsizei count = f.count[static_cast<std::size_t>(m)];
       if (count > 0) drawModel(m, f.base_instance[static_cast<std::size_t>(m)], count, &f.stats);
+      if (!flushed && f.stats.triangles >= split) {
+        glFlush();
+        flushed = true;
+      }
     }
 
-    // Sky where nothing was drawn (window depth still 0).
+    // Sky where nothing was drawn (window depth still 0), unless the lawn fills the view.
+    if (groundFillsView(r)) return;
     glUseProgram(sky_program);
     glBindVertexArray(empty_vao);
     glDisable(GL_CULL_FACE);  // the full-screen triangle's winding is mirrored too
@@ -727,6 +765,32 @@ struct Renderer::Impl {
     glEnable(GL_CULL_FACE);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_GREATER);
+  }
+
+  // True when every pixel's ray meets the lawn between the clip planes: the ray through a pixel
+  // has a world z component linear in (u, v), so the extreme rays pass through image corners;
+  // the rays' ground points form the image of the rectangle, inside the lawn when its corners
+  // are.
+  bool groundFillsView(const RenderRequest& r) const {
+    const Eigen::Vector3d eye = r.world_T_optical.translation();
+    if (eye.z() <= 0.0) return false;
+    const Mesh& ground = scene.models()[static_cast<std::size_t>(scene.procedural().ground)];
+    const Intrinsics& k = r.intrinsics;
+    for (int c = 0; c < 4; ++c) {
+      // Pixel edges, not centres: the rasterized area ends there.
+      const double u = (c & 1) ? k.width - 0.5 : -0.5, v = (c & 2) ? k.height - 0.5 : -0.5;
+      const Eigen::Vector3d d =
+          r.world_T_optical.linear() * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+      if (d.z() >= 0.0) return false;
+      const double z_hit = eye.z() / -d.z();  // optical z of the ground point
+      if (z_hit >= 0.99 * r.far_clip || z_hit <= 1.01 * r.near_clip) return false;
+      const Eigen::Vector3d g = eye + z_hit * d;
+      if (g.x() <= ground.min.x() || g.x() >= ground.max.x() || g.y() <= ground.min.y() ||
+          g.y() >= ground.max.y()) {
+        return false;
+      }
+    }
+    return true;
   }
 
   // Counter-based key of (scenario seed, camera index, frame index): particles use x, y; the
@@ -788,7 +852,7 @@ struct Renderer::Impl {
         glProgramUniform1f(p, particle_loc.alpha, pl.alpha);
         glProgramUniform1f(p, particle_loc.density, pl.density * intensity);
         glProgramUniform1ui(p, particle_loc.layer, first_layer + static_cast<GLuint>(k));
-        glDrawArraysInstanced(GL_TRIANGLES, 0, 6, nx * ny);
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, nx * ny);
       }
     };
     layers(kRainLayers, rain, 1);
@@ -939,7 +1003,7 @@ struct Renderer::Impl {
     setFrameUniforms(f);
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glViewport(0, 0, t.width, t.height);
-    glUseProgram(geometry_program);
+    bound_program = 0;
     glBindVertexArray(vao);
     glVertexArrayVertexBuffer(vao, 1, f.instance_buffer, 0, sizeof(GpuInstance));
     glDisable(GL_SCISSOR_TEST);
@@ -948,6 +1012,7 @@ struct Renderer::Impl {
     glDepthFunc(GL_GREATER);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT1);
+    glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     const GLuint none[4] = {0, 0, 0, 0};
     const float zero = 0.0f;
     const int models = static_cast<int>(scene.models().size());
@@ -976,6 +1041,11 @@ struct Renderer::Impl {
                            static_cast<GLintptr>(f.upload.size() * sizeof(GpuInstance)),
                            static_cast<GLsizeiptr>(box_upload.size() * sizeof(GpuInstance)),
                            box_upload.data());
+      // Only the group's rectangles matter: clear and draw inside their union (the colour is
+      // not needed).
+      if (x1 <= x0 || y1 <= y0) continue;
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(x0, y0, x1 - x0, y1 - y0);
       glClearNamedFramebufferuiv(t.fbo, GL_COLOR, 1, none);
       glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &zero);
       RenderStats counted;  // RenderStats::triangles counts the geometry pass only
@@ -984,8 +1054,8 @@ struct Renderer::Impl {
         if (c > 0) drawModel(m, group_base[static_cast<std::size_t>(m)], c, &counted);
       }
       f.stats.draw_calls += counted.draw_calls;
+      glDisable(GL_SCISSOR_TEST);
       // Count each member's label inside its own rectangle.
-      if (x1 <= x0 || y1 <= y0) continue;
       const int w = x1 - x0, h = y1 - y0;
       box_labels.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
       glReadPixels(x0, y0, w, h, GL_GREEN_INTEGER, GL_UNSIGNED_INT, box_labels.data());
@@ -1001,6 +1071,7 @@ struct Renderer::Impl {
         box_total[a] = count;
       }
     }
+    glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     out->boxes.reserve(n);
     for (std::size_t a = 0; a < n; ++a) {
       const auto& [id, acc] = f.touched[a];
@@ -1042,6 +1113,9 @@ struct Renderer::Impl {
       *ms += msSince(*t0);
       *t0 = Clock::now();
     };
+    // Culling of every request first (cheap), so that the geometry is submitted lightest first:
+    // the GL rasterizes a light frame while the CPU processes the vertices of a heavy one.
+    order.clear();
     for (std::size_t i = 0; i < requests.size(); ++i) {
       Frame& f = frameSlot(i);
       const RenderRequest& r = *requests[i];
@@ -1060,8 +1134,18 @@ struct Renderer::Impl {
       cullAndUpload(r, f);
       f.lighting = lightingFor(config.environment, r.weather);
       cameraEffects(f);
+      std::size_t triangles = 0;
+      for (int m = 0; m < static_cast<int>(f.count.size()); ++m) {
+        triangles += static_cast<std::size_t>(f.count[static_cast<std::size_t>(m)]) * scene.drawnIndexCount(m) / 3;
+      }
+      order.emplace_back(triangles, i);
       stage_end(&t0, &f.stats.cull_upload_ms);
-      geometryPass(f);
+    }
+    std::stable_sort(order.begin(), order.end());
+    for (const auto& [triangles, i] : order) {
+      Frame& f = *frames[i];
+      auto t0 = Clock::now();
+      geometryPass(f, triangles);
       stage_end(&t0, &f.stats.draw_ms);
       particlePass(f);
       glFlush();
@@ -1110,8 +1194,9 @@ struct Renderer::Impl {
   RenderStats stats;
   std::unordered_multimap<std::string, int> by_id;
 
-  GLuint geometry_program = 0, sky_program = 0, particle_program = 0;
-  Uniforms u{};
+  GeometryProgram geometry[2];  // objects, ground layers
+  GLuint bound_program = 0;
+  GLuint sky_program = 0, particle_program = 0;
   struct {
     GLint world_R_optical, intrinsics, zenith, horizon, sun_dir, glow, far_clip, haze_color, haze_k;
   } sky_loc{};
@@ -1126,6 +1211,7 @@ struct Renderer::Impl {
   std::vector<InstanceRecord> records;
   std::uint32_t uav_record = 0;
   std::vector<std::unique_ptr<Frame>> frames;  // one slot per request of a batch
+  std::vector<std::pair<std::size_t, std::size_t>> order;  // (triangles, frame) of a batch
 
   // Culling.
   int grid_nx = 1, grid_ny = 1;

@@ -9,7 +9,6 @@ namespace hameritt::render::shaders {
 // Per-instance data are instanced vertex attributes (fetched once per instance): the culled
 // records of the frame, in draw order.
 inline constexpr const char* kGeometryVertex = R"GLSL(
-#version 450 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in uint a_material;  // Kd (sqrt-encoded RGB8) << 8 | MaterialKind
@@ -24,27 +23,74 @@ layout(location = 9) in uvec2 i_ids;      // colour, label
 uniform mat4 u_view_proj;  // projection * world-to-optical rotation, camera-relative
 uniform vec3 u_camera;     // optical centre in the world
 uniform vec3 u_canopy_center;  // foliage vertices scale about it by the canopy factor
+uniform vec3 u_sun_dir;
+uniform vec3 u_sun_color;
+uniform vec3 u_sky_ambient;
+uniform vec3 u_ground_ambient;
+uniform float u_snow;  // snow cover on upward surfaces
+uniform float u_wet;   // rain darkens surfaces
 
-// Everything the fragment shader needs is constant per triangle (the meshes have per-face
-// normals), so nothing is interpolated but the position: the fragment rebuilds its world
-// position from the pixel and the depth.
-flat out vec3 v_normal;  // world normal (not normalized)
-flat out uvec3 v_ids;    // colour, label, material
-flat out vec4 v_frame;   // instance origin x, y and unit heading x, y (street markings)
-flat out vec2 v_extent;  // instance length and width
+// The meshes have one normal per face, so the lighting is constant per triangle: it is computed
+// here and passed flat. Nothing is interpolated but the position. Objects (compiled without
+// GROUND_LAYERS) get their final lit colour; the ground layers (lawn, streets, sidewalks) a
+// colour of the form base * pattern + snow (or alt where the pattern switches colour: dry grass
+// on the lawn, the centre line on a street), the pattern computed per pixel at the world point
+// that the fragment shader rebuilds from the pixel and the depth.
+#ifdef GROUND_LAYERS
+flat out vec3 v_base;   // (1 - snow cover) * light * albedo
+flat out vec3 v_alt;    // (1 - snow cover) * light * the pattern's second colour
+flat out vec3 v_snow;   // snow cover * light * snow
+flat out uvec2 v_ids;   // label, material kind
+flat out vec4 v_frame;  // instance origin x, y and unit heading x, y (street markings)
+flat out vec2 v_extent; // instance length and width
+#else
+flat out vec3 v_color;  // lit colour
+flat out uint v_label;
+#endif
 invariant gl_Position;
 
+vec3 unpack8(uint c) {
+  return vec3(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) / 255.0;
+}
+
 void main() {
+  uint kind = a_material & 255u;
   vec3 p = a_position;
-  if ((a_material & 255u) == 2u) p = u_canopy_center + i_normal0.w * (p - u_canopy_center);
+  if (kind == 2u) p = u_canopy_center + i_normal0.w * (p - u_canopy_center);
   vec4 p4 = vec4(p, 1.0);
   vec3 world = vec3(dot(i_row0, p4), dot(i_row1, p4), dot(i_row2, p4));
-  v_normal = vec3(dot(i_normal0.xyz, a_normal), dot(i_normal1.xyz, a_normal),
-                  dot(i_normal2.xyz, a_normal));
+  gl_Position = u_view_proj * vec4(world - u_camera, 1.0);
+
+  vec3 n = normalize(vec3(dot(i_normal0.xyz, a_normal), dot(i_normal1.xyz, a_normal),
+                          dot(i_normal2.xyz, a_normal)));
+  vec3 kd = vec3(float(a_material >> 24), float((a_material >> 16) & 255u),
+                 float((a_material >> 8) & 255u)) / 255.0;
+  vec3 albedo = kd * kd;  // colours are stored gamma-2 encoded
+  vec3 alt = kind == 4u ? vec3(0.62, 0.45, 0.06) : vec3(0.26, 0.25, 0.13);  // dash, dry grass
+  if (kind == 1u) {
+    albedo = unpack8(i_ids.x);
+    albedo *= albedo;
+  } else if (kind == 2u) {
+    albedo *= 2.0 * unpack8(i_ids.x);
+  }
+  float keep = 1.0;
+  if (u_wet > 0.0) keep = 1.0 - u_wet * (0.18 + 0.22 * max(n.z, 0.0));
+  // Snow lies on upward surfaces; traffic clears part of it from the streets.
+  float cover = u_snow * (kind == 4u ? 0.55 : 1.0) * smoothstep(0.3, 0.85, n.z);
+  vec3 light = u_sun_color * max(dot(n, u_sun_dir), 0.0) +
+               mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
+  vec3 snow = cover * light * vec3(0.82, 0.84, 0.88);
+#ifdef GROUND_LAYERS
+  v_base = (1.0 - cover) * keep * light * albedo;
+  v_alt = (1.0 - cover) * keep * light * alt;
+  v_snow = snow;
   v_extent = vec2(i_normal1.w, i_normal2.w);
   v_frame = vec4(i_row0.w, i_row1.w, vec2(i_row0.x, i_row1.x) / max(v_extent.x, 1e-6));
-  v_ids = uvec3(i_ids, a_material);
-  gl_Position = u_view_proj * vec4(world - u_camera, 1.0);
+  v_ids = uvec2(i_ids.y, kind);
+#else
+  v_color = (1.0 - cover) * keep * light * albedo + snow;
+  v_label = i_ids.y;
+#endif
 }
 )GLSL";
 
@@ -65,31 +111,32 @@ vec3 haze(vec3 c, float distance) {
 )GLSL";
 
 inline constexpr const char* kGeometryFragment = R"GLSL(
-flat in vec3 v_normal;
-flat in uvec3 v_ids;
+#ifdef GROUND_LAYERS
+flat in vec3 v_base;
+flat in vec3 v_alt;
+flat in vec3 v_snow;
+flat in uvec2 v_ids;
 flat in vec4 v_frame;
 flat in vec2 v_extent;
+#else
+flat in vec3 v_color;
+flat in uint v_label;
+#endif
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out uvec2 o_depth_label;  // depth (float bits), semantic << 16 | instance
 
 uniform float u_near;
 uniform float u_far;
-uniform vec3 u_sun_dir;
-uniform vec3 u_sun_color;
-uniform vec3 u_sky_ambient;
-uniform vec3 u_ground_ambient;
-uniform float u_snow;
-uniform float u_wet;
 uniform vec3 u_camera;
-uniform vec3 u_air_color;  // aerial perspective: clear air fades far surfaces to the horizon
-uniform float u_air_k;
 uniform mat3 u_world_R_optical;
 uniform vec4 u_intrinsics;  // fx, fy, cx, cy
+// Clear air (aerial perspective) and weather haze together: one extinction coefficient and the
+// in-scattered colour of both media, c = mix(u_extinction_color, c, exp(-k d)).
+uniform vec3 u_extinction_color;
+uniform float u_extinction_k;
 
-vec3 unpack8(uint c) {
-  return vec3(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) / 255.0;
-}
+#ifdef GROUND_LAYERS
 float hash21(vec2 p) {
   uvec2 q = uvec2(ivec2(floor(p)) + 32768) * uvec2(1597334673u, 3812015801u);
   uint n = (q.x ^ q.y) * 1597334673u;
@@ -101,60 +148,47 @@ float valueNoise(vec2 p) {
   return mix(mix(hash21(i), hash21(i + vec2(1, 0)), u.x),
              mix(hash21(i + vec2(0, 1)), hash21(i + vec2(1, 1)), u.x), u.y);
 }
+#endif
 
 void main() {
   // Distance along the optical axis from the reversed-Z window depth (exact inverse of the
   // projection): z_w = n (f - Z) / (Z (f - n)).
   float depth = u_near * u_far / (gl_FragCoord.z * (u_far - u_near) + u_near);
-  // The pixel's ray (optical z = 1; rows top first: window y = v + 0.5) and the world point.
+  // The pixel's ray (optical z = 1; rows top first: window y = v + 0.5).
   vec3 ray = vec3((gl_FragCoord.x - 0.5 - u_intrinsics.z) / u_intrinsics.x,
                   (gl_FragCoord.y - 0.5 - u_intrinsics.w) / u_intrinsics.y, 1.0);
-  vec3 rel = depth * (u_world_R_optical * ray);
-  vec3 n = normalize(v_normal);
-  uint material = v_ids.z;
-  uint kind = material & 255u;
-  vec3 kd = vec3(float(material >> 24), float((material >> 16) & 255u),
-                 float((material >> 8) & 255u)) / 255.0;
-  vec3 albedo = kd * kd;
-  float snow_hold = 1.0;  // how well snow stays on the surface
-  if (kind == 1u) {
-    albedo = unpack8(v_ids.x);
-    albedo *= albedo;
-  } else if (kind == 2u) {
-    albedo *= 2.0 * unpack8(v_ids.x);
-  } else if (kind == 3u) {
-    vec2 w = rel.xy + u_camera.xy;
-    float patches = valueNoise(w * (1.0 / 9.0));
-    albedo *= 0.8 + 0.4 * patches;
-    albedo = mix(albedo, vec3(0.26, 0.25, 0.13), 0.4 * smoothstep(0.6, 0.95, patches));
-  } else if (kind == 4u) {
-    vec2 w = rel.xy + u_camera.xy;
-    albedo *= 0.85 + 0.3 * valueNoise(w * 0.9);
-    // Dashed yellow centre line, not across the intersections at either end.
-    vec2 d = w - v_frame.xy;
-    float along = dot(d, v_frame.zw), across = dot(d, vec2(-v_frame.w, v_frame.z));
-    float open = 0.5 * v_extent.x - v_extent.y - 1.0;
-    if (abs(across) < 0.07 && abs(along) < open && fract(along / 6.0) < 0.5) {
-      albedo = vec3(0.62, 0.45, 0.06);
+#ifdef GROUND_LAYERS
+  uint kind = v_ids.y;
+  vec3 c = v_base;
+  if (kind >= 3u) {
+    // Ground layers: patterns in world coordinates.
+    vec2 w = depth * (u_world_R_optical * ray).xy + u_camera.xy;
+    if (kind == 3u) {
+      float patches = valueNoise(w * (1.0 / 9.0));
+      c = mix(v_base * (0.8 + 0.4 * patches), v_alt, 0.4 * smoothstep(0.6, 0.95, patches));
+    } else if (kind == 4u) {
+      // Asphalt, and a dashed yellow centre line, not across the crossings at either end.
+      vec2 d = w - v_frame.xy;
+      float along = dot(d, v_frame.zw), across = dot(d, vec2(-v_frame.w, v_frame.z));
+      float open = 0.5 * v_extent.x - v_extent.y - 1.0;
+      if (abs(across) < 0.07 && abs(along) < open && fract(along / 6.0) < 0.5) {
+        c = v_alt;
+      } else {
+        c = v_base * (0.85 + 0.3 * valueNoise(w * 0.9));
+      }
+    } else {
+      c = v_base * (0.92 + 0.12 * valueNoise(w * 1.7));
     }
-    snow_hold = 0.55;  // traffic clears part of it
-  } else if (kind == 5u) {
-    vec2 w = rel.xy + u_camera.xy;
-    albedo *= 0.92 + 0.12 * valueNoise(w * 1.7);
   }
-  if (u_wet > 0.0) albedo *= 1.0 - u_wet * (0.18 + 0.22 * max(n.z, 0.0));
-  if (u_snow > 0.0) {
-    float cover = u_snow * snow_hold * smoothstep(0.3, 0.85, n.z);
-    albedo = mix(albedo, vec3(0.82, 0.84, 0.88), cover);
-  }
-  float ndl = max(dot(n, u_sun_dir), 0.0);
-  vec3 hemi = mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
-  vec3 c = albedo * (u_sun_color * ndl + hemi);
-  float distance = depth * length(ray);
-  c = mix(u_air_color, c, exp(-u_air_k * distance));
-  c = haze(c, distance);
+  c += v_snow;
+  uint label = v_ids.x;
+#else
+  vec3 c = v_color;
+  uint label = v_label;
+#endif
+  c = mix(u_extinction_color, c, exp(-u_extinction_k * depth * length(ray)));
   o_color = vec4(toDisplay(c), 1.0);
-  o_depth_label = uvec2(floatBitsToUint(depth), v_ids.y);
+  o_depth_label = uvec2(floatBitsToUint(depth), label);
 }
 )GLSL";
 
@@ -211,8 +245,8 @@ vec4 uniform01(uvec4 h) { return vec4(h >> 8u) * (1.0 / 16777216.0); }
 )GLSL";
 
 // Weather particles: one screen-space particle per cell of a grid (a rain streak or a snow
-// flake), present with probability `density`, drawn as an instanced quad and blended onto the
-// colour. Each instance is a cell; its particle comes from the hash of (cell, layer, key).
+// flake), present with probability `density`, drawn as an instanced quad (a four-vertex strip)
+// and blended onto the colour. Each instance is a cell; its particle comes from the hash of (cell, layer, key).
 inline constexpr const char* kParticleVertex = R"GLSL(
 uniform uvec4 u_key;
 uniform vec2 u_size;       // image width, height
@@ -232,9 +266,8 @@ void main() {
   int cell = gl_InstanceID;
   vec2 id = vec2(float(cell % u_cells_x), float(cell / u_cells_x));
   vec4 h = uniform01(pcg4d(uvec4(uint(cell), u_layer, u_key.x, u_key.y)));
-  const vec2 corners[6] = vec2[6](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1),
-                                  vec2(1, 1), vec2(-1, 1));
-  vec2 corner = corners[gl_VertexID];
+  // A triangle strip of four corners.
+  vec2 corner = vec2(float(gl_VertexID & 1) * 2.0 - 1.0, float(gl_VertexID >> 1) * 2.0 - 1.0);
   vec2 p;
   if (h.x >= u_density) {
     gl_Position = vec4(2.0, 2.0, 0.5, 1.0);  // no particle in this cell: outside the view
