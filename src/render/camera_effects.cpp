@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
+#include <thread>
 
 namespace hameritt::render {
 
@@ -86,7 +89,8 @@ std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_
 __attribute__((target_clones("avx2", "default")))
 #endif
 void applyCameraEffects(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
-                        std::uint8_t* out, CameraEffectsScratch* scratch) {
+                        std::uint8_t* out, CameraEffectsScratch* scratch, int row_begin,
+                        int row_end) {
   const bool blur = fx.blur.size() > 1;
   const int n = 3 * width;
   scratch->acc.resize(static_cast<std::size_t>(n));
@@ -103,7 +107,8 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
   std::uint32_t* h3 = h2 + width;
   scratch->sums.resize(noisy ? static_cast<std::size_t>(n) : 0);
   std::int16_t* sums = scratch->sums.data();
-  for (int y = 0; y < height; ++y) {
+  if (row_end < 0) row_end = height;
+  for (int y = row_begin; y < row_end; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
     if (blur) {
       blurRow(in, width, height, y, fx.blur, acc);
@@ -164,6 +169,65 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
       }
     }
   }
+}
+
+struct CameraEffectsWorker::State {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool busy = false, stop = false;
+  // The job: rows [0, rows) of the image.
+  const std::uint8_t* in = nullptr;
+  std::uint8_t* out = nullptr;
+  int width = 0, height = 0, rows = 0;
+  const CameraEffects* fx = nullptr;
+  CameraEffectsScratch scratch;
+  std::thread thread;
+};
+
+CameraEffectsWorker::CameraEffectsWorker() : state_(std::make_unique<State>()) {
+  State* s = state_.get();
+  s->thread = std::thread([s] {
+    std::unique_lock<std::mutex> lock(s->mutex);
+    while (true) {
+      s->cv.wait(lock, [s] { return s->busy || s->stop; });
+      if (s->stop) return;
+      lock.unlock();
+      applyCameraEffects(s->in, s->width, s->height, *s->fx, s->out, &s->scratch, 0, s->rows);
+      lock.lock();
+      s->busy = false;
+      s->cv.notify_all();
+    }
+  });
+}
+
+CameraEffectsWorker::~CameraEffectsWorker() {
+  {
+    std::lock_guard<std::mutex> lock(state_->mutex);
+    state_->stop = true;
+  }
+  state_->cv.notify_all();
+  state_->thread.join();
+}
+
+void CameraEffectsWorker::apply(const std::uint8_t* in, int width, int height,
+                                const CameraEffects& fx, std::uint8_t* out,
+                                CameraEffectsScratch* scratch) {
+  State* s = state_.get();
+  const int half = height / 2;
+  {
+    std::lock_guard<std::mutex> lock(s->mutex);
+    s->in = in;
+    s->out = out;
+    s->width = width;
+    s->height = height;
+    s->rows = half;
+    s->fx = &fx;
+    s->busy = true;
+  }
+  s->cv.notify_all();
+  applyCameraEffects(in, width, height, fx, out, scratch, half, height);
+  std::unique_lock<std::mutex> lock(s->mutex);
+  s->cv.wait(lock, [s] { return !s->busy; });
 }
 
 }  // namespace hameritt::render

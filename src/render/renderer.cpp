@@ -1158,8 +1158,8 @@ struct Renderer::Impl {
       splitLabels(f);
       stage_end(&t0, &f.stats.readback_ms);
       if (f.effects.any()) {
-        applyCameraEffects(f.color.data(), f.targets->width, f.targets->height, f.effects,
-                           f.out->rgb.data(), &effects_scratch);
+        effects_worker.apply(f.color.data(), f.targets->width, f.targets->height, f.effects,
+                             f.out->rgb.data(), &effects_scratch);
       }
       stage_end(&t0, &f.stats.post_ms);
     }
@@ -1235,6 +1235,7 @@ struct Renderer::Impl {
   std::vector<int> touched;
   std::vector<std::uint32_t> label_scratch;
   CameraEffectsScratch effects_scratch;
+  CameraEffectsWorker effects_worker;
   std::vector<std::array<int, 4>> box_rect;
   std::vector<int> box_group, box_total;
   std::vector<GpuInstance> box_upload;
