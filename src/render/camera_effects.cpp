@@ -15,7 +15,7 @@ constexpr int kMaxBlurSamples = 16;
 
 // Blurred row y into acc (value * 256 per channel).
 inline void blurRow(const std::uint8_t* in, int width, int height, int y,
-             const std::vector<BlurTap>& taps, std::uint16_t* acc) {
+                    const std::vector<BlurTap>& taps, std::uint16_t* acc) {
   const int n = 3 * width;
   std::fill(acc, acc + n, 0);
   for (const BlurTap& t : taps) {
@@ -25,13 +25,16 @@ inline void blurRow(const std::uint8_t* in, int width, int height, int y,
     // Interior: x + dx inside the row, one contiguous (vectorizable) loop; edges clamp.
     const int x0 = std::clamp(-t.dx, 0, width), x1 = std::clamp(width - t.dx, x0, width);
     for (int x = 0; x < x0; ++x) {
-      for (int c = 0; c < 3; ++c) acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * src[c]);
+      for (int c = 0; c < 3; ++c)
+        acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * src[c]);
     }
     const std::uint8_t* shifted = src + 3 * t.dx;
-    for (int i = 3 * x0; i < 3 * x1; ++i) acc[i] = static_cast<std::uint16_t>(acc[i] + w * shifted[i]);
+    for (int i = 3 * x0; i < 3 * x1; ++i)
+      acc[i] = static_cast<std::uint16_t>(acc[i] + w * shifted[i]);
     const std::uint8_t* last = src + 3 * (width - 1);
     for (int x = x1; x < width; ++x) {
-      for (int c = 0; c < 3; ++c) acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * last[c]);
+      for (int c = 0; c < 3; ++c)
+        acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * last[c]);
     }
   }
 }
@@ -61,7 +64,8 @@ std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_
   std::vector<int> count;
   for (int k = 0; k < samples; ++k) {
     const double s = static_cast<double>(k) / (samples - 1) - 0.5;
-    const int dx = static_cast<int>(std::lround(bx * s)), dy = static_cast<int>(std::lround(by * s));
+    const int dx = static_cast<int>(std::lround(bx * s)),
+              dy = static_cast<int>(std::lround(by * s));
     std::size_t j = 0;
     while (j < taps.size() && (taps[j].dx != dx || taps[j].dy != dy)) ++j;
     if (j == taps.size()) {
@@ -96,8 +100,8 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
   scratch->acc.resize(static_cast<std::size_t>(n));
   std::uint16_t* acc = scratch->acc.data();
   const float noise_scale = fx.noise_std * 255.0f / 147.80f;
-  const auto salt_threshold = static_cast<std::uint32_t>(
-      std::clamp(static_cast<double>(fx.salt), 0.0, 1.0) * 16777216.0);
+  const auto salt_threshold =
+      static_cast<std::uint32_t>(std::clamp(static_cast<double>(fx.salt), 0.0, 1.0) * 16777216.0);
   const bool noisy = fx.noise_std > 0 || salt_threshold > 0;
   // Per-row hash lanes (structure of arrays, so that the loops vectorize).
   scratch->lanes.resize(noisy ? 4 * static_cast<std::size_t>(width) : 0);
@@ -113,7 +117,8 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
     if (blur) {
       blurRow(in, width, height, y, fx.blur, acc);
     } else {
-      for (int i = 0; i < n; ++i) acc[i] = static_cast<std::uint16_t>(in[row + static_cast<std::size_t>(i)] << 8);
+      for (int i = 0; i < n; ++i)
+        acc[i] = static_cast<std::uint16_t>(in[row + static_cast<std::size_t>(i)] << 8);
     }
     std::uint8_t* dst = out + row;
     if (!noisy) {
@@ -146,8 +151,8 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
     // Gaussian noise: per channel the Irwin-Hall sum of the four bytes of one hash lane
     // (mean 510, standard deviation 147.80), scaled to noise_std of full scale.
     auto byte_sum = [](std::uint32_t v) {
-      return static_cast<std::int16_t>(static_cast<int>((v & 255u) + ((v >> 8) & 255u) +
-                                                        ((v >> 16) & 255u) + (v >> 24)) - 510);
+      return static_cast<std::int16_t>(
+          static_cast<int>((v & 255u) + ((v >> 8) & 255u) + ((v >> 16) & 255u) + (v >> 24)) - 510);
     };
     for (int x = 0; x < width; ++x) {
       sums[3 * x] = byte_sum(h0[x]);

@@ -15,18 +15,18 @@ namespace hameritt::render {
 
 // Per-instance data as the vertex shader reads it (std430, 64 bytes).
 struct InstanceRecord {
-  float row[3][4];            // rows of the 3x4 model matrix (mesh -> world)
-  std::uint32_t color = 0;    // kPaint: sRGB8 colour; kFoliage: linear tint / 2 (RGB8)
-  std::uint32_t label = 0;    // semantic << 16 | instance
-  float canopy = 1.0f;        // canopy scale about the mesh's canopy centre
+  float row[3][4];          // rows of the 3x4 model matrix (mesh -> world)
+  std::uint32_t color = 0;  // kPaint: sRGB8 colour; kFoliage: linear tint / 2 (RGB8)
+  std::uint32_t label = 0;  // semantic << 16 | instance
+  float canopy = 1.0f;      // canopy scale about the mesh's canopy centre
   std::uint32_t pad = 0;
 };
 static_assert(sizeof(InstanceRecord) == 64, "std430 layout");
 
 // One drawn object.
 struct SceneInstance {
-  int model = 0;              // index into Scene::models()
-  int instance_id = 0;        // label instance (0 for ground layers)
+  int model = 0;        // index into Scene::models()
+  int instance_id = 0;  // label instance (0 for ground layers)
   int semantic = 0;
   int scenario_entity = -1;   // index into SimConfig::entities when it comes from the scenario
   bool mover = false;         // posed from its trajectory at the frame time

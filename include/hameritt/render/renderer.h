@@ -115,14 +115,14 @@ struct RendererOptions {
 // What the last render() call did and where its time went (milliseconds of wall time; summed
 // over the requests of a batch).
 struct RenderStats {
-  double cull_upload_ms = 0;  // frustum culling, instance upload
-  double draw_ms = 0;         // geometry pass (with stage_timing: until the GL has finished it)
-  double post_ms = 0;         // weather particles, blur, noise
-  double readback_ms = 0;     // colour, depth and labels read back and split
-  double boxes_ms = 0;        // boxes from the instance mask, occlusion queries
-  std::size_t instances = 0;  // instances drawn in the geometry pass
-  std::size_t triangles = 0;  // triangles submitted to the geometry pass
-  std::size_t draw_calls = 0; // all passes
+  double cull_upload_ms = 0;   // frustum culling, instance upload
+  double draw_ms = 0;          // geometry pass (with stage_timing: until the GL has finished it)
+  double post_ms = 0;          // weather particles, motion blur, noise
+  double readback_ms = 0;      // colour, depth and labels read back and split
+  double boxes_ms = 0;         // boxes: entities drawn alone and their pixels counted
+  std::size_t instances = 0;   // instances drawn in the geometry pass
+  std::size_t triangles = 0;   // triangles submitted to the geometry pass
+  std::size_t draw_calls = 0;  // all passes
 };
 
 // World triangles for ray-cast checks (what the renderer draws, in world coordinates).
