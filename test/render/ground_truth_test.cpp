@@ -417,6 +417,29 @@ TEST(RenderGroundTruth, BatchOfRequestsEqualsOneRenderEach) {
             0);
 }
 
+TEST(RenderGroundTruth, UavModelIsDrawnOnlyWhenAsked) {
+  Renderer& r = defaultRenderer();
+  RenderRequest req = clean(RenderRequest{});
+  req.intrinsics = intrinsicsFromHfov(160, 120, 60.0);
+  const Eigen::Isometry3d uav = uavPose(-271.0, 249.0, 30.0, 0.4);
+  req.world_T_uav = uav;
+  req.world_T_optical = lookAt(uav.translation() + Eigen::Vector3d(1.2, -0.9, 0.6), uav.translation());
+  const FrameSet without = r.render(req);
+  req.draw_uav = true;
+  const FrameSet with = r.render(req);
+  const int id = r.instanceCount() - 1;
+  EXPECT_EQ(r.instanceEntityId(id), "uav");
+  EXPECT_EQ(std::count(without.semantic.begin(), without.semantic.end(), kUavSemantic), 0);
+  const auto n = std::count(with.semantic.begin(), with.semantic.end(), kUavSemantic);
+  EXPECT_GT(n, 100) << "the UAV fills part of a close view";
+  EXPECT_EQ(std::count(with.instance.begin(), with.instance.end(), id), n);
+  Eigen::Vector2d uv;
+  ASSERT_TRUE(projectPoint(req.intrinsics, req.world_T_optical, uav.translation(), &uv));
+  const std::size_t centre = static_cast<std::size_t>(std::lround(uv.y())) * 160 + std::lround(uv.x());
+  EXPECT_EQ(with.instance[centre], id);
+  EXPECT_LT(with.depth[centre], 1.6f);
+}
+
 TEST(RenderGroundTruth, SceneTrianglesCarryValidInstances) {
   Renderer& r = defaultRenderer();
   const SceneTriangles& t = caster().triangles();
