@@ -54,24 +54,22 @@ void pcg4d(std::uint32_t v[4]) {
   v[3] += v[1] * v[2];
 }
 
-std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_px) {
-  std::vector<BlurTap> taps;
+void motionBlurKernel(double dir_x, double dir_y, double length_px, std::vector<BlurTap>* out) {
+  std::vector<BlurTap>& taps = *out;
+  taps.clear();
   const double norm = std::hypot(dir_x, dir_y);
-  if (!(length_px > 0.0) || !(norm > 0.0)) return taps;
+  if (!(length_px > 0.0) || !(norm > 0.0)) return;
   const double bx = dir_x / norm * length_px, by = dir_y / norm * length_px;
   const int samples =
       std::min(kMaxBlurSamples, std::max(2, static_cast<int>(std::ceil(2.0 * length_px)) + 1));
-  std::vector<int> count;
+  int count[kMaxBlurSamples] = {};
   for (int k = 0; k < samples; ++k) {
     const double s = static_cast<double>(k) / (samples - 1) - 0.5;
     const int dx = static_cast<int>(std::lround(bx * s)),
               dy = static_cast<int>(std::lround(by * s));
     std::size_t j = 0;
     while (j < taps.size() && (taps[j].dx != dx || taps[j].dy != dy)) ++j;
-    if (j == taps.size()) {
-      taps.push_back({dx, dy, 0});
-      count.push_back(0);
-    }
+    if (j == taps.size()) taps.push_back({dx, dy, 0});
     ++count[j];
   }
   // Fixed-point weights that sum to exactly 256 (the remainder goes to the heaviest tap).
@@ -84,7 +82,6 @@ std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_
   }
   taps[heaviest].weight += 256 - total;
   if (taps.size() == 1) taps.clear();  // shorter than half a pixel: nothing moves
-  return taps;
 }
 
 // The loops are written to vectorize; on x86-64 an AVX2 clone is picked at load time when the

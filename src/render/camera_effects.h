@@ -27,7 +27,8 @@ struct CameraEffects {
 
 // The blur kernel of a motion of `length_px` along `(dir_x, dir_y)`: the segment centred on
 // the pixel sampled at up to 16 points, each rounded to a pixel offset, equal offsets merged.
-std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_px);
+// `out` is reused (no allocation once it has grown).
+void motionBlurKernel(double dir_x, double dir_y, double length_px, std::vector<BlurTap>* out);
 
 // PCG-based 4D hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020).
 void pcg4d(std::uint32_t v[4]);

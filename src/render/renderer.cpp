@@ -888,9 +888,8 @@ struct Renderer::Impl {
   void cameraEffects(Frame& f) const {
     const RenderRequest& r = *f.request;
     const auto& pert = config.perturbations;
-    f.effects.blur =
-        r.noise ? motionBlurKernel(r.blur_direction.x(), r.blur_direction.y(), pert.motion_blur_px)
-                : std::vector<BlurTap>{};
+    motionBlurKernel(r.blur_direction.x(), r.blur_direction.y(),
+                     r.noise ? pert.motion_blur_px : 0.0, &f.effects.blur);
     f.effects.noise_std = r.noise ? static_cast<float>(pert.gaussian_noise_std) : 0.0f;
     f.effects.salt = r.noise ? static_cast<float>(pert.salt_pepper_probability) : 0.0f;
     GLuint key[4];
@@ -1239,7 +1238,9 @@ struct Renderer::Impl {
   std::vector<int> draw_order;
   std::vector<InstanceRecord> records;
   std::uint32_t uav_record = 0;
-  std::vector<std::unique_ptr<Frame>> frames;              // one slot per request of a batch
+  std::vector<std::unique_ptr<Frame>> frames;      // one slot per request of a batch
+  std::vector<const RenderRequest*> request_list;  // the requests of the current call
+  std::vector<FrameSet*> out_list;
   std::vector<std::pair<std::size_t, std::size_t>> order;  // (triangles, frame) of a batch
 
   // Culling.
@@ -1280,24 +1281,28 @@ Renderer::Renderer(const scenario::World& world, const scenario::SimConfig& conf
 Renderer::~Renderer() = default;
 
 void Renderer::render(const RenderRequest& request, FrameSet* out) {
-  impl_->render({&request}, {out});
+  auto& i = *impl_;
+  i.request_list.assign(1, &request);
+  i.out_list.assign(1, out);
+  i.render(i.request_list, i.out_list);
 }
 
 FrameSet Renderer::render(const RenderRequest& request) {
   FrameSet f;
-  impl_->render({&request}, {&f});
+  render(request, &f);
   return f;
 }
 
 void Renderer::render(const std::vector<RenderRequest>& requests, std::vector<FrameSet>* out) {
+  auto& i = *impl_;
   out->resize(requests.size());
-  std::vector<const RenderRequest*> r;
-  std::vector<FrameSet*> o;
-  for (std::size_t i = 0; i < requests.size(); ++i) {
-    r.push_back(&requests[i]);
-    o.push_back(&(*out)[i]);
+  i.request_list.clear();
+  i.out_list.clear();
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    i.request_list.push_back(&requests[k]);
+    i.out_list.push_back(&(*out)[k]);
   }
-  impl_->render(r, o);
+  i.render(i.request_list, i.out_list);
 }
 
 void Renderer::makeCurrent() { impl_->egl.makeCurrent(); }
