@@ -2,9 +2,10 @@
 // The in-house off-screen renderer: OpenGL 4.5 core over EGL, headless (Mesa's surfaceless
 // platform with llvmpipe on a CPU-only machine, the EGL device platform on an NVIDIA GPU). One
 // geometry pass writes lit colour, metric depth along the optical axis and packed semantic +
-// instance labels into a multi-target framebuffer; a post pass adds weather particles and the
-// seeded camera noise to the colour only. Labels and depth are exact ground truth of the drawn
-// geometry; bounding boxes come from the instance mask. ROS-free.
+// instance labels into a multi-target framebuffer; a particle pass adds rain and snow, and after
+// the read-back the CPU adds motion blur and the seeded camera noise, to the colour only. Labels
+// and depth are exact ground truth of the drawn geometry; bounding boxes come from the instance
+// mask. ROS-free.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
