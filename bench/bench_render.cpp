@@ -8,6 +8,8 @@
 //
 // Usage: bench_render [frame_sets] [--backend auto|surfaceless|device]
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -15,8 +17,6 @@
 #include <cstdlib>
 #include <string>
 #include <vector>
-
-#include <sys/resource.h>
 
 #include "hameritt/render/renderer.h"
 #include "hameritt/scenario/sim_config_io.h"
@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
     } else if (!a.empty() && a[0] != '-') {
       frames = std::max(1, std::atoi(a.c_str()));
     } else {
-      std::fprintf(stderr, "usage: bench_render [frame_sets] [--backend auto|surfaceless|device]\n");
+      std::fprintf(stderr,
+                   "usage: bench_render [frame_sets] [--backend auto|surfaceless|device]\n");
       return 2;
     }
   }
@@ -95,12 +96,12 @@ int main(int argc, char** argv) {
     std::printf("  camera %s: %d x %d, hfov %.3f deg, pitch %.2f deg\n", c.name.c_str(), c.width,
                 c.height, c.hfov_deg, c.mount_rpy.y());
   }
-  std::printf("environment: time %.2f h, rain %.2f, snow %.2f, fog %.2f, dust %.2f, foliage %.2f; "
-              "noise std %.4f, salt %.5f, blur %.2f px\n",
-              cfg.environment.time_of_day, cfg.environment.rain, cfg.environment.snow,
-              cfg.environment.fog, cfg.environment.dust, cfg.environment.foliage,
-              cfg.perturbations.gaussian_noise_std, cfg.perturbations.salt_pepper_probability,
-              cfg.perturbations.motion_blur_px);
+  std::printf(
+      "environment: time %.2f h, rain %.2f, snow %.2f, fog %.2f, dust %.2f, foliage %.2f; "
+      "noise std %.4f, salt %.5f, blur %.2f px\n",
+      cfg.environment.time_of_day, cfg.environment.rain, cfg.environment.snow, cfg.environment.fog,
+      cfg.environment.dust, cfg.environment.foliage, cfg.perturbations.gaussian_noise_std,
+      cfg.perturbations.salt_pepper_probability, cfg.perturbations.motion_blur_px);
 
   std::vector<render::FrameSet> out(cfg.uav.cameras.size());
   const int warmup = 5;
@@ -144,9 +145,10 @@ int main(int argc, char** argv) {
     for (int i = 0; i < frames; ++i) run(frameSet(cfg, i, frames), &per_camera);
     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
     const double cpu = cpuSeconds() - cpu0;
-    std::printf("\n%s: %d frame sets in %.2f s: %.1f frame sets/s (%.1f ms wall, %.1f ms CPU "
-                "per frame set)\n",
-                kModes[mode], frames, wall, frames / wall, 1e3 * wall / frames, 1e3 * cpu / frames);
+    std::printf(
+        "\n%s: %d frame sets in %.2f s: %.1f frame sets/s (%.1f ms wall, %.1f ms CPU "
+        "per frame set)\n",
+        kModes[mode], frames, wall, frames / wall, 1e3 * wall / frames, 1e3 * cpu / frames);
     if (mode == 2) {
       std::printf("  per frame (ms):  %12s %8s %8s %10s %8s %8s | %9s %9s %6s\n", "cull/upload",
                   "draw", "post", "readback", "boxes", "total", "triangles", "instances", "boxes");

@@ -26,8 +26,8 @@ Intrinsics intrinsicsFromHfov(int width, int height, double hfov_deg) {
   return k;
 }
 
-Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base, const Eigen::Vector3d& mount_xyz,
-                              const Eigen::Vector3d& mount_rpy) {
+Eigen::Isometry3d opticalPose(const Eigen::Isometry3d& world_T_base,
+                              const Eigen::Vector3d& mount_xyz, const Eigen::Vector3d& mount_rpy) {
   // base_T_link: the camera link in FLU (x forward) with fixed-axis roll-pitch-yaw (URDF).
   Eigen::Isometry3d base_T_link = Eigen::Isometry3d::Identity();
   base_T_link.translation() = mount_xyz;

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
+#include <thread>
 
 namespace hameritt::render {
 
@@ -12,7 +15,7 @@ constexpr int kMaxBlurSamples = 16;
 
 // Blurred row y into acc (value * 256 per channel).
 inline void blurRow(const std::uint8_t* in, int width, int height, int y,
-             const std::vector<BlurTap>& taps, std::uint16_t* acc) {
+                    const std::vector<BlurTap>& taps, std::uint16_t* acc) {
   const int n = 3 * width;
   std::fill(acc, acc + n, 0);
   for (const BlurTap& t : taps) {
@@ -22,13 +25,16 @@ inline void blurRow(const std::uint8_t* in, int width, int height, int y,
     // Interior: x + dx inside the row, one contiguous (vectorizable) loop; edges clamp.
     const int x0 = std::clamp(-t.dx, 0, width), x1 = std::clamp(width - t.dx, x0, width);
     for (int x = 0; x < x0; ++x) {
-      for (int c = 0; c < 3; ++c) acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * src[c]);
+      for (int c = 0; c < 3; ++c)
+        acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * src[c]);
     }
     const std::uint8_t* shifted = src + 3 * t.dx;
-    for (int i = 3 * x0; i < 3 * x1; ++i) acc[i] = static_cast<std::uint16_t>(acc[i] + w * shifted[i]);
+    for (int i = 3 * x0; i < 3 * x1; ++i)
+      acc[i] = static_cast<std::uint16_t>(acc[i] + w * shifted[i]);
     const std::uint8_t* last = src + 3 * (width - 1);
     for (int x = x1; x < width; ++x) {
-      for (int c = 0; c < 3; ++c) acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * last[c]);
+      for (int c = 0; c < 3; ++c)
+        acc[3 * x + c] = static_cast<std::uint16_t>(acc[3 * x + c] + w * last[c]);
     }
   }
 }
@@ -48,23 +54,22 @@ void pcg4d(std::uint32_t v[4]) {
   v[3] += v[1] * v[2];
 }
 
-std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_px) {
-  std::vector<BlurTap> taps;
+void motionBlurKernel(double dir_x, double dir_y, double length_px, std::vector<BlurTap>* out) {
+  std::vector<BlurTap>& taps = *out;
+  taps.clear();
   const double norm = std::hypot(dir_x, dir_y);
-  if (!(length_px > 0.0) || !(norm > 0.0)) return taps;
+  if (!(length_px > 0.0) || !(norm > 0.0)) return;
   const double bx = dir_x / norm * length_px, by = dir_y / norm * length_px;
   const int samples =
       std::min(kMaxBlurSamples, std::max(2, static_cast<int>(std::ceil(2.0 * length_px)) + 1));
-  std::vector<int> count;
+  int count[kMaxBlurSamples] = {};
   for (int k = 0; k < samples; ++k) {
     const double s = static_cast<double>(k) / (samples - 1) - 0.5;
-    const int dx = static_cast<int>(std::lround(bx * s)), dy = static_cast<int>(std::lround(by * s));
+    const int dx = static_cast<int>(std::lround(bx * s)),
+              dy = static_cast<int>(std::lround(by * s));
     std::size_t j = 0;
     while (j < taps.size() && (taps[j].dx != dx || taps[j].dy != dy)) ++j;
-    if (j == taps.size()) {
-      taps.push_back({dx, dy, 0});
-      count.push_back(0);
-    }
+    if (j == taps.size()) taps.push_back({dx, dy, 0});
     ++count[j];
   }
   // Fixed-point weights that sum to exactly 256 (the remainder goes to the heaviest tap).
@@ -77,7 +82,6 @@ std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_
   }
   taps[heaviest].weight += 256 - total;
   if (taps.size() == 1) taps.clear();  // shorter than half a pixel: nothing moves
-  return taps;
 }
 
 // The loops are written to vectorize; on x86-64 an AVX2 clone is picked at load time when the
@@ -86,14 +90,15 @@ std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_
 __attribute__((target_clones("avx2", "default")))
 #endif
 void applyCameraEffects(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
-                        std::uint8_t* out, CameraEffectsScratch* scratch) {
+                        std::uint8_t* out, CameraEffectsScratch* scratch, int row_begin,
+                        int row_end) {
   const bool blur = fx.blur.size() > 1;
   const int n = 3 * width;
   scratch->acc.resize(static_cast<std::size_t>(n));
   std::uint16_t* acc = scratch->acc.data();
   const float noise_scale = fx.noise_std * 255.0f / 147.80f;
-  const auto salt_threshold = static_cast<std::uint32_t>(
-      std::clamp(static_cast<double>(fx.salt), 0.0, 1.0) * 16777216.0);
+  const auto salt_threshold =
+      static_cast<std::uint32_t>(std::clamp(static_cast<double>(fx.salt), 0.0, 1.0) * 16777216.0);
   const bool noisy = fx.noise_std > 0 || salt_threshold > 0;
   // Per-row hash lanes (structure of arrays, so that the loops vectorize).
   scratch->lanes.resize(noisy ? 4 * static_cast<std::size_t>(width) : 0);
@@ -103,12 +108,14 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
   std::uint32_t* h3 = h2 + width;
   scratch->sums.resize(noisy ? static_cast<std::size_t>(n) : 0);
   std::int16_t* sums = scratch->sums.data();
-  for (int y = 0; y < height; ++y) {
+  if (row_end < 0) row_end = height;
+  for (int y = row_begin; y < row_end; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(n);
     if (blur) {
       blurRow(in, width, height, y, fx.blur, acc);
     } else {
-      for (int i = 0; i < n; ++i) acc[i] = static_cast<std::uint16_t>(in[row + static_cast<std::size_t>(i)] << 8);
+      for (int i = 0; i < n; ++i)
+        acc[i] = static_cast<std::uint16_t>(in[row + static_cast<std::size_t>(i)] << 8);
     }
     std::uint8_t* dst = out + row;
     if (!noisy) {
@@ -141,8 +148,8 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
     // Gaussian noise: per channel the Irwin-Hall sum of the four bytes of one hash lane
     // (mean 510, standard deviation 147.80), scaled to noise_std of full scale.
     auto byte_sum = [](std::uint32_t v) {
-      return static_cast<std::int16_t>(static_cast<int>((v & 255u) + ((v >> 8) & 255u) +
-                                                        ((v >> 16) & 255u) + (v >> 24)) - 510);
+      return static_cast<std::int16_t>(
+          static_cast<int>((v & 255u) + ((v >> 8) & 255u) + ((v >> 16) & 255u) + (v >> 24)) - 510);
     };
     for (int x = 0; x < width; ++x) {
       sums[3 * x] = byte_sum(h0[x]);
@@ -164,6 +171,65 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
       }
     }
   }
+}
+
+struct CameraEffectsWorker::State {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool busy = false, stop = false;
+  // The job: rows [0, rows) of the image.
+  const std::uint8_t* in = nullptr;
+  std::uint8_t* out = nullptr;
+  int width = 0, height = 0, rows = 0;
+  const CameraEffects* fx = nullptr;
+  CameraEffectsScratch scratch;
+  std::thread thread;
+};
+
+CameraEffectsWorker::CameraEffectsWorker() : state_(std::make_unique<State>()) {
+  State* s = state_.get();
+  s->thread = std::thread([s] {
+    std::unique_lock<std::mutex> lock(s->mutex);
+    while (true) {
+      s->cv.wait(lock, [s] { return s->busy || s->stop; });
+      if (s->stop) return;
+      lock.unlock();
+      applyCameraEffects(s->in, s->width, s->height, *s->fx, s->out, &s->scratch, 0, s->rows);
+      lock.lock();
+      s->busy = false;
+      s->cv.notify_all();
+    }
+  });
+}
+
+CameraEffectsWorker::~CameraEffectsWorker() {
+  {
+    std::lock_guard<std::mutex> lock(state_->mutex);
+    state_->stop = true;
+  }
+  state_->cv.notify_all();
+  state_->thread.join();
+}
+
+void CameraEffectsWorker::apply(const std::uint8_t* in, int width, int height,
+                                const CameraEffects& fx, std::uint8_t* out,
+                                CameraEffectsScratch* scratch) {
+  State* s = state_.get();
+  const int half = height / 2;
+  {
+    std::lock_guard<std::mutex> lock(s->mutex);
+    s->in = in;
+    s->out = out;
+    s->width = width;
+    s->height = height;
+    s->rows = half;
+    s->fx = &fx;
+    s->busy = true;
+  }
+  s->cv.notify_all();
+  applyCameraEffects(in, width, height, fx, out, scratch, half, height);
+  std::unique_lock<std::mutex> lock(s->mutex);
+  s->cv.wait(lock, [s] { return !s->busy; });
 }
 
 }  // namespace hameritt::render

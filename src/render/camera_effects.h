@@ -6,6 +6,7 @@
 // the result does not depend on threads or on the order of evaluation.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace hameritt::render {
@@ -26,7 +27,8 @@ struct CameraEffects {
 
 // The blur kernel of a motion of `length_px` along `(dir_x, dir_y)`: the segment centred on
 // the pixel sampled at up to 16 points, each rounded to a pixel offset, equal offsets merged.
-std::vector<BlurTap> motionBlurKernel(double dir_x, double dir_y, double length_px);
+// `out` is reused (no allocation once it has grown).
+void motionBlurKernel(double dir_x, double dir_y, double length_px, std::vector<BlurTap>* out);
 
 // PCG-based 4D hash (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020).
 void pcg4d(std::uint32_t v[4]);
@@ -38,8 +40,28 @@ struct CameraEffectsScratch {
   std::vector<std::int16_t> sums;
 };
 
-// Applies `fx` to `in` (RGB8, rows top first) into `out` (same size).
+// Applies `fx` to `in` (RGB8, rows top first) into `out` (same size), rows [row_begin, row_end)
+// only (row_end < 0: to the last row); every output pixel depends on its coordinates alone, so
+// row ranges can run on different threads.
 void applyCameraEffects(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
-                        std::uint8_t* out, CameraEffectsScratch* scratch);
+                        std::uint8_t* out, CameraEffectsScratch* scratch, int row_begin = 0,
+                        int row_end = -1);
+
+// A thread that applies camera effects to the first half of an image while the caller does
+// the second (two cores are the target machine's). One job at a time.
+class CameraEffectsWorker {
+ public:
+  CameraEffectsWorker();
+  ~CameraEffectsWorker();
+  CameraEffectsWorker(const CameraEffectsWorker&) = delete;
+  CameraEffectsWorker& operator=(const CameraEffectsWorker&) = delete;
+
+  void apply(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
+             std::uint8_t* out, CameraEffectsScratch* scratch);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace hameritt::render

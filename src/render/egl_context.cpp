@@ -17,18 +17,30 @@ namespace {
 
 std::string eglErrorName(EGLint e) {
   switch (e) {
-    case EGL_SUCCESS: return "EGL_SUCCESS";
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_CURRENT_SURFACE: return "EGL_BAD_CURRENT_SURFACE";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
+    case EGL_SUCCESS:
+      return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED:
+      return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS:
+      return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC:
+      return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE:
+      return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG:
+      return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT:
+      return "EGL_BAD_CONTEXT";
+    case EGL_BAD_CURRENT_SURFACE:
+      return "EGL_BAD_CURRENT_SURFACE";
+    case EGL_BAD_DISPLAY:
+      return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH:
+      return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER:
+      return "EGL_BAD_PARAMETER";
+    case EGL_BAD_SURFACE:
+      return "EGL_BAD_SURFACE";
     default: {
       char buf[32];
       std::snprintf(buf, sizeof(buf), "EGL error 0x%04x", static_cast<unsigned>(e));
@@ -99,8 +111,8 @@ EGLDisplay hardwareDeviceDisplay() {
   for (EGLint i = 0; i < n; ++i) {
     const char* ext = device_string(devices[static_cast<std::size_t>(i)], EGL_EXTENSIONS);
     if (hasExtension(ext, "EGL_MESA_device_software")) continue;
-    EGLDisplay d = platform_display(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<std::size_t>(i)],
-                                    nullptr);
+    EGLDisplay d =
+        platform_display(EGL_PLATFORM_DEVICE_EXT, devices[static_cast<std::size_t>(i)], nullptr);
     if (d != EGL_NO_DISPLAY && initializeDisplay(d)) return d;
   }
   return EGL_NO_DISPLAY;
@@ -109,8 +121,9 @@ EGLDisplay hardwareDeviceDisplay() {
 EGLDisplay surfacelessDisplay() {
   const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
   if (!hasExtension(client, "EGL_MESA_platform_surfaceless")) {
-    throw RenderError("EGL: the surfaceless platform (EGL_MESA_platform_surfaceless) is not "
-                      "available; install libegl-mesa0");
+    throw RenderError(
+        "EGL: the surfaceless platform (EGL_MESA_platform_surfaceless) is not "
+        "available; install libegl-mesa0");
   }
   auto platform_display = proc<PFNEGLGETPLATFORMDISPLAYEXTPROC>("eglGetPlatformDisplayEXT");
   if (!platform_display) fail("eglGetProcAddress(eglGetPlatformDisplayEXT)");
@@ -135,8 +148,9 @@ EglContext::EglContext(const std::string& requested) {
   if (backend != "surfaceless") {
     d = hardwareDeviceDisplay();
     if (d == EGL_NO_DISPLAY && backend == "device") {
-      throw RenderError("EGL: backend 'device' requested but no hardware EGL device could be "
-                        "initialised (EGL_EXT_device_enumeration, a non-software device)");
+      throw RenderError(
+          "EGL: backend 'device' requested but no hardware EGL device could be "
+          "initialised (EGL_EXT_device_enumeration, a non-software device)");
     }
     if (d != EGL_NO_DISPLAY) platform_ = "device";
   }
@@ -156,9 +170,13 @@ EglContext::EglContext(const std::string& requested) {
       EGLint n = 0;
       if (!eglChooseConfig(d, attribs, &config, 1, &n) || n < 1) fail("eglChooseConfig");
     }
-    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                  4,
+                                  EGL_CONTEXT_MINOR_VERSION,
+                                  5,
                                   EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                  EGL_NONE};
     context_ = eglCreateContext(d, config, EGL_NO_CONTEXT, ctx_attribs);
     if (context_ == EGL_NO_CONTEXT) {
       fail("eglCreateContext (OpenGL 4.5 core on the " + platform_ + " platform)");
@@ -189,8 +207,9 @@ void EglContext::makeCurrent() {
   if (!eglMakeCurrent(display_, surface_, surface_, context_)) {
     const EGLint e = eglGetError();
     if (e == EGL_BAD_ACCESS) {
-      throw RenderError("EGL: eglMakeCurrent failed (EGL_BAD_ACCESS): the renderer's context is "
-                        "current on another thread; call Renderer::releaseCurrent() there first");
+      throw RenderError(
+          "EGL: eglMakeCurrent failed (EGL_BAD_ACCESS): the renderer's context is "
+          "current on another thread; call Renderer::releaseCurrent() there first");
     }
     throw RenderError("EGL: eglMakeCurrent failed (" + eglErrorName(e) + ")");
   }

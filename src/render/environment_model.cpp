@@ -73,8 +73,8 @@ Lighting lightingFor(const scenario::Environment& env, bool weather) {
   const Eigen::Vector3f day_z(0.16f, 0.30f, 0.66f), day_h(0.56f, 0.68f, 0.86f);
   l.sky_zenith = mix(night_z, mix(dusk_z, day_z, day), twilight);
   l.sky_horizon = mix(night_h, mix(dusk_h, day_h, day), twilight);
-  l.sun_glow = sun_up * mix(Eigen::Vector3f(0.9f, 0.45f, 0.15f),
-                            Eigen::Vector3f(0.5f, 0.45f, 0.35f), day);
+  l.sun_glow =
+      sun_up * mix(Eigen::Vector3f(0.9f, 0.45f, 0.15f), Eigen::Vector3f(0.5f, 0.45f, 0.35f), day);
   l.air_color = l.sky_horizon;
   l.air_k = 3.0f / 8000.0f;
   if (!weather) return l;
@@ -93,8 +93,8 @@ Lighting lightingFor(const scenario::Environment& env, bool weather) {
                        0.8f * overcast);
     l.sky_horizon = mix(l.sky_horizon, Eigen::Vector3f::Constant(grey_h), 0.8f * overcast);
     l.air_color = l.sky_horizon;
-    l.sky_ambient = mix(l.sky_ambient, Eigen::Vector3f::Constant(luminance(l.sky_ambient)),
-                        0.6f * overcast);
+    l.sky_ambient =
+        mix(l.sky_ambient, Eigen::Vector3f::Constant(luminance(l.sky_ambient)), 0.6f * overcast);
   }
   // Extinction coefficients for a 5 % contrast visibility V: k = 3 / V. Fog 1 -> 80 m,
   // dust 1 -> 150 m, rain 1 -> 1.2 km.
@@ -103,14 +103,14 @@ Lighting lightingFor(const scenario::Environment& env, bool weather) {
   l.haze_k = k_fog + k_dust + k_rain;
   if (l.haze_k > 0.0f) {
     // The haze is as bright as the diffuse light that reaches it.
-    const float brightness = std::clamp(
-        luminance(l.sky_ambient + 0.35f * l.sun_color) / luminance(Eigen::Vector3f(
-            0.30f + 0.35f * 1.9f, 0.35f + 0.35f * 1.84f, 0.44f + 0.35f * 1.72f)),
-        0.0f, 1.0f);
+    const float brightness =
+        std::clamp(luminance(l.sky_ambient + 0.35f * l.sun_color) /
+                       luminance(Eigen::Vector3f(0.30f + 0.35f * 1.9f, 0.35f + 0.35f * 1.84f,
+                                                 0.44f + 0.35f * 1.72f)),
+                   0.0f, 1.0f);
     const Eigen::Vector3f fog_c(0.78f, 0.80f, 0.82f), dust_c(0.66f, 0.52f, 0.34f),
         rain_c(0.52f, 0.54f, 0.57f);
-    l.haze_color =
-        brightness * (k_fog * fog_c + k_dust * dust_c + k_rain * rain_c) / l.haze_k;
+    l.haze_color = brightness * (k_fog * fog_c + k_dust * dust_c + k_rain * rain_c) / l.haze_k;
   }
   l.snow_cover = snow;
   l.wetness = rain;

@@ -13,7 +13,7 @@ namespace hameritt::render {
 // formulas without the equation of time).
 struct SunPosition {
   double elevation_deg = 0;
-  double azimuth_deg = 0;  // clockwise from north (ENU +y), east = 90
+  double azimuth_deg = 0;             // clockwise from north (ENU +y), east = 90
   Eigen::Vector3d direction() const;  // unit vector towards the sun in ENU
 };
 SunPosition sunPosition(double hours);
@@ -26,7 +26,7 @@ struct Lighting {
   Eigen::Vector3f ground_ambient{0, 0, 0};  // hemisphere light from below
   Eigen::Vector3f sky_zenith{0, 0, 0};
   Eigen::Vector3f sky_horizon{0, 0, 0};
-  Eigen::Vector3f sun_glow{0, 0, 0};        // sky brightening around the sun
+  Eigen::Vector3f sun_glow{0, 0, 0};  // sky brightening around the sun
   // Aerial perspective of clear air (visibility about 8 km): surfaces fade towards the colour
   // of the horizon sky; weather or not, it is part of the scene.
   Eigen::Vector3f air_color{0, 0, 0};

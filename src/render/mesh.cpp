@@ -1,10 +1,10 @@
 #include "mesh.h"
 
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -80,7 +80,8 @@ void computeBounds(Mesh* mesh) {
   Eigen::Vector3f flo = lo, fhi = hi;
   mesh->foliage_first = static_cast<std::uint32_t>(mesh->indices.size());
   for (const auto& s : mesh->submeshes) {
-    if (s.kind == MaterialKind::kFoliage) mesh->foliage_first = std::min(mesh->foliage_first, s.first_index);
+    if (s.kind == MaterialKind::kFoliage)
+      mesh->foliage_first = std::min(mesh->foliage_first, s.first_index);
     for (std::uint32_t i = s.first_index; i < s.first_index + s.index_count; ++i) {
       const Eigen::Vector3f p = mesh->position(mesh->indices[i]);
       lo = lo.cwiseMin(p);
@@ -115,10 +116,10 @@ Mesh loadObjMesh(const std::string& path, bool normalized) {
   Assimp::Importer importer;
   // Keep the file's per-face normals (generate flat ones only where a face has none); corners
   // with the same position and normal become one vertex, shaded once per instance.
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_GenNormals | aiProcess_JoinIdenticalVertices |
-                aiProcess_SortByPType | aiProcess_ValidateDataStructure |
-                aiProcess_FindInvalidData);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_GenNormals |
+                                  aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                                  aiProcess_ValidateDataStructure | aiProcess_FindInvalidData);
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !scene->mRootNode) {
     throw RenderError(path + ": malformed model: " + importer.GetErrorString());
   }
@@ -136,7 +137,8 @@ Mesh loadObjMesh(const std::string& path, bool normalized) {
     Submesh s;
     s.material = name.C_Str();
     if (s.material == AI_DEFAULT_MATERIAL_NAME) {
-      throw RenderError(path + ": faces without a material defined in the .mtl file (usemtl and "
+      throw RenderError(path +
+                        ": faces without a material defined in the .mtl file (usemtl and "
                         "mtllib are required)");
     }
     aiColor3D kd(0.8f, 0.8f, 0.8f);
@@ -162,10 +164,12 @@ Mesh loadObjMesh(const std::string& path, bool normalized) {
                       mesh.min.y() >= -0.5f - tol && mesh.max.y() <= 0.5f + tol &&
                       mesh.min.z() >= -tol && mesh.max.z() <= 1.0f + tol;
     if (!fits) {
-      throw RenderError(path + ": model does not fit the unit box [-0.5, 0.5] x [-0.5, 0.5] x "
-                        "[0, 1]: bounds [" + fmt(mesh.min.x()) + ", " + fmt(mesh.max.x()) +
-                        "] x [" + fmt(mesh.min.y()) + ", " + fmt(mesh.max.y()) + "] x [" +
-                        fmt(mesh.min.z()) + ", " + fmt(mesh.max.z()) + "]");
+      throw RenderError(path +
+                        ": model does not fit the unit box [-0.5, 0.5] x [-0.5, 0.5] x "
+                        "[0, 1]: bounds [" +
+                        fmt(mesh.min.x()) + ", " + fmt(mesh.max.x()) + "] x [" + fmt(mesh.min.y()) +
+                        ", " + fmt(mesh.max.y()) + "] x [" + fmt(mesh.min.z()) + ", " +
+                        fmt(mesh.max.z()) + "]");
     }
   }
   return mesh;
@@ -193,7 +197,8 @@ Mesh flatMesh(const std::string& name, MaterialKind kind, const Eigen::Vector3f&
 }
 
 Mesh unitQuad(const std::string& name, MaterialKind kind, const Eigen::Vector3f& kd) {
-  return flatMesh(name, kind, kd, {{{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}}}});
+  return flatMesh(name, kind, kd,
+                  {{{{-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0.5f, 0.5f, 0}, {-0.5f, 0.5f, 0}}}});
 }
 
 Mesh unitBox(const std::string& name, MaterialKind kind, const Eigen::Vector3f& kd) {

@@ -12,12 +12,12 @@ namespace hameritt::render {
 
 // How a material gets its albedo (and its procedural pattern) in the geometry pass.
 enum class MaterialKind : int {
-  kPlain = 0,    // the MTL's Kd
-  kPaint = 1,    // the instance colour (entity colour attribute, driveway material)
-  kFoliage = 2,  // Kd tinted by the instance colour (tree species); scaled about the canopy centre
-  kLawn = 3,     // ground: green with a low-frequency world-space variation
-  kStreet = 4,   // asphalt with a dashed centre line (street-local coordinates)
-  kSidewalk = 5, // light concrete
+  kPlain = 0,     // the MTL's Kd
+  kPaint = 1,     // the instance colour (entity colour attribute, driveway material)
+  kFoliage = 2,   // Kd tinted by the instance colour (tree species); scaled about the canopy centre
+  kLawn = 3,      // ground: green with a low-frequency world-space variation
+  kStreet = 4,    // asphalt with a dashed centre line (street-local coordinates)
+  kSidewalk = 5,  // light concrete
 };
 
 // One material's triangles: indices [first_index, first_index + index_count).

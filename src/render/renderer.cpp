@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstring>
-#include <cmath>
 #include <limits>
 #include <unordered_map>
 
@@ -145,7 +145,6 @@ constexpr ParticleLayer kRainLayers[] = {
 constexpr ParticleLayer kSnowLayers[] = {
     {40, 0, 3.2f, 0.95f, 0.45f}, {22, 0, 2.0f, 0.85f, 0.55f}, {12, 0, 1.2f, 0.70f, 0.60f}};
 
-
 struct Uniforms {
   GLint view_proj, camera, canopy_center, near_clip, far_clip, sun_dir, sun_color, sky_ambient,
       ground_ambient, snow, wet, world_R_optical, intrinsics, extinction_color, extinction_k;
@@ -178,7 +177,7 @@ struct Frame {
   std::vector<int> slot;              // per record: its index in the upload, or -1
   std::vector<std::uint32_t> uploaded;
   std::vector<GpuInstance> upload;
-  std::vector<std::uint8_t> color;    // read-back colour before the camera effects
+  std::vector<std::uint8_t> color;              // read-back colour before the camera effects
   std::vector<std::pair<int, BoxAcc>> touched;  // instances of interest in the mask
   RenderStats stats;
 };
@@ -238,24 +237,35 @@ struct Renderer::Impl {
                                    version + define + shaders::kCommon + shaders::kGeometryFragment,
                                    g == 1 ? "geometry (ground layers)" : "geometry (objects)");
       auto loc = [this, g](const char* n) { return glGetUniformLocation(geometry[g].id, n); };
-      geometry[g].u = {loc("u_view_proj"),      loc("u_camera"),        loc("u_canopy_center"),
-                       loc("u_near"),           loc("u_far"),           loc("u_sun_dir"),
-                       loc("u_sun_color"),      loc("u_sky_ambient"),   loc("u_ground_ambient"),
-                       loc("u_snow"),           loc("u_wet"),           loc("u_world_R_optical"),
-                       loc("u_intrinsics"),     loc("u_extinction_color"), loc("u_extinction_k")};
+      geometry[g].u = {loc("u_view_proj"),
+                       loc("u_camera"),
+                       loc("u_canopy_center"),
+                       loc("u_near"),
+                       loc("u_far"),
+                       loc("u_sun_dir"),
+                       loc("u_sun_color"),
+                       loc("u_sky_ambient"),
+                       loc("u_ground_ambient"),
+                       loc("u_snow"),
+                       loc("u_wet"),
+                       loc("u_world_R_optical"),
+                       loc("u_intrinsics"),
+                       loc("u_extinction_color"),
+                       loc("u_extinction_k")};
     }
     sky_program = linkProgram(shaders::kFullscreenVertex,
                               version + shaders::kCommon + shaders::kSkyFragment, "sky");
     particle_program = linkProgram(version + shaders::kHash + shaders::kParticleVertex,
                                    version + shaders::kParticleFragment, "particles");
     auto sky = [this](const char* n) { return glGetUniformLocation(sky_program, n); };
-    sky_loc = {sky("u_world_R_optical"), sky("u_intrinsics"), sky("u_zenith"),
-               sky("u_horizon"),         sky("u_sun_dir"),    sky("u_glow"),
-               sky("u_far"),             sky("u_haze_color"), sky("u_haze_k")};
+    sky_loc = {sky("u_world_R_optical"), sky("u_intrinsics"), sky("u_zenith"), sky("u_horizon"),
+               sky("u_sun_dir"),         sky("u_glow"),       sky("u_far"),    sky("u_haze_color"),
+               sky("u_haze_k")};
     auto part = [this](const char* n) { return glGetUniformLocation(particle_program, n); };
-    particle_loc = {part("u_key"),    part("u_size"),       part("u_cells_x"), part("u_cell"),
-                    part("u_length"), part("u_radius"),     part("u_density"), part("u_layer"),
-                    part("u_fall"),   part("u_intrinsics"), part("u_alpha"),   part("u_brightness")};
+    particle_loc = {part("u_key"),        part("u_size"),   part("u_cells_x"),
+                    part("u_cell"),       part("u_length"), part("u_radius"),
+                    part("u_density"),    part("u_layer"),  part("u_fall"),
+                    part("u_intrinsics"), part("u_alpha"),  part("u_brightness")};
 
     // All meshes in one vertex and one element buffer.
     std::vector<Vertex> vertices;
@@ -368,8 +378,10 @@ struct Renderer::Impl {
         always.push_back(static_cast<std::uint32_t>(i));
         continue;
       }
-      const int cx = std::clamp(static_cast<int>((si.center.x() - lo.x()) / kCellSize), 0, grid_nx - 1);
-      const int cy = std::clamp(static_cast<int>((si.center.y() - lo.y()) / kCellSize), 0, grid_ny - 1);
+      const int cx =
+          std::clamp(static_cast<int>((si.center.x() - lo.x()) / kCellSize), 0, grid_nx - 1);
+      const int cy =
+          std::clamp(static_cast<int>((si.center.y() - lo.y()) / kCellSize), 0, grid_ny - 1);
       const auto c = static_cast<std::size_t>(cy * grid_nx + cx);
       per[c * static_cast<std::size_t>(models) + static_cast<std::size_t>(si.model)].push_back(
           static_cast<std::uint32_t>(i));
@@ -466,8 +478,8 @@ struct Renderer::Impl {
     }
     auto positive = [](const char* field, double v) {
       if (!std::isfinite(v) || v <= 0.0) {
-        throw RenderError(std::string("RenderRequest.") + field + ": expected a finite value > 0, got " +
-                          num(v));
+        throw RenderError(std::string("RenderRequest.") + field +
+                          ": expected a finite value > 0, got " + num(v));
       }
     };
     positive("intrinsics.fx", k.fx);
@@ -567,7 +579,8 @@ struct Renderer::Impl {
     for (const std::string& id : ids) {
       auto [b, e] = by_id.equal_range(id);
       for (auto it = b; it != e; ++it) {
-        const auto rec = static_cast<std::uint32_t>(instance_record[static_cast<std::size_t>(it->second)]);
+        const auto rec =
+            static_cast<std::uint32_t>(instance_record[static_cast<std::size_t>(it->second)]);
         hidden[rec] = 1;
         hidden_list.push_back(rec);
       }
@@ -617,7 +630,8 @@ struct Renderer::Impl {
     for (std::uint32_t i : movers) {
       if (hidden[i]) continue;
       const auto& [c, radius] = mover_sphere[i];
-      if (sphereVisible(c, radius, true)) visible[static_cast<std::size_t>(inst[i].model)].push_back(i);
+      if (sphereVisible(c, radius, true))
+        visible[static_cast<std::size_t>(inst[i].model)].push_back(i);
     }
     for (std::uint32_t i : always) {
       if (sphereVisible(inst[i].center, inst[i].radius, true)) {
@@ -655,12 +669,14 @@ struct Renderer::Impl {
     // Clear air and weather haze as one medium: summed extinction, in-scattered colours
     // weighted by their extinction.
     const float k = l.air_k + l.haze_k;
-    const Eigen::Vector3f ext = k > 0 ? Eigen::Vector3f((l.air_k * l.air_color + l.haze_k * l.haze_color) / k)
-                                      : Eigen::Vector3f::Zero();
+    const Eigen::Vector3f ext =
+        k > 0 ? Eigen::Vector3f((l.air_k * l.air_color + l.haze_k * l.haze_color) / k)
+              : Eigen::Vector3f::Zero();
     const Eigen::Vector3f cam = f.camera.cast<float>();
     const Eigen::Matrix3f rot = r.world_T_optical.linear().cast<float>();
     const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
-                           static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
+                           static_cast<float>(r.intrinsics.cx),
+                           static_cast<float>(r.intrinsics.cy)};
     for (const auto& g : geometry) {
       const GLuint p = g.id;
       const Uniforms& u = g.u;
@@ -752,7 +768,8 @@ struct Renderer::Impl {
     const Eigen::Matrix3f rot = r.world_T_optical.linear().cast<float>();
     glProgramUniformMatrix3fv(sky_program, sky_loc.world_R_optical, 1, GL_FALSE, rot.data());
     const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
-                           static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
+                           static_cast<float>(r.intrinsics.cx),
+                           static_cast<float>(r.intrinsics.cy)};
     glProgramUniform4fv(sky_program, sky_loc.intrinsics, 1, intr);
     glProgramUniform3fv(sky_program, sky_loc.zenith, 1, l.sky_zenith.data());
     glProgramUniform3fv(sky_program, sky_loc.horizon, 1, l.sky_horizon.data());
@@ -797,8 +814,9 @@ struct Renderer::Impl {
   // noise z, w.
   void frameKey(const RenderRequest& r, GLuint key[4]) const {
     const std::uint64_t k1 = splitmix64(
-        config.seed ^ splitmix64(static_cast<std::uint64_t>(static_cast<std::int64_t>(r.camera_index)) ^
-                                 splitmix64(r.frame_index)));
+        config.seed ^
+        splitmix64(static_cast<std::uint64_t>(static_cast<std::int64_t>(r.camera_index)) ^
+                   splitmix64(r.frame_index)));
     const std::uint64_t k2 = splitmix64(k1);
     key[0] = static_cast<GLuint>(k1);
     key[1] = static_cast<GLuint>(k1 >> 32);
@@ -810,19 +828,23 @@ struct Renderer::Impl {
   void particlePass(const Frame& f) {
     const RenderRequest& r = *f.request;
     const Targets& t = *f.targets;
-    const float rain = r.weather ? static_cast<float>(std::clamp(config.environment.rain, 0.0, 1.0)) : 0.0f;
-    const float snow = r.weather ? static_cast<float>(std::clamp(config.environment.snow, 0.0, 1.0)) : 0.0f;
+    const float rain =
+        r.weather ? static_cast<float>(std::clamp(config.environment.rain, 0.0, 1.0)) : 0.0f;
+    const float snow =
+        r.weather ? static_cast<float>(std::clamp(config.environment.snow, 0.0, 1.0)) : 0.0f;
     if (rain <= 0.0f && snow <= 0.0f) return;
     const GLuint p = particle_program;
     GLuint key[4];
     frameKey(r, key);
     glProgramUniform4uiv(p, particle_loc.key, 1, key);
-    glProgramUniform2f(p, particle_loc.size, static_cast<float>(t.width), static_cast<float>(t.height));
+    glProgramUniform2f(p, particle_loc.size, static_cast<float>(t.width),
+                       static_cast<float>(t.height));
     const Eigen::Vector3f fall =
         (r.world_T_optical.linear().transpose() * Eigen::Vector3d(0, 0, -1)).cast<float>();
     glProgramUniform3fv(p, particle_loc.fall, 1, fall.data());
     const float intr[4] = {static_cast<float>(r.intrinsics.fx), static_cast<float>(r.intrinsics.fy),
-                           static_cast<float>(r.intrinsics.cx), static_cast<float>(r.intrinsics.cy)};
+                           static_cast<float>(r.intrinsics.cx),
+                           static_cast<float>(r.intrinsics.cy)};
     glProgramUniform4fv(p, particle_loc.intrinsics, 1, intr);
     // Particles are lit by the diffuse light.
     const Eigen::Vector3f light = f.lighting.sky_ambient + 0.3f * f.lighting.sun_color;
@@ -866,9 +888,8 @@ struct Renderer::Impl {
   void cameraEffects(Frame& f) const {
     const RenderRequest& r = *f.request;
     const auto& pert = config.perturbations;
-    f.effects.blur = r.noise ? motionBlurKernel(r.blur_direction.x(), r.blur_direction.y(),
-                                                pert.motion_blur_px)
-                             : std::vector<BlurTap>{};
+    motionBlurKernel(r.blur_direction.x(), r.blur_direction.y(),
+                     r.noise ? pert.motion_blur_px : 0.0, &f.effects.blur);
     f.effects.noise_std = r.noise ? static_cast<float>(pert.gaussian_noise_std) : 0.0f;
     f.effects.salt = r.noise ? static_cast<float>(pert.salt_pepper_probability) : 0.0f;
     GLuint key[4];
@@ -949,7 +970,8 @@ struct Renderer::Impl {
     const Eigen::Isometry3d optical_T_world = r.world_T_optical.inverse();
     double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
     for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d p((c & 1) ? mesh.max.x() : mesh.min.x(), (c & 2) ? mesh.max.y() : mesh.min.y(),
+      const Eigen::Vector3d p((c & 1) ? mesh.max.x() : mesh.min.x(),
+                              (c & 2) ? mesh.max.y() : mesh.min.y(),
                               (c & 4) ? mesh.max.z() : mesh.min.z());
       Eigen::Vector3d w;
       for (int a = 0; a < 3; ++a) {
@@ -986,7 +1008,8 @@ struct Renderer::Impl {
     box_total.assign(n, 0);
     int groups = 0;
     for (std::size_t a = 0; a < n; ++a) {
-      const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+      const auto rec =
+          static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
       box_rect[a] = projectedRect(f, scene.instances()[rec].model, f.slot[rec]);
       for (int g = 0; g <= groups && box_group[a] < 0; ++g) {
         bool free = true;
@@ -994,7 +1017,8 @@ struct Renderer::Impl {
           if (box_group[b] != g) continue;
           const auto& p = box_rect[a];
           const auto& q = box_rect[b];
-          free = p[0] + p[2] <= q[0] || q[0] + q[2] <= p[0] || p[1] + p[3] <= q[1] || q[1] + q[3] <= p[1];
+          free = p[0] + p[2] <= q[0] || q[0] + q[2] <= p[0] || p[1] + p[3] <= q[1] ||
+                 q[1] + q[3] <= p[1];
         }
         if (free) box_group[a] = g;
       }
@@ -1023,10 +1047,12 @@ struct Renderer::Impl {
       group_count.assign(static_cast<std::size_t>(models), 0);
       int x0 = t.width, y0 = t.height, x1 = 0, y1 = 0;
       for (int m = 0; m < models; ++m) {
-        group_base[static_cast<std::size_t>(m)] = static_cast<GLuint>(f.upload.size() + box_upload.size());
+        group_base[static_cast<std::size_t>(m)] =
+            static_cast<GLuint>(f.upload.size() + box_upload.size());
         for (std::size_t a = 0; a < n; ++a) {
           if (box_group[a] != g) continue;
-          const auto rec = static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+          const auto rec = static_cast<std::size_t>(
+              instance_record[static_cast<std::size_t>(f.touched[a].first)]);
           if (scene.instances()[rec].model != m) continue;
           box_upload.push_back(f.upload[static_cast<std::size_t>(f.slot[rec])]);
           ++group_count[static_cast<std::size_t>(m)];
@@ -1037,10 +1063,9 @@ struct Renderer::Impl {
           y1 = std::max(y1, r[1] + r[3]);
         }
       }
-      glNamedBufferSubData(f.instance_buffer,
-                           static_cast<GLintptr>(f.upload.size() * sizeof(GpuInstance)),
-                           static_cast<GLsizeiptr>(box_upload.size() * sizeof(GpuInstance)),
-                           box_upload.data());
+      glNamedBufferSubData(
+          f.instance_buffer, static_cast<GLintptr>(f.upload.size() * sizeof(GpuInstance)),
+          static_cast<GLsizeiptr>(box_upload.size() * sizeof(GpuInstance)), box_upload.data());
       // Only the group's rectangles matter: clear and draw inside their union (the colour is
       // not needed).
       if (x1 <= x0 || y1 <= y0) continue;
@@ -1065,7 +1090,8 @@ struct Renderer::Impl {
         const auto& r = box_rect[a];
         int count = 0;
         for (int y = r[1]; y < r[1] + r[3]; ++y) {
-          const std::uint32_t* row = box_labels.data() + static_cast<std::size_t>(y - y0) * static_cast<std::size_t>(w);
+          const std::uint32_t* row =
+              box_labels.data() + static_cast<std::size_t>(y - y0) * static_cast<std::size_t>(w);
           for (int x = r[0]; x < r[0] + r[2]; ++x) count += (row[x - x0] & 0xFFFFu) == id ? 1 : 0;
         }
         box_total[a] = count;
@@ -1104,7 +1130,8 @@ struct Renderer::Impl {
   // submitted first (the GL rasterizes one while the next is culled and its vertices
   // processed), then each frame is read back, then the camera effects of each run on the CPU
   // (while the GL still works on later frames), then the boxes.
-  void render(const std::vector<const RenderRequest*>& requests, const std::vector<FrameSet*>& outs) {
+  void render(const std::vector<const RenderRequest*>& requests,
+              const std::vector<FrameSet*>& outs) {
     egl.makeCurrent();
     for (const RenderRequest* r : requests) validate(*r);
     const bool timing = options.stage_timing;
@@ -1136,7 +1163,8 @@ struct Renderer::Impl {
       cameraEffects(f);
       std::size_t triangles = 0;
       for (int m = 0; m < static_cast<int>(f.count.size()); ++m) {
-        triangles += static_cast<std::size_t>(f.count[static_cast<std::size_t>(m)]) * scene.drawnIndexCount(m) / 3;
+        triangles += static_cast<std::size_t>(f.count[static_cast<std::size_t>(m)]) *
+                     scene.drawnIndexCount(m) / 3;
       }
       order.emplace_back(triangles, i);
       stage_end(&t0, &f.stats.cull_upload_ms);
@@ -1158,8 +1186,8 @@ struct Renderer::Impl {
       splitLabels(f);
       stage_end(&t0, &f.stats.readback_ms);
       if (f.effects.any()) {
-        applyCameraEffects(f.color.data(), f.targets->width, f.targets->height, f.effects,
-                           f.out->rgb.data(), &effects_scratch);
+        effects_worker.apply(f.color.data(), f.targets->width, f.targets->height, f.effects,
+                             f.out->rgb.data(), &effects_scratch);
       }
       stage_end(&t0, &f.stats.post_ms);
     }
@@ -1210,7 +1238,9 @@ struct Renderer::Impl {
   std::vector<int> draw_order;
   std::vector<InstanceRecord> records;
   std::uint32_t uav_record = 0;
-  std::vector<std::unique_ptr<Frame>> frames;  // one slot per request of a batch
+  std::vector<std::unique_ptr<Frame>> frames;      // one slot per request of a batch
+  std::vector<const RenderRequest*> request_list;  // the requests of the current call
+  std::vector<FrameSet*> out_list;
   std::vector<std::pair<std::size_t, std::size_t>> order;  // (triangles, frame) of a batch
 
   // Culling.
@@ -1235,6 +1265,7 @@ struct Renderer::Impl {
   std::vector<int> touched;
   std::vector<std::uint32_t> label_scratch;
   CameraEffectsScratch effects_scratch;
+  CameraEffectsWorker effects_worker;
   std::vector<std::array<int, 4>> box_rect;
   std::vector<int> box_group, box_total;
   std::vector<GpuInstance> box_upload;
@@ -1250,24 +1281,28 @@ Renderer::Renderer(const scenario::World& world, const scenario::SimConfig& conf
 Renderer::~Renderer() = default;
 
 void Renderer::render(const RenderRequest& request, FrameSet* out) {
-  impl_->render({&request}, {out});
+  auto& i = *impl_;
+  i.request_list.assign(1, &request);
+  i.out_list.assign(1, out);
+  i.render(i.request_list, i.out_list);
 }
 
 FrameSet Renderer::render(const RenderRequest& request) {
   FrameSet f;
-  impl_->render({&request}, {&f});
+  render(request, &f);
   return f;
 }
 
 void Renderer::render(const std::vector<RenderRequest>& requests, std::vector<FrameSet>* out) {
+  auto& i = *impl_;
   out->resize(requests.size());
-  std::vector<const RenderRequest*> r;
-  std::vector<FrameSet*> o;
-  for (std::size_t i = 0; i < requests.size(); ++i) {
-    r.push_back(&requests[i]);
-    o.push_back(&(*out)[i]);
+  i.request_list.clear();
+  i.out_list.clear();
+  for (std::size_t k = 0; k < requests.size(); ++k) {
+    i.request_list.push_back(&requests[k]);
+    i.out_list.push_back(&(*out)[k]);
   }
-  impl_->render(r, o);
+  i.render(i.request_list, i.out_list);
 }
 
 void Renderer::makeCurrent() { impl_->egl.makeCurrent(); }

@@ -19,7 +19,9 @@ std::uint32_t packRgb8(int r, int g, int b) {
 }
 
 std::uint32_t packLinearHalf(const Eigen::Vector3f& c) {
-  auto q = [](float v) { return static_cast<int>(std::lround(std::clamp(0.5f * v, 0.0f, 1.0f) * 255.0f)); };
+  auto q = [](float v) {
+    return static_cast<int>(std::lround(std::clamp(0.5f * v, 0.0f, 1.0f) * 255.0f));
+  };
   return packRgb8(q(c.x()), q(c.y()), q(c.z()));
 }
 
@@ -131,11 +133,11 @@ bool paintColor(const std::string& name, std::uint32_t* srgb8) {
   };
   // Typical paint and facade values (sRGB).
   static const Named kColors[] = {
-      {"red", 158, 26, 28},      {"blue", 32, 62, 130},     {"white", 232, 232, 226},
-      {"black", 24, 24, 27},     {"silver", 168, 171, 175}, {"grey", 108, 110, 114},
-      {"gray", 108, 110, 114},   {"green", 38, 92, 52},     {"yellow", 222, 184, 52},
-      {"beige", 214, 196, 160},  {"brick", 146, 64, 48},    {"brown", 104, 70, 44},
-      {"orange", 222, 108, 30},  {"concrete", 178, 175, 166}, {"asphalt", 68, 68, 70},
+      {"red", 158, 26, 28},     {"blue", 32, 62, 130},       {"white", 232, 232, 226},
+      {"black", 24, 24, 27},    {"silver", 168, 171, 175},   {"grey", 108, 110, 114},
+      {"gray", 108, 110, 114},  {"green", 38, 92, 52},       {"yellow", 222, 184, 52},
+      {"beige", 214, 196, 160}, {"brick", 146, 64, 48},      {"brown", 104, 70, 44},
+      {"orange", 222, 108, 30}, {"concrete", 178, 175, 166}, {"asphalt", 68, 68, 70},
   };
   for (const auto& c : kColors) {
     if (name == c.name) {
@@ -175,11 +177,11 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     return m;
   };
   // Every class mesh is loaded up front, so that a missing file fails the construction.
-  for (const char* f : {"house_1.obj", "house_2.obj", "garage_1.obj", "garage_2.obj",
-                        "fence_wood.obj", "fence_vinyl.obj", "fence_chain_link.obj",
-                        "tree_deciduous.obj", "tree_pine.obj", "car_sedan.obj", "car_suv.obj",
-                        "car_pickup.obj", "car_hatchback.obj", "car_van.obj", "pedestrian.obj",
-                        "sentinel.obj"}) {
+  for (const char* f :
+       {"house_1.obj", "house_2.obj", "garage_1.obj", "garage_2.obj", "fence_wood.obj",
+        "fence_vinyl.obj", "fence_chain_link.obj", "tree_deciduous.obj", "tree_pine.obj",
+        "car_sedan.obj", "car_suv.obj", "car_pickup.obj", "car_hatchback.obj", "car_van.obj",
+        "pedestrian.obj", "sentinel.obj"}) {
     model(f);
   }
   procedural_.uav = model("sentinel.obj");
@@ -260,8 +262,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
         si.model = model(species == "pine" ? "tree_pine.obj" : "tree_deciduous.obj");
         // Foliage density: canopies scale about their centre by 0.35 + 0.65 * foliage, a
         // "sparse" tree by a further 0.85; at density 0 only trunks are drawn.
-        si.record.canopy = static_cast<float>((0.35 + 0.65 * foliage_) *
-                                              (e.attributes.str("foliage") == "sparse" ? 0.85 : 1.0));
+        si.record.canopy = static_cast<float>(
+            (0.35 + 0.65 * foliage_) * (e.attributes.str("foliage") == "sparse" ? 0.85 : 1.0));
         Eigen::Vector3f tint(0.85f, 1.0f, 0.8f);  // oak
         if (species == "maple") tint = Eigen::Vector3f(1.0f, 0.92f, 0.72f);
         if (species == "birch") tint = Eigen::Vector3f(1.15f, 1.2f, 0.75f);
@@ -273,7 +275,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       case EntityClass::kCar: {
         const std::string vc = e.attributes.str("vehicle_class");
         if (vc != "sedan" && vc != "suv" && vc != "pickup" && vc != "hatchback" && vc != "van") {
-          throw RenderError(attributeError(e, "vehicle_class", "sedan, suv, pickup, hatchback or van"));
+          throw RenderError(
+              attributeError(e, "vehicle_class", "sedan, suv, pickup, hatchback or van"));
         }
         si.model = model("car_" + vc + ".obj");
         color_key = "color";
@@ -355,8 +358,8 @@ SceneTriangles Scene::triangles(double time) const {
         if (canopy) p = mesh.canopy_center + rec.canopy * (p - mesh.canopy_center);
         Eigen::Vector3f w;
         for (int r = 0; r < 3; ++r) {
-          w[r] = rec.row[r][0] * p.x() + rec.row[r][1] * p.y() + rec.row[r][2] * p.z() +
-                 rec.row[r][3];
+          w[r] =
+              rec.row[r][0] * p.x() + rec.row[r][1] * p.y() + rec.row[r][2] * p.z() + rec.row[r][3];
         }
         out.indices.push_back(static_cast<std::uint32_t>(out.vertices.size()));
         out.vertices.push_back(w);

@@ -13,20 +13,18 @@
 
 namespace hameritt::render {
 
-// Per-instance data as the vertex shader reads it (std430, 64 bytes).
+// Per-instance data (the renderer turns it into the vertex shader's instance attributes).
 struct InstanceRecord {
-  float row[3][4];            // rows of the 3x4 model matrix (mesh -> world)
-  std::uint32_t color = 0;    // kPaint: sRGB8 colour; kFoliage: linear tint / 2 (RGB8)
-  std::uint32_t label = 0;    // semantic << 16 | instance
-  float canopy = 1.0f;        // canopy scale about the mesh's canopy centre
-  std::uint32_t pad = 0;
+  float row[3][4];          // rows of the 3x4 model matrix (mesh -> world)
+  std::uint32_t color = 0;  // kPaint: display colour (RGB8, gamma 2); kFoliage: linear tint / 2
+  std::uint32_t label = 0;  // semantic << 16 | instance
+  float canopy = 1.0f;      // canopy scale about the mesh's canopy centre
 };
-static_assert(sizeof(InstanceRecord) == 64, "std430 layout");
 
 // One drawn object.
 struct SceneInstance {
-  int model = 0;              // index into Scene::models()
-  int instance_id = 0;        // label instance (0 for ground layers)
+  int model = 0;        // index into Scene::models()
+  int instance_id = 0;  // label instance (0 for ground layers)
   int semantic = 0;
   int scenario_entity = -1;   // index into SimConfig::entities when it comes from the scenario
   bool mover = false;         // posed from its trajectory at the frame time
@@ -46,7 +44,8 @@ class Scene {
  public:
   // Loads every class mesh from models_dir/meshes (RenderError naming a missing or malformed
   // file) and builds the instances. Throws RenderError for unknown colour names and for more
-  // instances than a 16-bit label holds.
+  // instances than a 16-bit label holds. `config` must outlive the scene (movers are posed
+  // from it).
   Scene(const scenario::World& world, const scenario::SimConfig& config,
         const std::string& models_dir);
 
@@ -83,9 +82,9 @@ class Scene {
   double foliage_ = 1.0;
 };
 
-// Linear-RGB albedo of a named paint colour (red, blue, white, black, silver, grey, green,
-// yellow, beige, brick, brown, orange, concrete, asphalt), as sRGB8 packed in a uint32; false
-// for an unknown name.
+// The display colour (RGB8, gamma 2, packed R | G << 8 | B << 16 | 255 << 24) of a named paint:
+// red, blue, white, black, silver, grey, green, yellow, beige, brick, brown, orange, and the
+// driveway materials concrete and asphalt; false for an unknown name.
 bool paintColor(const std::string& name, std::uint32_t* srgb8);
 
 // Model matrix rows of a normalized mesh placed at an entity box (bottom centre, yaw, size).

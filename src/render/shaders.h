@@ -1,7 +1,7 @@
 #pragma once
 // GLSL 4.50 sources of the renderer's three programs: the geometry pass (lit colour, and linear
-// depth with the label in one two-channel integer target), the sky (pixels no geometry covered) and the weather
-// particles blended onto the colour. Motion blur and sensor noise follow on the CPU
+// depth with the label in one two-channel integer target), the sky (pixels no geometry covered) and
+// the weather particles blended onto the colour. Motion blur and sensor noise follow on the CPU
 // (camera_effects.h).
 
 namespace hameritt::render::shaders {
@@ -246,7 +246,8 @@ vec4 uniform01(uvec4 h) { return vec4(h >> 8u) * (1.0 / 16777216.0); }
 
 // Weather particles: one screen-space particle per cell of a grid (a rain streak or a snow
 // flake), present with probability `density`, drawn as an instanced quad (a four-vertex strip)
-// and blended onto the colour. Each instance is a cell; its particle comes from the hash of (cell, layer, key).
+// and blended onto the colour. Each instance is a cell; its particle comes from the hash of (cell,
+// layer, key).
 inline constexpr const char* kParticleVertex = R"GLSL(
 uniform uvec4 u_key;
 uniform vec2 u_size;       // image width, height

@@ -14,8 +14,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <limits>
 #include <exception>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -158,7 +158,8 @@ Options parseArgs(int argc, char** argv, bool* help) {
         }
       }
       if (parts.size() != 4) throw ConfigError("--pose: expected x,y,z,yaw, got '" + v + "'");
-      for (int k = 0; k < 4; ++k) o.pose[k] = parseNumber("--pose", parts[static_cast<std::size_t>(k)]);
+      for (int k = 0; k < 4; ++k)
+        o.pose[k] = parseNumber("--pose", parts[static_cast<std::size_t>(k)]);
       o.have_pose = true;
     } else if (a == "--set") {
       o.sets.push_back(next());
@@ -226,17 +227,17 @@ cv::Mat depthImage(const render::FrameSet& f) {
 // Class palette (RGB) by semantic id.
 cv::Vec3b semanticColor(int id) {
   static const int kPalette[][3] = {
-      {70, 130, 180},  // 0 sky
-      {110, 160, 70},  // 1 ground
-      {128, 64, 128},  // 2 street
-      {170, 150, 120}, // 3 driveway
-      {220, 60, 50},   // 4 house
-      {250, 170, 30},  // 5 garage
-      {190, 153, 153}, // 6 fence
-      {40, 120, 40},   // 7 tree
-      {0, 60, 230},    // 8 car
-      {220, 20, 200},  // 9 pedestrian
-      {255, 255, 255}, // 10 uav
+      {70, 130, 180},   // 0 sky
+      {110, 160, 70},   // 1 ground
+      {128, 64, 128},   // 2 street
+      {170, 150, 120},  // 3 driveway
+      {220, 60, 50},    // 4 house
+      {250, 170, 30},   // 5 garage
+      {190, 153, 153},  // 6 fence
+      {40, 120, 40},    // 7 tree
+      {0, 60, 230},     // 8 car
+      {220, 20, 200},   // 9 pedestrian
+      {255, 255, 255},  // 10 uav
   };
   const int n = static_cast<int>(sizeof(kPalette) / sizeof(kPalette[0]));
   const int* c = kPalette[id >= 0 && id < n ? id : 0];
@@ -247,7 +248,8 @@ cv::Vec3b semanticColor(int id) {
 cv::Mat segmentationImage(const render::FrameSet& f) {
   cv::Mat m(f.intrinsics.height, f.intrinsics.width, CV_8UC3);
   for (int i = 0; i < m.rows * m.cols; ++i) {
-    m.at<cv::Vec3b>(i / m.cols, i % m.cols) = semanticColor(f.semantic[static_cast<std::size_t>(i)]);
+    m.at<cv::Vec3b>(i / m.cols, i % m.cols) =
+        semanticColor(f.semantic[static_cast<std::size_t>(i)]);
   }
   return m;
 }
@@ -262,7 +264,8 @@ cv::Mat instanceImage(const render::FrameSet& f) {
       h ^= h >> 15;
       h *= 2246822519u;
       h ^= h >> 13;
-      c = cv::Vec3b(static_cast<std::uint8_t>(64 + (h & 0xBF)), static_cast<std::uint8_t>(64 + ((h >> 8) & 0xBF)),
+      c = cv::Vec3b(static_cast<std::uint8_t>(64 + (h & 0xBF)),
+                    static_cast<std::uint8_t>(64 + ((h >> 8) & 0xBF)),
                     static_cast<std::uint8_t>(64 + ((h >> 16) & 0xBF)));
     }
     m.at<cv::Vec3b>(i / m.cols, i % m.cols) = c;
@@ -300,15 +303,16 @@ std::string png(const cv::Mat& m, const std::string& name) {
 
 std::string cameraInfoYaml(const std::string& name, const render::Intrinsics& k) {
   char buf[1024];
-  std::snprintf(buf, sizeof(buf),
-                "image_width: %d\nimage_height: %d\ncamera_name: %s\n"
-                "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [%.9g, 0, %.9g, 0, %.9g, %.9g, 0, 0, 1]\n"
-                "distortion_model: plumb_bob\n"
-                "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n"
-                "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
-                "projection_matrix:\n  rows: 3\n  cols: 4\n"
-                "  data: [%.9g, 0, %.9g, 0, 0, %.9g, %.9g, 0, 0, 0, 1, 0]\n",
-                k.width, k.height, name.c_str(), k.fx, k.cx, k.fy, k.cy, k.fx, k.cx, k.fy, k.cy);
+  std::snprintf(
+      buf, sizeof(buf),
+      "image_width: %d\nimage_height: %d\ncamera_name: %s\n"
+      "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [%.9g, 0, %.9g, 0, %.9g, %.9g, 0, 0, 1]\n"
+      "distortion_model: plumb_bob\n"
+      "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n"
+      "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+      "projection_matrix:\n  rows: 3\n  cols: 4\n"
+      "  data: [%.9g, 0, %.9g, 0, 0, %.9g, %.9g, 0, 0, 0, 1, 0]\n",
+      k.width, k.height, name.c_str(), k.fx, k.cx, k.fy, k.cy, k.fx, k.cx, k.fy, k.cy);
   return buf;
 }
 
@@ -395,13 +399,13 @@ int main(int argc, char** argv) {
       req.camera_index = camera_index;
       req.intrinsics = render::intrinsicsFromHfov(c.width, c.height, c.hfov_deg);
       const double d2r = 3.14159265358979323846 / 180.0;
-      req.world_T_optical = render::opticalPose(world_T_base, c.mount_xyz,
-                                                c.mount_rpy * d2r);
+      req.world_T_optical = render::opticalPose(world_T_base, c.mount_xyz, c.mount_rpy * d2r);
       const render::FrameSet f = renderer.render(req);
       const std::string p = o.out + "/" + c.name;
       files.emplace_back(p + "_rgb.png", png(rgbToBgr(f), p + "_rgb.png"));
       files.emplace_back(p + "_depth.png", png(depthImage(f), p + "_depth.png"));
-      files.emplace_back(p + "_segmentation.png", png(segmentationImage(f), p + "_segmentation.png"));
+      files.emplace_back(p + "_segmentation.png",
+                         png(segmentationImage(f), p + "_segmentation.png"));
       files.emplace_back(p + "_instances.png", png(instanceImage(f), p + "_instances.png"));
       files.emplace_back(p + "_boxes.png", png(boxesImage(f), p + "_boxes.png"));
       files.emplace_back(p + "_camera_info.yaml", cameraInfoYaml(c.name, req.intrinsics));
@@ -435,9 +439,9 @@ int main(int argc, char** argv) {
       scenario::writeFileAtomic(path, content);
       written.push_back(path);
     }
-    std::fprintf(stderr, "hameritt_render: %zu camera(s) at t = %s s (%s) -> %s [%s]\n", cams.size(),
-                 scenario::formatNumber(o.time).c_str(), pose_source.c_str(), o.out.c_str(),
-                 renderer.glRenderer().c_str());
+    std::fprintf(stderr, "hameritt_render: %zu camera(s) at t = %s s (%s) -> %s [%s]\n",
+                 cams.size(), scenario::formatNumber(o.time).c_str(), pose_source.c_str(),
+                 o.out.c_str(), renderer.glRenderer().c_str());
     return 0;
   } catch (const ConfigError& e) {
     cleanup();

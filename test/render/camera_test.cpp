@@ -34,8 +34,10 @@ TEST(RenderCamera, IntrinsicsRejectBadSizesAndFieldsOfView) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message([] { intrinsicsFromHfov(0, 480, 90); }).find("width and height"), std::string::npos);
-  EXPECT_NE(message([] { intrinsicsFromHfov(640, -1, 90); }).find("width and height"), std::string::npos);
+  EXPECT_NE(message([] { intrinsicsFromHfov(0, 480, 90); }).find("width and height"),
+            std::string::npos);
+  EXPECT_NE(message([] { intrinsicsFromHfov(640, -1, 90); }).find("width and height"),
+            std::string::npos);
   EXPECT_NE(message([] { intrinsicsFromHfov(640, 480, 0); }).find("hfov_deg"), std::string::npos);
   EXPECT_NE(message([] { intrinsicsFromHfov(640, 480, 180); }).find("got 180"), std::string::npos);
   EXPECT_NE(message([] { intrinsicsFromHfov(640, 480, NAN); }).find("hfov_deg"), std::string::npos);

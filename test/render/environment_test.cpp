@@ -50,7 +50,8 @@ double meanLuminance(const FrameSet& f) {
 }
 
 double colourDistance(const FrameSet& a, std::size_t i, const double c[3]) {
-  return std::abs(a.rgb[3 * i] - c[0]) + std::abs(a.rgb[3 * i + 1] - c[1]) + std::abs(a.rgb[3 * i + 2] - c[2]);
+  return std::abs(a.rgb[3 * i] - c[0]) + std::abs(a.rgb[3 * i + 1] - c[1]) +
+         std::abs(a.rgb[3 * i + 2] - c[2]);
 }
 
 TEST(RenderEnvironment, ZeroIntensitiesAndEffectsOffGiveTheSameBytes) {
@@ -112,7 +113,8 @@ TEST(RenderEnvironment, FogPullsFarPixelsToTheFogColourAndLeavesNearOnesAlmostAl
   ASSERT_GT(far, 300);
   near_change /= near;
   far_change /= far;
-  EXPECT_LT(far_fog_dist / far, 0.25 * far_clear_dist / far) << "far pixels close to the fog colour";
+  EXPECT_LT(far_fog_dist / far, 0.25 * far_clear_dist / far)
+      << "far pixels close to the fog colour";
   EXPECT_LT(near_change, 0.5 * far_change) << "near pixels change much less than far ones";
 }
 
@@ -139,7 +141,8 @@ TEST(RenderEnvironment, SnowWhitensUpwardSurfaces) {
 
 TEST(RenderEnvironment, DuskIsDarkerThanNoonAndNightDarkerStill) {
   auto at = [](double hours) {
-    Renderer r(defaultWorld(), config([hours](scenario::SimConfig* c) { c->environment.time_of_day = hours; }));
+    Renderer r(defaultWorld(),
+               config([hours](scenario::SimConfig* c) { c->environment.time_of_day = hours; }));
     return meanLuminance(r.render(obliqueView()));
   };
   const double noon = at(12.0), dusk = at(18.3), night = at(23.0);
@@ -150,15 +153,18 @@ TEST(RenderEnvironment, DuskIsDarkerThanNoonAndNightDarkerStill) {
 
 TEST(RenderEnvironment, FoliageDensityScalesCanopiesAndZeroLeavesBareTrunks) {
   auto tree_stats = [](double foliage, std::size_t* triangles) {
-    Renderer r(defaultWorld(), config([foliage](scenario::SimConfig* c) { c->environment.foliage = foliage; }));
+    Renderer r(defaultWorld(),
+               config([foliage](scenario::SimConfig* c) { c->environment.foliage = foliage; }));
     RenderRequest req = obliqueView();
     req.world_T_optical = lookAt(Eigen::Vector3d(-250, 200, 80), Eigen::Vector3d(-250.5, 200.5, 0));
     *triangles = r.sceneTriangles(0).triangle_instance.size();
     const FrameSet f = r.render(req);
-    return std::count(f.semantic.begin(), f.semantic.end(), scenario::semanticId(scenario::EntityClass::kTree));
+    return std::count(f.semantic.begin(), f.semantic.end(),
+                      scenario::semanticId(scenario::EntityClass::kTree));
   };
   std::size_t t_full = 0, t_half = 0, t_bare = 0;
-  const auto full = tree_stats(1.0, &t_full), half = tree_stats(0.5, &t_half), bare = tree_stats(0.0, &t_bare);
+  const auto full = tree_stats(1.0, &t_full), half = tree_stats(0.5, &t_half),
+             bare = tree_stats(0.0, &t_bare);
   EXPECT_GT(full, 1000);
   EXPECT_LT(half, full * 8 / 10);
   EXPECT_LT(bare, half / 3) << "trunks only";
@@ -168,9 +174,9 @@ TEST(RenderEnvironment, FoliageDensityScalesCanopiesAndZeroLeavesBareTrunks) {
 
 TEST(RenderEnvironment, NoiseIsSeededByScenarioCameraAndFrame) {
   Renderer r(defaultWorld(), config([](scenario::SimConfig* c) {
-    c->perturbations.gaussian_noise_std = 0.04;
-    c->perturbations.salt_pepper_probability = 0.002;
-  }));
+               c->perturbations.gaussian_noise_std = 0.04;
+               c->perturbations.salt_pepper_probability = 0.002;
+             }));
   RenderRequest req = obliqueView();
   req.frame_index = 11;
   const FrameSet a = r.render(req);
@@ -185,10 +191,10 @@ TEST(RenderEnvironment, NoiseIsSeededByScenarioCameraAndFrame) {
   EXPECT_NE(a.rgb, d.rgb);
   // A different scenario seed, same everything else.
   Renderer other(defaultWorld(), config([](scenario::SimConfig* c) {
-    c->seed += 1;
-    c->perturbations.gaussian_noise_std = 0.04;
-    c->perturbations.salt_pepper_probability = 0.002;
-  }));
+                   c->seed += 1;
+                   c->perturbations.gaussian_noise_std = 0.04;
+                   c->perturbations.salt_pepper_probability = 0.002;
+                 }));
   req.camera_index = 0;
   EXPECT_NE(other.render(req).rgb, a.rgb);
 }
@@ -196,9 +202,9 @@ TEST(RenderEnvironment, NoiseIsSeededByScenarioCameraAndFrame) {
 TEST(RenderEnvironment, NoiseStatisticsMatchTheConfiguredStandardDeviation) {
   const double sigma = 0.05, salt = 0.01;
   Renderer noisy(defaultWorld(), config([&](scenario::SimConfig* c) {
-    c->perturbations.gaussian_noise_std = sigma;
-    c->perturbations.salt_pepper_probability = salt;
-  }));
+                   c->perturbations.gaussian_noise_std = sigma;
+                   c->perturbations.salt_pepper_probability = salt;
+                 }));
   RenderRequest req = obliqueView();
   req.noise = false;
   const FrameSet clean = noisy.render(req);
@@ -208,8 +214,9 @@ TEST(RenderEnvironment, NoiseStatisticsMatchTheConfiguredStandardDeviation) {
   double sum = 0, sum2 = 0;
   int n = 0, salted = 0;
   for (std::size_t i = 0; i < f.depth.size(); ++i) {
-    const bool extreme = (f.rgb[3 * i] == 0 && f.rgb[3 * i + 1] == 0 && f.rgb[3 * i + 2] == 0) ||
-                         (f.rgb[3 * i] == 255 && f.rgb[3 * i + 1] == 255 && f.rgb[3 * i + 2] == 255);
+    const bool extreme =
+        (f.rgb[3 * i] == 0 && f.rgb[3 * i + 1] == 0 && f.rgb[3 * i + 2] == 0) ||
+        (f.rgb[3 * i] == 255 && f.rgb[3 * i + 1] == 255 && f.rgb[3 * i + 2] == 255);
     if (extreme) {
       ++salted;
       continue;
@@ -232,7 +239,8 @@ TEST(RenderEnvironment, NoiseStatisticsMatchTheConfiguredStandardDeviation) {
 }
 
 TEST(RenderEnvironment, MotionBlurSmoothsAlongItsDirectionOnly) {
-  Renderer r(defaultWorld(), config([](scenario::SimConfig* c) { c->perturbations.motion_blur_px = 6.0; }));
+  Renderer r(defaultWorld(),
+             config([](scenario::SimConfig* c) { c->perturbations.motion_blur_px = 6.0; }));
   RenderRequest req = obliqueView();
   // Straight down with the image axes along the street grid (east right, north up).
   req.world_T_optical = lookAt(Eigen::Vector3d(-250, 200, 60), Eigen::Vector3d(-250, 200.01, 0));
@@ -265,9 +273,9 @@ TEST(RenderEnvironment, MotionBlurSmoothsAlongItsDirectionOnly) {
 
 TEST(RenderEnvironment, RainAndSnowParticlesAreSeededAndOnlyTouchTheColour) {
   Renderer r(defaultWorld(), config([](scenario::SimConfig* c) {
-    c->environment.rain = 0.8;
-    c->environment.snow = 0.5;
-  }));
+               c->environment.rain = 0.8;
+               c->environment.snow = 0.5;
+             }));
   RenderRequest req = obliqueView();
   req.frame_index = 4;
   const FrameSet a = r.render(req);
@@ -286,7 +294,8 @@ TEST(RenderEnvironment, RainAndSnowParticlesAreSeededAndOnlyTouchTheColour) {
     const int w = f.intrinsics.width;
     for (std::size_t i = 1; i + 1 < f.depth.size(); ++i) {
       if (static_cast<int>(i % w) == 0 || static_cast<int>(i % w) == w - 1) continue;
-      if (!std::isinf(f.depth[i - 1]) || !std::isinf(f.depth[i]) || !std::isinf(f.depth[i + 1])) continue;
+      if (!std::isinf(f.depth[i - 1]) || !std::isinf(f.depth[i]) || !std::isinf(f.depth[i + 1]))
+        continue;
       if (luminance(f, i) > 0.5 * (luminance(f, i - 1) + luminance(f, i + 1)) + 12) ++n;
     }
     return n;

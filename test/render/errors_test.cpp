@@ -57,7 +57,8 @@ RendererOptions in(const std::string& dir) {
 }
 
 TEST(RenderErrors, MissingModelsDirectoryNamesTheFile) {
-  const std::string e = errorOf([] { Renderer r(defaultWorld(), defaultSimConfig(), in("/nonexistent/models")); });
+  const std::string e =
+      errorOf([] { Renderer r(defaultWorld(), defaultSimConfig(), in("/nonexistent/models")); });
   EXPECT_NE(e.find("/nonexistent/models/meshes/house_1.obj"), std::string::npos) << e;
   EXPECT_NE(e.find("missing"), std::string::npos) << e;
 }
@@ -68,7 +69,8 @@ TEST(RenderErrors, MalformedOrMisfitModelsNameTheFile) {
   std::string e = errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), in(m.dir())); });
   EXPECT_NE(e.find(m.mesh("car_suv.obj")), std::string::npos) << e;
   // Faces that index vertices that do not exist.
-  m.write("car_suv.obj", "mtllib car_suv.mtl\nv 0 0 0\nv 1 0 0\nvn 0 0 1\nusemtl paint\nf 1//1 2//1 9//1\n");
+  m.write("car_suv.obj",
+          "mtllib car_suv.mtl\nv 0 0 0\nv 1 0 0\nvn 0 0 1\nusemtl paint\nf 1//1 2//1 9//1\n");
   e = errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), in(m.dir())); });
   EXPECT_NE(e.find(m.mesh("car_suv.obj")), std::string::npos) << e;
   // A material that the .mtl does not define.
@@ -77,10 +79,12 @@ TEST(RenderErrors, MalformedOrMisfitModelsNameTheFile) {
   EXPECT_NE(e.find(m.mesh("car_suv.obj")), std::string::npos) << e;
   EXPECT_NE(e.find("material"), std::string::npos) << e;
   // A class mesh outside the unit box.
-  m.write("car_suv.obj", "mtllib car_suv.mtl\nv -0.5 -0.5 0\nv 3.5 -0.5 0\nv 0 0.5 1\nvn 0 0 1\n"
-                         "usemtl paint\nf 1//1 2//1 3//1\n");
+  m.write("car_suv.obj",
+          "mtllib car_suv.mtl\nv -0.5 -0.5 0\nv 3.5 -0.5 0\nv 0 0.5 1\nvn 0 0 1\n"
+          "usemtl paint\nf 1//1 2//1 3//1\n");
   e = errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), in(m.dir())); });
-  EXPECT_NE(e.find(m.mesh("car_suv.obj") + ": model does not fit the unit box"), std::string::npos) << e;
+  EXPECT_NE(e.find(m.mesh("car_suv.obj") + ": model does not fit the unit box"), std::string::npos)
+      << e;
   // An empty file.
   m.write("pedestrian.obj", "");
   fs::copy_file(defaultModelsDir() + "/meshes/car_suv.obj", m.mesh("car_suv.obj"),
@@ -112,26 +116,38 @@ TEST(RenderErrors, BadRequestsNameTheField) {
     edit(&q);
     return errorOf([&] { r.render(q); });
   };
-  EXPECT_NE(fails([](RenderRequest* q) { q->intrinsics.width = 0; }).find("RenderRequest.intrinsics"), std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->intrinsics.fx = 0; }).find("intrinsics.fx"), std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->intrinsics.fy = NAN; }).find("intrinsics.fy"), std::string::npos);
+  EXPECT_NE(
+      fails([](RenderRequest* q) { q->intrinsics.width = 0; }).find("RenderRequest.intrinsics"),
+      std::string::npos);
+  EXPECT_NE(fails([](RenderRequest* q) { q->intrinsics.fx = 0; }).find("intrinsics.fx"),
+            std::string::npos);
+  EXPECT_NE(fails([](RenderRequest* q) { q->intrinsics.fy = NAN; }).find("intrinsics.fy"),
+            std::string::npos);
   EXPECT_NE(fails([](RenderRequest* q) { q->near_clip = 0; }).find("near_clip"), std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->far_clip = 0.05; }).find("far_clip"), std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->time = INFINITY; }).find("RenderRequest.time"), std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->world_T_optical.translation().x() = NAN; }).find("world_T_optical"),
+  EXPECT_NE(fails([](RenderRequest* q) { q->far_clip = 0.05; }).find("far_clip"),
             std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->hidden_entities = {"car_706", "boat_1"}; })
-                .find("hidden_entities: unknown entity 'boat_1'"),
+  EXPECT_NE(fails([](RenderRequest* q) { q->time = INFINITY; }).find("RenderRequest.time"),
             std::string::npos);
-  EXPECT_NE(fails([](RenderRequest* q) { q->intrinsics.width = 1 << 20; }).find("exceeds the GL limit"),
+  EXPECT_NE(fails([](RenderRequest* q) {
+              q->world_T_optical.translation().x() = NAN;
+            }).find("world_T_optical"),
             std::string::npos);
+  EXPECT_NE(fails([](RenderRequest* q) {
+              q->hidden_entities = {"car_706", "boat_1"};
+            }).find("hidden_entities: unknown entity 'boat_1'"),
+            std::string::npos);
+  EXPECT_NE(
+      fails([](RenderRequest* q) { q->intrinsics.width = 1 << 20; }).find("exceeds the GL limit"),
+      std::string::npos);
   EXPECT_NO_THROW(r.render(ok));
 }
 
 TEST(RenderErrors, BackendIsValidated) {
   RendererOptions o;
   o.backend = "vulkan";
-  EXPECT_NE(errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), o); }).find("backend: expected auto, surfaceless or device"),
+  EXPECT_NE(errorOf([&] {
+              Renderer r(defaultWorld(), defaultSimConfig(), o);
+            }).find("backend: expected auto, surfaceless or device"),
             std::string::npos);
   ::setenv("HAMERITT_EGL_BACKEND", "bogus", 1);
   const std::string e = errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig()); });

@@ -59,7 +59,8 @@ std::vector<RenderRequest> depthViews() {
   low.world_T_optical = lookAt(c + Eigen::Vector3d(45.0, 6.0, 7.0), c);
   views.push_back(low);
   views.push_back(clean(cameraRequest(cfg.uav.cameras[1], uav, kTime)));
-  EXPECT_NEAR(cfg.uav.cameras[1].mount_rpy.y(), 90.0, 1e-9) << "the down camera looks straight down";
+  EXPECT_NEAR(cfg.uav.cameras[1].mount_rpy.y(), 90.0, 1e-9)
+      << "the down camera looks straight down";
   return views;
 }
 
@@ -78,7 +79,8 @@ TEST(RenderGroundTruth, DepthAndInstanceEqualRayCastsThroughPixelCentres) {
         const auto hit = caster().cast(eye, eye + req.far_clip * ray);
         if (!hit.hit) {
           ++misses;
-          if (!std::isinf(f.depth[i]) || f.instance[i] != 0 || f.semantic[i] != kSkySemantic) ++sky_bad;
+          if (!std::isinf(f.depth[i]) || f.instance[i] != 0 || f.semantic[i] != kSkySemantic)
+            ++sky_bad;
           continue;
         }
         ++hits;
@@ -94,8 +96,8 @@ TEST(RenderGroundTruth, DepthAndInstanceEqualRayCastsThroughPixelCentres) {
       }
     }
   }
-  std::printf("%d pixels: %d hits, %d sky; depth off: %d, instance off: %d, sky off: %d\n",
-              samples, hits, misses, depth_bad, instance_bad, sky_bad);
+  std::printf("%d pixels: %d hits, %d sky; depth off: %d, instance off: %d, sky off: %d\n", samples,
+              hits, misses, depth_bad, instance_bad, sky_bad);
   EXPECT_GE(hits, 200);
   EXPECT_GE(misses, 20);  // the oblique views see the sky
   // A pixel centre within float rounding of a silhouette edge can fall on either side in the
@@ -107,7 +109,8 @@ TEST(RenderGroundTruth, DepthAndInstanceEqualRayCastsThroughPixelCentres) {
 
 // Centroids of visible, camera-facing triangles of an instance (well inside the triangle, so
 // not on an edge), with the optical z of each.
-std::vector<Eigen::Vector3d> visibleSurfacePoints(const RenderRequest& req, int instance, std::size_t max) {
+std::vector<Eigen::Vector3d> visibleSurfacePoints(const RenderRequest& req, int instance,
+                                                  std::size_t max) {
   const SceneTriangles& t = caster().triangles();
   const Eigen::Vector3d eye = req.world_T_optical.translation();
   std::vector<Eigen::Vector3d> out;
@@ -147,8 +150,10 @@ TEST(RenderGroundTruth, ProjectedSurfacePointsLandOnTheirPixels) {
     for (const Eigen::Vector3d& p : visibleSurfacePoints(req, id, 40)) {
       Eigen::Vector2d uv;
       ASSERT_TRUE(projectPoint(req.intrinsics, req.world_T_optical, p, &uv));
-      const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
-      if (u < 1 || v < 1 || u >= req.intrinsics.width - 1 || v >= req.intrinsics.height - 1) continue;
+      const int u = static_cast<int>(std::lround(uv.x())),
+                v = static_cast<int>(std::lround(uv.y()));
+      if (u < 1 || v < 1 || u >= req.intrinsics.width - 1 || v >= req.intrinsics.height - 1)
+        continue;
       ++points;
       const double z = (req.world_T_optical.inverse() * p).z();
       bool found = false;
@@ -169,7 +174,8 @@ TEST(RenderGroundTruth, BoxesContainExactlyTheirInstancesPixels) {
   Renderer& r = defaultRenderer();
   const auto& cfg = defaultSimConfig();
   const auto p = scenario::sampleTrajectory(cfg.uav.perception_path->trajectory, kTime);
-  const FrameSet f = r.render(cameraRequest(cfg.uav.cameras[0], uavPose(p.x, p.y, p.z, p.yaw), kTime));
+  const FrameSet f =
+      r.render(cameraRequest(cfg.uav.cameras[0], uavPose(p.x, p.y, p.z, p.yaw), kTime));
   ASSERT_GE(f.boxes.size(), 5u);
   struct Count {
     int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1, n = 0;
@@ -242,7 +248,8 @@ TEST(RenderGroundTruth, UnoccludedCarIsFullyVisibleAndTotalEqualsItsCoverage) {
   RenderRequest req = clean(RenderRequest{});
   req.intrinsics = intrinsicsFromHfov(320, 240, 60.0);
   req.time = kTime;
-  req.world_T_optical = lookAt(target.box.center + Eigen::Vector3d(0.5, 0.3, 25.0), target.box.center);
+  req.world_T_optical =
+      lookAt(target.box.center + Eigen::Vector3d(0.5, 0.3, 25.0), target.box.center);
   const int id = r.instanceOf("car_706");
   const FrameSet f = r.render(req);
   const BoundingBox* b = boxOf(f, id);
@@ -302,7 +309,8 @@ TEST(RenderGroundTruth, HouseBetweenCameraAndCarHidesItFullyOrPartly) {
         const FrameSet f = r.render(req);
         const BoundingBox* b = boxOf(f, id);
         const int visible = static_cast<int>(std::count(f.instance.begin(), f.instance.end(), id));
-        if (visible != 0 && (b == nullptr || visible > b->total_pixels - 10 || partial_done)) continue;
+        if (visible != 0 && (b == nullptr || visible > b->total_pixels - 10 || partial_done))
+          continue;
         const int alone = aloneCount(req, id);
         if (!full_done && visible == 0) {
           EXPECT_EQ(b, nullptr) << car.id << " behind " << house.id << " has no box";
@@ -320,7 +328,8 @@ TEST(RenderGroundTruth, HouseBetweenCameraAndCarHidesItFullyOrPartly) {
     }
   }
   std::printf("%d car-house pairs, %d views tried\n", tried, renders);
-  EXPECT_TRUE(full_done) << "no fully hidden configuration found in " << tried << " car-house pairs";
+  EXPECT_TRUE(full_done) << "no fully hidden configuration found in " << tried
+                         << " car-house pairs";
   EXPECT_TRUE(partial_done) << "no partly hidden configuration found in " << tried << " pairs";
 }
 
@@ -342,8 +351,10 @@ TEST(RenderGroundTruth, MoversAreDrawnAtTheirTrajectoryPoseAtTheRequestTime) {
     ASSERT_TRUE(projectPoint(req.intrinsics, req.world_T_optical, c, &uv));
     const std::size_t i = static_cast<std::size_t>(std::lround(uv.y())) * 320 + std::lround(uv.x());
     EXPECT_EQ(f.instance[i], id) << "t = " << t;
-    if (t == 5.0) first = Eigen::Vector2d(p.x, p.y);
-    else EXPECT_GT((Eigen::Vector2d(p.x, p.y) - first).norm(), 20.0) << "it moved";
+    if (t == 5.0)
+      first = Eigen::Vector2d(p.x, p.y);
+    else
+      EXPECT_GT((Eigen::Vector2d(p.x, p.y) - first).norm(), 20.0) << "it moved";
   }
 }
 
@@ -390,7 +401,9 @@ TEST(RenderGroundTruth, BatchOfRequestsEqualsOneRenderEach) {
   for (std::size_t i = 0; i < reqs.size(); ++i) {
     const FrameSet one = r.render(reqs[i]);
     EXPECT_EQ(batch[i].rgb, one.rgb) << i;
-    EXPECT_EQ(std::memcmp(batch[i].depth.data(), one.depth.data(), one.depth.size() * sizeof(float)), 0) << i;
+    EXPECT_EQ(
+        std::memcmp(batch[i].depth.data(), one.depth.data(), one.depth.size() * sizeof(float)), 0)
+        << i;
     EXPECT_EQ(batch[i].instance, one.instance) << i;
     ASSERT_EQ(batch[i].boxes.size(), one.boxes.size()) << i;
     for (std::size_t k = 0; k < one.boxes.size(); ++k) {
@@ -400,7 +413,31 @@ TEST(RenderGroundTruth, BatchOfRequestsEqualsOneRenderEach) {
     }
     EXPECT_EQ(batch[i].time, reqs[i].time);
   }
-  EXPECT_EQ(std::count(batch[1].instance.begin(), batch[1].instance.end(), r.instanceOf("car_706")), 0);
+  EXPECT_EQ(std::count(batch[1].instance.begin(), batch[1].instance.end(), r.instanceOf("car_706")),
+            0);
+}
+
+TEST(RenderGroundTruth, UavModelIsDrawnOnlyWhenAsked) {
+  Renderer& r = defaultRenderer();
+  RenderRequest req = clean(RenderRequest{});
+  req.intrinsics = intrinsicsFromHfov(160, 120, 60.0);
+  const Eigen::Isometry3d uav = uavPose(-271.0, 249.0, 30.0, 0.4);
+  req.world_T_uav = uav;
+  req.world_T_optical = lookAt(uav.translation() + Eigen::Vector3d(1.2, -0.9, 0.6), uav.translation());
+  const FrameSet without = r.render(req);
+  req.draw_uav = true;
+  const FrameSet with = r.render(req);
+  const int id = r.instanceCount() - 1;
+  EXPECT_EQ(r.instanceEntityId(id), "uav");
+  EXPECT_EQ(std::count(without.semantic.begin(), without.semantic.end(), kUavSemantic), 0);
+  const auto n = std::count(with.semantic.begin(), with.semantic.end(), kUavSemantic);
+  EXPECT_GT(n, 100) << "the UAV fills part of a close view";
+  EXPECT_EQ(std::count(with.instance.begin(), with.instance.end(), id), n);
+  Eigen::Vector2d uv;
+  ASSERT_TRUE(projectPoint(req.intrinsics, req.world_T_optical, uav.translation(), &uv));
+  const std::size_t centre = static_cast<std::size_t>(std::lround(uv.y())) * 160 + std::lround(uv.x());
+  EXPECT_EQ(with.instance[centre], id);
+  EXPECT_LT(with.depth[centre], 1.6f);
 }
 
 TEST(RenderGroundTruth, SceneTrianglesCarryValidInstances) {

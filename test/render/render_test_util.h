@@ -62,8 +62,8 @@ inline Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3
 }
 
 // A request of a payload camera of the default scenario on the UAV at world_T_base.
-inline RenderRequest cameraRequest(const scenario::CameraSpec& cam, const Eigen::Isometry3d& world_T_base,
-                                   double time) {
+inline RenderRequest cameraRequest(const scenario::CameraSpec& cam,
+                                   const Eigen::Isometry3d& world_T_base, double time) {
   RenderRequest r;
   r.intrinsics = intrinsicsFromHfov(cam.width, cam.height, cam.hfov_deg);
   r.world_T_optical = opticalPose(world_T_base, cam.mount_xyz, cam.mount_rpy * (M_PI / 180.0));
@@ -100,7 +100,8 @@ class SceneRayCaster {
   // renderer).
   Hit cast(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
     struct Callback : btTriangleRaycastCallback {
-      Callback(const btVector3& f, const btVector3& t) : btTriangleRaycastCallback(f, t, kF_FilterBackfaces) {}
+      Callback(const btVector3& f, const btVector3& t)
+          : btTriangleRaycastCallback(f, t, kF_FilterBackfaces) {}
       btScalar reportHit(const btVector3&, btScalar fraction, int, int triangle) override {
         if (fraction < best) {
           best = fraction;
@@ -137,8 +138,7 @@ class SceneRayCaster {
 // z component is 1.
 inline Eigen::Vector3d pixelRay(const RenderRequest& r, double u, double v) {
   const Intrinsics& k = r.intrinsics;
-  return r.world_T_optical.linear() *
-         Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+  return r.world_T_optical.linear() * Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
 }
 
 }  // namespace hameritt::render::testing

@@ -2,9 +2,10 @@
 // The in-house off-screen renderer: OpenGL 4.5 core over EGL, headless (Mesa's surfaceless
 // platform with llvmpipe on a CPU-only machine, the EGL device platform on an NVIDIA GPU). One
 // geometry pass writes lit colour, metric depth along the optical axis and packed semantic +
-// instance labels into a multi-target framebuffer; a post pass adds weather particles and the
-// seeded camera noise to the colour only. Labels and depth are exact ground truth of the drawn
-// geometry; bounding boxes come from the instance mask. ROS-free.
+// instance labels into a multi-target framebuffer; a particle pass adds rain and snow, and after
+// the read-back the CPU adds motion blur and the seeded camera noise, to the colour only. Labels
+// and depth are exact ground truth of the drawn geometry; bounding boxes come from the instance
+// mask. ROS-free.
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
@@ -115,14 +116,14 @@ struct RendererOptions {
 // What the last render() call did and where its time went (milliseconds of wall time; summed
 // over the requests of a batch).
 struct RenderStats {
-  double cull_upload_ms = 0;  // frustum culling, instance upload
-  double draw_ms = 0;         // geometry pass (with stage_timing: until the GL has finished it)
-  double post_ms = 0;         // weather particles, blur, noise
-  double readback_ms = 0;     // colour, depth and labels read back and split
-  double boxes_ms = 0;        // boxes from the instance mask, occlusion queries
-  std::size_t instances = 0;  // instances drawn in the geometry pass
-  std::size_t triangles = 0;  // triangles submitted to the geometry pass
-  std::size_t draw_calls = 0; // all passes
+  double cull_upload_ms = 0;   // frustum culling, instance upload
+  double draw_ms = 0;          // geometry pass (with stage_timing: until the GL has finished it)
+  double post_ms = 0;          // weather particles, motion blur, noise
+  double readback_ms = 0;      // colour, depth and labels read back and split
+  double boxes_ms = 0;         // boxes: entities drawn alone and their pixels counted
+  std::size_t instances = 0;   // instances drawn in the geometry pass
+  std::size_t triangles = 0;   // triangles submitted to the geometry pass
+  std::size_t draw_calls = 0;  // all passes
 };
 
 // World triangles for ray-cast checks (what the renderer draws, in world coordinates).
