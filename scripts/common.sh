@@ -18,11 +18,13 @@ HAMERITT_PACKAGES=(
   rosbash python3-roslaunch python3-rostest python3-rosbag ros-environment
   libgtest-dev googletest
   libnav-msgs-dev libsensor-msgs-dev libros-rosgraph-msgs-dev libtf2-dev libtf2-ros-dev
-  libvisualization-msgs-dev
+  libvisualization-msgs-dev libmessage-filters-dev libtopic-tools-dev
   libeigen3-dev nlohmann-json3-dev libopencv-dev
   libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev libompl-dev
   python3-jsonschema python3-rospy python3-nav-msgs python3-rosgraph-msgs
   python3-geometry-msgs python3-std-msgs python3-actionlib-msgs
+  # rostopic and friends on the cameras' messages, and the MarkerArray for RViz users.
+  python3-rostopic python3-sensor-msgs python3-visualization-msgs
   # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
   # assimp for the meshes.
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
