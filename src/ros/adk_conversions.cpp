@@ -29,15 +29,6 @@ std::vector<geometry_msgs::Point> points(const std::vector<geometry::Vec2>& v, d
   return out;
 }
 
-hameritt::TimeWindow toMsg(const geometry::TimeWindow& w) {
-  hameritt::TimeWindow m;
-  m.has_net = w.net.has_value();
-  m.net = w.net.value_or(0.0);
-  m.has_nlt = w.nlt.has_value();
-  m.nlt = w.nlt.value_or(0.0);
-  return m;
-}
-
 std_msgs::ColorRGBA color(float r, float g, float b, float a) {
   std_msgs::ColorRGBA c;
   c.r = r;
