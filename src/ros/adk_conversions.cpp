@@ -61,27 +61,11 @@ std::string windowText(const geometry::TimeWindow& w) {
   return s;
 }
 
-std::string attributeValue(const scenario::AttributeValue& v) {
-  if (const auto* s = std::get_if<std::string>(&v)) return *s;
-  return std::to_string(std::get<std::int64_t>(v));
-}
-
 double yawOf(const geometry_msgs::Quaternion& q) {
   return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
 }
 
 }  // namespace
-
-std::vector<hameritt::KeyValue> toKeyValues(const scenario::Attributes& a) {
-  std::vector<hameritt::KeyValue> out;
-  for (const auto& [k, v] : a.items) {
-    hameritt::KeyValue kv;
-    kv.key = k;
-    kv.value = attributeValue(v);
-    out.push_back(kv);
-  }
-  return out;
-}
 
 hameritt::Mission toMsg(const scenario::Mission& m, const ros::Time& stamp) {
   // One conversion for the ADK and the clients (mission_conversions.cpp); the ADK stamps it.

@@ -72,6 +72,18 @@ scenario::AttributeValue attributeValue(const std::string& s) {
 
 }  // namespace
 
+std::vector<hameritt::KeyValue> toKeyValues(const scenario::Attributes& a) {
+  std::vector<hameritt::KeyValue> out;
+  out.reserve(a.items.size());
+  for (const auto& [k, v] : a.items) {
+    hameritt::KeyValue kv;
+    kv.key = k;
+    kv.value = attributeString(v);
+    out.push_back(std::move(kv));
+  }
+  return out;
+}
+
 hameritt::Mission toMsg(const scenario::Mission& mission) {
   hameritt::Mission m;
   m.header.frame_id = "map";
@@ -144,12 +156,7 @@ hameritt::Mission toMsg(const scenario::Mission& mission) {
     x.eventually = r.eventually;
     x.related_id = r.related_id;
     x.related_class = r.related_class;
-    for (const auto& [k, v] : r.related_attributes.items) {
-      hameritt::KeyValue kv;
-      kv.key = k;
-      kv.value = attributeString(v);
-      x.related_attributes.push_back(kv);
-    }
+    x.related_attributes = toKeyValues(r.related_attributes);
     x.distance = r.distance;
     x.bearing_deg = r.bearing_deg;
     x.dz = r.dz;

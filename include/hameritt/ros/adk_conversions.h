@@ -20,6 +20,7 @@
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/adk/detection_scoring.h"
 #include "hameritt/adk/metrics.h"
+#include "hameritt/ros/mission_conversions.h"
 #include "hameritt/scenario/scenario.h"
 
 namespace hameritt::ros_wrappers {
@@ -34,9 +35,6 @@ hameritt::Mission toMsg(const scenario::Mission& m, const ros::Time& stamp);
 // altitude bound is drawn at 0 m (below) or `open_top` m (above).
 visualization_msgs::MarkerArray missionMarkers(const scenario::Mission& m, double open_top,
                                                const ros::Time& stamp);
-
-// Attributes as key/value strings (integers in decimal).
-std::vector<hameritt::KeyValue> toKeyValues(const scenario::Attributes& a);
 
 hameritt::KozViolation toMsg(const adk::Violation& v);
 hameritt::ConstraintStatus toMsg(const adk::ConstraintMonitor& monitor, const ros::Time& stamp);
