@@ -1,10 +1,13 @@
 #include "hameritt/ros/client_conversions.h"
 
+#include <ros/console.h>
+
 #include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "hameritt/ros/mission_conversions.h"
 #include "hameritt/scenario/error.h"
 
 namespace hameritt::ros_wrappers {
@@ -120,6 +123,23 @@ std::optional<clients::MissionStateReading> readMissionState(const topic_tools::
   ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
   msg.write(out);
   return clients::readMissionState(msg.getMessageDefinition(), bytes.data(), bytes.size());
+}
+
+std::optional<scenario::Mission> acceptMission(const hameritt::Mission& msg,
+                                               const std::string& scenario_id, const char* client) {
+  scenario::Mission m;
+  try {
+    m = fromMsg(msg);
+  } catch (const std::exception& e) {
+    ROS_ERROR("%s: ignoring the mission: %s", client, e.what());
+    return std::nullopt;
+  }
+  if (m.scenario_id != scenario_id) {
+    ROS_ERROR("%s: ignoring mission %s: the sim_config is for %s", client, m.scenario_id.c_str(),
+              scenario_id.c_str());
+    return std::nullopt;
+  }
+  return m;
 }
 
 }  // namespace hameritt::ros_wrappers

@@ -158,20 +158,10 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
 }
 
 void ColorShapeDetectorRos::onMission(const hameritt::Mission::ConstPtr& msg) {
-  scenario::Mission m;
-  try {
-    m = fromMsg(*msg);
-  } catch (const std::exception& e) {
-    ROS_ERROR("%s: ignoring the mission: %s", kClientName, e.what());
-    return;
-  }
-  if (m.scenario_id != sim_.scenario_id) {
-    ROS_ERROR("%s: ignoring mission %s: the sim_config is for %s", kClientName,
-              m.scenario_id.c_str(), sim_.scenario_id.c_str());
-    return;
-  }
-  if (mission_ && mission_->scenario_id == m.scenario_id) return;
-  mission_ = std::move(m);
+  std::optional<scenario::Mission> m = acceptMission(*msg, sim_.scenario_id, kClientName);
+  if (!m) return;
+  if (mission_ && mission_->scenario_id == m->scenario_id) return;
+  mission_ = std::move(*m);
   filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get(), context_settings_);
   for (const auto& t : mission_->objective.targets) {
     if (!detector_->settings().colors.count(t.color)) {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "hameritt/Detection.h"
+#include "hameritt/Mission.h"
 #include "hameritt/PerceivedEntity.h"
 #include "hameritt/clients/color_detector.h"
 #include "hameritt/clients/context_filter.h"
@@ -37,6 +38,11 @@ hameritt::Detection makeDetection(const std::string& client,
                                   const scenario::TargetDescription& target,
                                   const geometry::Vec3& position, double confidence,
                                   const ros::Time& stamp);
+
+// The mission of a /mission message, or nullopt (logged as an error for `client`) when it does
+// not convert or is for another scenario than `scenario_id` (the client's sim_config).
+std::optional<scenario::Mission> acceptMission(const hameritt::Mission& msg,
+                                               const std::string& scenario_id, const char* client);
 
 // The mission state in an /adk/state message of any type (see clients::readMissionState).
 std::optional<clients::MissionStateReading> readMissionState(const topic_tools::ShapeShifter& msg);
