@@ -4,8 +4,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <ros/ros.h>
 
-#include <cmath>
-
+#include "hameritt/ros/conversions.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/sim_config_io.h"
 
@@ -39,17 +38,8 @@ int main(int argc, char** argv) {
   ros::Timer timer = nh.createTimer(ros::Duration(1.0 / rate_hz), [&](const ros::TimerEvent&) {
     const double t = ros::Time::now().toSec();
     if (t <= 0) return;  // no /clock yet
-    const auto p = hameritt::scenario::sampleTrajectory(path, t + lead);
-    geometry_msgs::PoseStamped m;
-    m.header.stamp = ros::Time::now();
-    m.header.frame_id = "map";
-    m.pose.position.x = p.x;
-    m.pose.position.y = p.y;
-    // The path starts on the ground: keep the setpoint at least at take-off height once moving.
-    m.pose.position.z = p.z;
-    m.pose.orientation.z = std::sin(0.5 * p.yaw);
-    m.pose.orientation.w = std::cos(0.5 * p.yaw);
-    pub.publish(m);
+    pub.publish(hameritt::ros_wrappers::toPoseMsg(hameritt::scenario::sampleTrajectory(path, t + lead),
+                                                  ros::Time::now()));
   });
   ros::spin();
   return 0;

@@ -116,21 +116,23 @@ geometry_msgs::TransformStamped toEntityTransform(const sim::EntityState& e, con
   return t;
 }
 
+geometry_msgs::PoseStamped toPoseMsg(const scenario::TrajectoryPoint& p, const ros::Time& stamp) {
+  geometry_msgs::PoseStamped ps;
+  ps.header.stamp = stamp;
+  ps.header.frame_id = kMapFrame;
+  ps.pose.position.x = p.x;
+  ps.pose.position.y = p.y;
+  ps.pose.position.z = p.z;
+  ps.pose.orientation = yawQuat(p.yaw);
+  return ps;
+}
+
 nav_msgs::Path toPathMsg(const scenario::Trajectory& path, const ros::Time& stamp) {
   nav_msgs::Path m;
   m.header.stamp = stamp;
   m.header.frame_id = kMapFrame;
   m.poses.reserve(path.size());
-  for (const auto& p : path) {
-    geometry_msgs::PoseStamped ps;
-    ps.header.stamp.fromSec(p.t);
-    ps.header.frame_id = kMapFrame;
-    ps.pose.position.x = p.x;
-    ps.pose.position.y = p.y;
-    ps.pose.position.z = p.z;
-    ps.pose.orientation = yawQuat(p.yaw);
-    m.poses.push_back(ps);
-  }
+  for (const auto& p : path) m.poses.push_back(toPoseMsg(p, ros::Time(p.t)));
   return m;
 }
 

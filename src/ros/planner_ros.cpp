@@ -245,15 +245,7 @@ void PlannerRos::onTick(const ros::TimerEvent&) {
   }
   for (const auto& k : zones) committed_.insert(k.id);
   const scenario::TrajectoryPoint sp = scenario::sampleTrajectory(path_, plan_t + lookahead_);
-  geometry_msgs::PoseStamped m;
-  m.header.stamp = ros::Time::now();
-  m.header.frame_id = kMapFrame;
-  m.pose.position.x = sp.x;
-  m.pose.position.y = sp.y;
-  m.pose.position.z = sp.z;
-  m.pose.orientation.z = std::sin(0.5 * sp.yaw);
-  m.pose.orientation.w = std::cos(0.5 * sp.yaw);
-  setpoint_pub_.publish(m);
+  setpoint_pub_.publish(toPoseMsg(sp, ros::Time::now()));
   publishProgress("following", "");
 }
 

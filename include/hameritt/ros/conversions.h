@@ -1,6 +1,7 @@
 #pragma once
 // Conversions between the simulator core's types and ROS messages, in one place.
 
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
@@ -41,6 +42,10 @@ hameritt::BoundingBoxArray toBoxesMsg(const std::vector<render::BoundingBox>& bo
 // A static transform (parent -> child) from an isometry.
 geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& t, const std::string& parent,
                                                const std::string& child, const ros::Time& stamp);
+
+// A trajectory pose (position and yaw) as a pose in map stamped `stamp`: what setpoints on
+// uav/cmd_pose and the poses of a timed path are.
+geometry_msgs::PoseStamped toPoseMsg(const scenario::TrajectoryPoint& p, const ros::Time& stamp);
 
 // A timed path as nav_msgs/Path in map: each pose stamped with its sim time, yaw-only.
 nav_msgs::Path toPathMsg(const scenario::Trajectory& path, const ros::Time& stamp);
