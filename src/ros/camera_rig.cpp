@@ -4,6 +4,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/image_encodings.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -29,13 +30,16 @@ struct CameraRig::Camera {
   ros::Publisher rgb_pub, depth_pub, seg_pub, inst_pub, info_pub, boxes_pub;
   ros::Publisher rgb_dec, depth_dec, seg_dec, inst_dec;
 
+  // Every topic of this camera (unadvertised ones are empty publishers with no subscribers).
+  std::array<const ros::Publisher*, 10> publishers() const {
+    return {&rgb_pub, &depth_pub, &seg_pub, &inst_pub, &info_pub,
+            &boxes_pub, &rgb_dec, &depth_dec, &seg_dec, &inst_dec};
+  }
   bool wanted() const {
-    return rgb_pub.getNumSubscribers() + depth_pub.getNumSubscribers() +
-               seg_pub.getNumSubscribers() + inst_pub.getNumSubscribers() +
-               info_pub.getNumSubscribers() + boxes_pub.getNumSubscribers() +
-               rgb_dec.getNumSubscribers() + depth_dec.getNumSubscribers() +
-               seg_dec.getNumSubscribers() + inst_dec.getNumSubscribers() >
-           0;
+    for (const ros::Publisher* p : publishers()) {
+      if (*p && p->getNumSubscribers() > 0) return true;
+    }
+    return false;
   }
 };
 
@@ -150,8 +154,7 @@ std::uint64_t CameraRig::framesPublished() const {
 
 int CameraRig::subscribers(const std::string& topic) const {
   for (const auto& cam : cameras_) {
-    for (const ros::Publisher* p : {&cam->rgb_pub, &cam->depth_pub, &cam->seg_pub, &cam->inst_pub, &cam->info_pub,
-                                    &cam->boxes_pub, &cam->rgb_dec, &cam->depth_dec, &cam->seg_dec, &cam->inst_dec}) {
+    for (const ros::Publisher* p : cam->publishers()) {
       if (*p && p->getTopic() == topic) return static_cast<int>(p->getNumSubscribers());
     }
   }
