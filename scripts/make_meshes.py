@@ -5,11 +5,15 @@
     /usr/bin/python3 scripts/make_meshes.py --check    # only check the files already there
     /usr/bin/python3 scripts/make_meshes.py --out DIR  # write somewhere else
 
-Standard library only and deterministic: running it twice gives byte-identical files.
+Standard library only and deterministic: running it twice gives byte-identical files. Besides
+the fine meshes it writes one coarse level of detail of the heavy class meshes (<name>_lod1.obj,
+from the same builders with lod=1).
 
 Conventions (the renderer depends on them; see models/README.md):
 * triangles only, every face "f v//vn" with its own (flat) normal, counter-clockwise seen from
-  outside; every part is a closed convex solid (boxes, prisms, cylinders, cones, icospheres).
+  outside; every part is a closed convex solid (boxes, prisms, cylinders, cones, icospheres),
+  except the decals of lod1 meshes (the outer face of a thin slab alone: a planar convex polygon).
+* lod1 meshes are normalized with their fine mesh's bounds: they lie within the unit box.
 * class meshes: x forward (heading), y left, z up, origin at the centre of the bottom face; the
   vertices span exactly [-0.5, 0.5] x [-0.5, 0.5] x [0, 1] (the renderer scales each axis by the
   entity's box). Each part is designed in metres at a typical real size, then normalized.
@@ -22,6 +26,7 @@ import os
 import sys
 
 FMT = "%.6f"
+LOD_FILE = "lod.json"
 UNIT_BOX = ((-0.5, 0.5), (-0.5, 0.5), (0.0, 1.0))
 
 # ----------------------------------------------------------------------------------------------
@@ -52,6 +57,21 @@ KD = {
     "camera": (0.05, 0.05, 0.06),
 }
 
+
+# Triangle budgets of the class meshes per level of detail (lod1: the coarse meshes; a mesh
+# name overrides its class). The pickup's open bed is three more boxes.
+LOD_BUDGET = {0: {"house": 400, "garage": 400, "tree": 400, "car": 400},
+              1: {"house": 150, "garage": 80, "tree": 150, "car": 200, "car_pickup": 230}}
+
+
+def budget(name, cls, lod):
+    return LOD_BUDGET[lod].get(name, LOD_BUDGET[lod][cls])
+
+
+# lod1 canopy icosahedra: vertex radius / icosphere radius. For a sphere, 1.0777 balances the
+# icosahedron's vertices outside the icosphere against its faces inside (deviation 0.078 r);
+# 1.083 minimises the two-sided deviation of this canopy (ellipsoids, overlapping).
+ICO_LOD_SCALE = 1.083
 
 # ----------------------------------------------------------------------------------------------
 # Small vector helpers
@@ -107,50 +127,54 @@ def rnd(v):
 
 
 # ----------------------------------------------------------------------------------------------
-# Mesh: a list of parts; each part is one closed convex solid of one material.
+# Mesh: a list of parts; each part is one closed convex solid of one material (or, lod > 0, a
+# decal: the outer face of a thin slab alone).
 # ----------------------------------------------------------------------------------------------
 class Mesh:
-    def __init__(self, name, budget, normalized=True, paint=(0.8, 0.8, 0.8)):
-        self.name = name
+    def __init__(self, name, budget, normalized=True, paint=(0.8, 0.8, 0.8), lod=0):
+        self.base = name           # the class mesh this is a level of detail of
+        self.lod = lod
+        self.name = name if lod == 0 else "%s_lod%d" % (name, lod)
         self.budget = budget
         self.normalized = normalized
         self.paint = paint
         self.kd_override = {}
         self.parts = []  # (material, [triangles (p0, p1, p2)])
+        self.decals = {}  # part index -> a point behind the decal (centre of the solid it replaces)
+        self.bounds_from = None  # lod > 0: the fine Mesh whose design bounds normalize this one
 
     # -- the one primitive everything is built from -------------------------------------------
     def solid(self, mat, polygons):
         """A closed convex solid given by its face polygons (any winding): every polygon is
         turned to face away from the solid's centre, then fan-triangulated."""
-        allp = [p for poly in polygons for p in poly]
-        c = centroid(allp)
+        c = centroid([p for poly in polygons for p in poly])
         tris = []
         for poly in polygons:
-            poly = list(poly)
-            pc = centroid(poly)
-            n = (0.0, 0.0, 0.0)
-            for i in range(1, len(poly) - 1):
-                n = add(n, cross(sub(poly[i], poly[0]), sub(poly[i + 1], poly[0])))
-            if dot(n, sub(pc, c)) < 0:
-                poly.reverse()
-            for i in range(1, len(poly) - 1):
-                tris.append((poly[0], poly[i], poly[i + 1]))
+            tris += outward_fan(poly, c)
         self.parts.append((mat, tris))
+
+    def decal(self, mat, polygons, k):
+        """Level of detail > 0: instead of the closed convex solid `polygons` (a thin slab on a
+        host face), only its outer face polygons[k], triangulated exactly as solid() would
+        (facing away from the solid's centre, counter-clockwise seen from outside). The one
+        exception to the closed-part convention: a planar convex polygon seen only from outside."""
+        c = centroid([p for poly in polygons for p in poly])
+        self.decals[len(self.parts)] = c
+        self.parts.append((mat, outward_fan(polygons[k], c)))
 
     def hexa(self, mat, bottom, top):
         """Hexahedron from two corresponding quads (planar faces expected)."""
-        faces = [list(bottom), list(top)]
-        for i in range(4):
-            j = (i + 1) % 4
-            faces.append([bottom[i], bottom[j], top[j], top[i]])
-        self.solid(mat, faces)
+        self.solid(mat, hexa_faces(bottom, top))
 
     def box(self, mat, lo, hi):
-        x0, y0, z0 = lo
-        x1, y1, z1 = hi
-        assert x1 > x0 and y1 > y0 and z1 > z0, (self.name, mat, lo, hi)
-        self.hexa(mat, [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0)],
-                  [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)])
+        self.solid(mat, box_faces(lo, hi, (self.name, mat)))
+
+    def box_or_decal(self, mat, lo, hi, face):
+        """A box, or (lod > 0) a decal on its face ("x"|"y"|"z", +1|-1)."""
+        if self.lod:
+            self.decal(mat, box_faces(lo, hi, (self.name, mat)), BOX_FACE[face])
+        else:
+            self.box(mat, lo, hi)
 
     def extrude(self, mat, poly, offset):
         """Prism: a convex planar polygon and its copy moved by offset."""
@@ -198,9 +222,10 @@ class Mesh:
 
     def ellipsoid(self, mat, c, radii):
         """Icosphere (one subdivision, 80 triangles) scaled to the radii; it has vertices on
-        the six axis points, so its extents are exactly c +- radii."""
+        the six axis points, so its extents are exactly c +- radii. Level of detail > 0: the
+        base icosahedron (20 triangles) scaled by ICO_LOD_SCALE (extents +-0.8507 * that)."""
         faces = []
-        for tri in icosphere1():
+        for tri in (icosahedron(ICO_LOD_SCALE) if self.lod else icosphere1()):
             faces.append([add(c, (p[0] * radii[0], p[1] * radii[1], p[2] * radii[2]))
                           for p in tri])
         self.solid(mat, faces)
@@ -211,14 +236,31 @@ class Mesh:
         n = unit(cross(sub(quad[1], quad[0]), sub(quad[3], quad[0])))
         if dot(n, sub(centroid(quad), host_centre)) < 0:
             n = mul(n, -1.0)
-        self.hexa(mat, [sub(p, mul(n, t_in)) for p in quad], [add(p, mul(n, t_out)) for p in quad])
+        faces = hexa_faces([sub(p, mul(n, t_in)) for p in quad],
+                           [add(p, mul(n, t_out)) for p in quad])
+        if self.lod:
+            self.decal(mat, faces, 1)  # the outer face
+        else:
+            self.solid(mat, faces)
 
     # -- output -----------------------------------------------------------------------------------
-    def finalize(self):
-        """Normalize (class meshes) and round; returns [(mat, [tri])] in final coordinates."""
+    def design_bounds(self):
+        """(lo, hi) of the design-metre vertices: the normalization of this mesh, or (lod > 0)
+        of its fine mesh, so that both overlap exactly when scaled by the same box."""
+        if self.bounds_from is not None:
+            return self.bounds_from.design_bounds()
         pts = [p for _, tris in self.parts for t in tris for p in t]
         lo = [min(p[i] for p in pts) for i in range(3)]
         hi = [max(p[i] for p in pts) for i in range(3)]
+        return lo, hi
+
+    def finalize(self):
+        """Normalize (class meshes) and round; returns [(mat, [tri])] in final coordinates."""
+        lo, hi = self.design_bounds()
+
+        def unrounded(p):
+            q = [(p[i] - lo[i]) / (hi[i] - lo[i]) for i in range(3)]
+            return (q[0] - 0.5, q[1] - 0.5, q[2])
 
         def tf(p):
             if not self.normalized:
@@ -228,6 +270,8 @@ class Mesh:
 
         self.design_size = tuple(hi[i] - lo[i] for i in range(3))
         self.final = [(mat, [tuple(tf(p) for p in t) for t in tris]) for mat, tris in self.parts]
+        self.final_decals = {k: unrounded(c) if self.normalized else c
+                             for k, c in self.decals.items()}
         return self.final
 
     def materials(self):
@@ -268,8 +312,12 @@ class Mesh:
         lines = ["# hameritt %s: generated by scripts/make_meshes.py, do not edit" % self.name,
                  "# %s, %d triangles, materials: %s" % (
                      "unit box [-0.5,0.5]x[-0.5,0.5]x[0,1], x forward, y left, z up"
-                     if self.normalized else "metres, base_link FLU frame", ntri, " ".join(mats)),
-                 "mtllib %s.mtl" % self.name, "o %s" % self.name]
+                     if self.normalized else "metres, base_link FLU frame", ntri, " ".join(mats))]
+        if self.lod:
+            lines.append("# level of detail %d of %s.obj: normalized with its design bounds (lies "
+                         "within the unit box), deviation bound in %s" % (self.lod, self.base,
+                                                                          LOD_FILE))
+        lines += ["mtllib %s.mtl" % self.name, "o %s" % self.name]
         lines += ["v " + k for k in vlist]
         lines += ["vn " + k for k in nlist]
         for m in mats:
@@ -290,6 +338,40 @@ class Mesh:
         return ntri
 
 
+def outward_fan(poly, c):
+    """Fan triangles of a convex planar polygon, turned to face away from the point c."""
+    poly = list(poly)
+    pc = centroid(poly)
+    n = (0.0, 0.0, 0.0)
+    for i in range(1, len(poly) - 1):
+        n = add(n, cross(sub(poly[i], poly[0]), sub(poly[i + 1], poly[0])))
+    if dot(n, sub(pc, c)) < 0:
+        poly.reverse()
+    return [(poly[0], poly[i], poly[i + 1]) for i in range(1, len(poly) - 1)]
+
+
+def hexa_faces(bottom, top):
+    """Face polygons of the hexahedron between two corresponding quads: bottom, top, then the
+    side faces (bottom[i], bottom[i + 1], ...)."""
+    faces = [list(bottom), list(top)]
+    for i in range(4):
+        j = (i + 1) % 4
+        faces.append([bottom[i], bottom[j], top[j], top[i]])
+    return faces
+
+
+# index in box_faces() of the face on each side
+BOX_FACE = {("z", -1): 0, ("z", 1): 1, ("y", -1): 2, ("x", 1): 3, ("y", 1): 4, ("x", -1): 5}
+
+
+def box_faces(lo, hi, what=None):
+    x0, y0, z0 = lo
+    x1, y1, z1 = hi
+    assert x1 > x0 and y1 > y0 and z1 > z0, (what, lo, hi)
+    return hexa_faces([(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0)],
+                      [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)])
+
+
 def basis(axis, u_hint, v_hint):
     """Orthonormal (u, v) perpendicular to axis, u close to u_hint (v to v_hint if given)."""
     w = unit(axis)
@@ -306,16 +388,28 @@ def basis(axis, u_hint, v_hint):
 _ICO = None
 
 
+def icosahedron0():
+    """The unit icosahedron (12 vertices on the unit sphere, 20 faces) icosphere1() refines."""
+    t = (1.0 + math.sqrt(5.0)) / 2.0
+    vs = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
+          (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    vs = [unit(v) for v in vs]
+    fs = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
+          (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
+          (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    return vs, fs
+
+
+def icosahedron(scale):
+    """The icosphere's base icosahedron, vertices at radius `scale` (20 triangles)."""
+    vs, fs = icosahedron0()
+    return [tuple(mul(vs[i], scale) for i in f) for f in fs]
+
+
 def icosphere1():
     global _ICO
     if _ICO is None:
-        t = (1.0 + math.sqrt(5.0)) / 2.0
-        vs = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t),
-              (0, -1, -t), (0, 1, -t), (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
-        vs = [unit(v) for v in vs]
-        fs = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4),
-              (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8),
-              (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+        vs, fs = icosahedron0()
         out = []
         for a, b, c in fs:
             pa, pb, pc = vs[a], vs[b], vs[c]
@@ -349,6 +443,7 @@ def sub_quad(A, B, C, D, u0, u1, v0, v1):
 # ----------------------------------------------------------------------------------------------
 def gable_building(m, along, half_across_wall, half_along_wall, half_across_roof, half_along_roof,
                    wall_h, height, roof_t, fascia=0.04, ridge_cap=True):
+    """lod > 0: the fascia boards become decals on their outer (eave) faces, no ridge cap."""
     def P(a, b, z):  # (across, along, z) -> (x, y, z)
         return (a, b, z) if along == "y" else (b, a, z)
 
@@ -375,8 +470,11 @@ def gable_building(m, along, half_across_wall, half_along_wall, half_across_roof
                   P(sg * ra, rb, top(ra) - drop), P(sg * slab_end, rb, top(slab_end) - drop)]
             ft = [P(sg * slab_end, -rb, top(slab_end)), P(sg * ra, -rb, top(ra)),
                   P(sg * ra, rb, top(ra)), P(sg * slab_end, rb, top(slab_end))]
-            m.hexa("trim", fb, ft)
-    if ridge_cap:
+            if m.lod:
+                m.decal("trim", hexa_faces(fb, ft), 3)  # the face at sg * ra
+            else:
+                m.hexa("trim", fb, ft)
+    if ridge_cap and not m.lod:
         w = 0.13
         cap = [(-w, height - s * w - 0.02), (w, height - s * w - 0.02), (w, height - s * w + 0.05),
                (0.0, height + 0.06), (-w, height - s * w + 0.05)]
@@ -386,17 +484,18 @@ def gable_building(m, along, half_across_wall, half_along_wall, half_across_roof
 
 def wall_slab(m, mat, face, center, w, z0, z1, proud, inset=0.03):
     """A window/door slab on a house wall. face: ('x', x_wall, sign) or ('y', y_wall, sign);
-    center: coordinate along the wall; w: width; z0..z1; proud: how far it stands out."""
+    center: coordinate along the wall; w: width; z0..z1; proud: how far it stands out.
+    lod > 0: a decal on the slab's outer face."""
     axis, wall, sg = face
     lo_o, hi_o = sorted((wall - sg * inset, wall + sg * proud))
     if axis == "x":
-        m.box(mat, (lo_o, center - w / 2, z0), (hi_o, center + w / 2, z1))
+        m.box_or_decal(mat, (lo_o, center - w / 2, z0), (hi_o, center + w / 2, z1), (axis, sg))
     else:
-        m.box(mat, (center - w / 2, lo_o, z0), (center + w / 2, hi_o, z1))
+        m.box_or_decal(mat, (center - w / 2, lo_o, z0), (center + w / 2, hi_o, z1), (axis, sg))
 
 
-def make_house(name, storeys):
-    m = Mesh(name, 400, paint=(0.86, 0.82, 0.70))
+def make_house(name, storeys, lod=0):
+    m = Mesh(name, budget(name, "house", lod), paint=(0.86, 0.82, 0.70), lod=lod)
     L, W = 10.0, 11.0
     H = 5.2 if storeys == 1 else 8.0
     wall_h = 2.9 if storeys == 1 else 5.6
@@ -438,13 +537,16 @@ def make_house(name, storeys):
     cx0, cx1, cy0, cy1 = 1.3, 2.0, 3.0, 3.8
     z_in = H - s * cx1 - 0.6
     top = H + 0.3
-    m.box("chimney", (cx0, cy0, z_in), (cx1, cy1, top))
-    m.box("chimney", (cx0 - 0.06, cy0 - 0.06, top), (cx1 + 0.06, cy1 + 0.06, top + 0.08))
+    if lod:  # chimney and cap as one box halfway between them (sides +0.03, top +0.04)
+        m.box("chimney", (cx0 - 0.03, cy0 - 0.03, z_in), (cx1 + 0.03, cy1 + 0.03, top + 0.04))
+    else:
+        m.box("chimney", (cx0, cy0, z_in), (cx1, cy1, top))
+        m.box("chimney", (cx0 - 0.06, cy0 - 0.06, top), (cx1 + 0.06, cy1 + 0.06, top + 0.08))
     return m
 
 
-def make_garage(name, doors):
-    m = Mesh(name, 400, paint=(0.86, 0.82, 0.70))
+def make_garage(name, doors, lod=0):
+    m = Mesh(name, budget(name, "garage", lod), paint=(0.86, 0.82, 0.70), lod=lod)
     L = 6.7
     W = 3.9 if doors == 1 else 6.6
     H, wall_h = 3.1, 2.6
@@ -457,6 +559,9 @@ def make_garage(name, doors):
     sh = (dz - gap * (nslab - 1)) / nslab
     for yc in centres:
         wall_slab(m, "trim", front, yc, door_w + 0.16, 0.0, dz + 0.1, 0.03)
+        if lod:  # one decal over the panels (the 3.5 cm gaps between them are sub-pixel)
+            wall_slab(m, "garage_door", front, yc, door_w, 0.01, dz, 0.07)
+            continue
         for k in range(nslab):
             z0 = k * (sh + gap)
             wall_slab(m, "garage_door", front, yc, door_w, z0 + (0.01 if k == 0 else 0.0),
@@ -514,17 +619,24 @@ def make_fence_chain_link():
 # ----------------------------------------------------------------------------------------------
 # Trees
 # ----------------------------------------------------------------------------------------------
-def make_tree_deciduous():
-    m = Mesh("tree_deciduous", 400)
+def make_tree_deciduous(lod=0):
+    m = Mesh("tree_deciduous", budget("tree_deciduous", "tree", lod), lod=lod)
     D, H = 5.0, 9.0
     r_tr = 0.06 * D / math.cos(math.pi / 8)   # octagon across flats = 12% of the width
-    m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), r_tr, r_tr * 0.8, 8, phase=math.pi / 8)
+    if lod:  # square trunk with the octagon's corner radius
+        m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), r_tr, r_tr * 0.8, 4, phase=math.pi / 4)
+    else:
+        m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), r_tr, r_tr * 0.8, 8, phase=math.pi / 8)
     for ang, z0, z1, reach in ((20.0, 2.3, 3.9, 1.3), (145.0, 2.7, 4.1, 1.2),
                                (260.0, 2.5, 3.7, 1.25)):
         a = math.radians(ang)
         d = (math.cos(a), math.sin(a), 0.0)
         tip = (reach * d[0], reach * d[1], z1)
-        m.beam("trunk", (0.0, 0.0, z0), tip, (-d[1], d[0], 0.0), 0.11, 0.11, 0.06, 0.06)
+        if lod:  # triangular, with the square beam's corner radius
+            m.frustum("trunk", (0.0, 0.0, z0), tip, 0.11 * math.sqrt(2.0), 0.06 * math.sqrt(2.0), 3,
+                      u_hint=(-d[1], d[0], 0.0))
+        else:
+            m.beam("trunk", (0.0, 0.0, z0), tip, (-d[1], d[0], 0.0), 0.11, 0.11, 0.06, 0.06)
     # canopy: 4 overlapping icospheres; their union spans exactly +-D/2 in x and y,
     # from 35% to 100% of the height
     h = D / 2
@@ -555,8 +667,8 @@ def make_tree_pine():
 # Cars. Body: a convex side profile (x, z) extruded across the width; cabin: a tapered
 # hexahedron; glass slabs on the cabin faces; 10-sided wheels touching z = 0.
 # ----------------------------------------------------------------------------------------------
-def make_car(name, spec):
-    m = Mesh(name, 400, paint=(0.72, 0.12, 0.10))
+def make_car(name, spec, lod=0):
+    m = Mesh(name, budget(name, "car", lod), paint=(0.72, 0.12, 0.10), lod=lod)
     L, W = spec["L"], spec["W"]
     hb = W / 2 - 0.05            # body half-width (mirrors reach W/2)
     body = spec["body"]
@@ -585,12 +697,14 @@ def make_car(name, spec):
         C, D = (xf1, sg * hw1, z1), (xr1, sg * hw1, z1)
         for u0, u1 in spec["side_windows"]:
             m.slab("glass", sub_quad(A, B, C, D, u0, u1, v0, v1), cc, tg_o, tg_i)
-    # wheels: 10-sided, a vertex at the bottom (z = 0)
+    # wheels: 10-sided (lod > 0: 6-sided, same radius: with a vertex at the bottom the hexagon's
+    # lower edges are 0.1286 r from the decagon's next vertex whatever its size), a vertex at the
+    # bottom (z = 0)
     r, tw = spec["wheel_r"], 0.23
     yo = W / 2 - 0.03
     for xw in spec["wheel_x"]:
         for sg in (-1.0, 1.0):
-            m.frustum("tire", (xw, sg * (yo - tw), r), (xw, sg * yo, r), r, r, 10,
+            m.frustum("tire", (xw, sg * (yo - tw), r), (xw, sg * yo, r), r, r, 6 if lod else 10,
                       u_hint=(1, 0, 0), v_hint=(0, 0, 1), phase=-math.pi / 2)
     # bumpers (they define the length), lights
     bz0, bz1 = spec["bumper_z"]
@@ -602,16 +716,18 @@ def make_car(name, spec):
     ty_in = spec.get("tail_y_in", 0.50)
     for sg in (-1.0, 1.0):
         y0, y1 = sorted((sg * 0.48, sg * (hb - 0.07)))
-        m.box("light_front", (xf_face - 0.06, y0, hz0), (xf_face + 0.015, y1, hz1))
+        m.box_or_decal("light_front", (xf_face - 0.06, y0, hz0), (xf_face + 0.015, y1, hz1),
+                       ("x", 1))
         y0, y1 = sorted((sg * ty_in, sg * (hb - 0.03)))
-        m.box("light_rear", (xr_face - 0.015, y0, tz0), (xr_face + 0.06, y1, tz1))
+        m.box_or_decal("light_rear", (xr_face - 0.015, y0, tz0), (xr_face + 0.06, y1, tz1),
+                       ("x", -1))
     # mirrors (they define the width)
     mx, mz = spec["mirror"]
     for sg in (-1.0, 1.0):
         y0, y1 = sorted((sg * (hw0 - 0.06), sg * W / 2))
         m.box("paint", (mx - 0.07, y0, mz), (mx + 0.07, y1, mz + 0.13))
-    for x0, x1, y0, y1, z0_, z1_, mat in spec.get("extras", []):
-        m.box(mat, (x0, y0, z0_), (x1, y1, z1_))
+    for x0, x1, y0, y1, z0_, z1_, mat in spec.get("extras", []) if not lod else []:
+        m.box(mat, (x0, y0, z0_), (x1, y1, z1_))  # (the SUV's roof rails: 4-5 cm, not in lod1)
     return m
 
 
@@ -748,27 +864,91 @@ def make_sentinel():
 
 
 # ----------------------------------------------------------------------------------------------
-def build_all():
-    meshes = [make_house("house_1", 1), make_house("house_2", 2),
-              make_garage("garage_1", 1), make_garage("garage_2", 2),
-              make_fence_wood(), make_fence_vinyl(), make_fence_chain_link(),
-              make_tree_deciduous(), make_tree_pine()]
+def build_lod(lod):
+    """The class meshes at a level of detail; lod 1: only those that have a coarse mesh."""
+    meshes = [make_house("house_1", 1, lod), make_house("house_2", 2, lod),
+              make_garage("garage_1", 1, lod), make_garage("garage_2", 2, lod)]
+    if lod == 0:
+        meshes += [make_fence_wood(), make_fence_vinyl(), make_fence_chain_link()]
+    meshes.append(make_tree_deciduous(lod))
+    if lod == 0:
+        meshes.append(make_tree_pine())
     for name, spec in CARS.items():
-        m = make_car(name, spec)
+        m = make_car(name, spec, lod)
         if name == "car_pickup":
             make_pickup_bed(m)
         meshes.append(m)
-    meshes += [make_pedestrian(), make_sentinel()]
+    if lod == 0:
+        meshes += [make_pedestrian(), make_sentinel()]
     return meshes
+
+
+def build_all():
+    """The fine meshes, then the lod1 meshes (each normalized with its fine mesh's bounds)."""
+    fine = build_lod(0)
+    by_name = {m.name: m for m in fine}
+    coarse = build_lod(1)
+    for m in coarse:
+        m.bounds_from = by_name[m.base]
+    return fine + coarse
 
 
 # ----------------------------------------------------------------------------------------------
 # Checks
 # ----------------------------------------------------------------------------------------------
+def check_decal(pi, mat, tris, behind):
+    """A decal part: one planar convex polygon (a fan of triangles), non-degenerate, wound
+    consistently, facing away from `behind` (the centre of the solid it stands for)."""
+    errs = []
+    what = "part %d (%s, decal)" % (pi, mat)
+    ns = []
+    for t in tris:
+        n = cross(sub(t[1], t[0]), sub(t[2], t[0]))
+        if norm(n) < 1e-12:
+            return [what + ": degenerate triangle %s" % (t,)]
+        ns.append(unit(n))
+    n0 = ns[0]
+    if any(dot(n, n0) < 0.9999 for n in ns):
+        errs.append(what + ": triangles not coplanar or not consistently wound")
+    if any(abs(dot(sub(p, tris[0][0]), n0)) > 1e-5 for t in tris for p in t):
+        errs.append(what + ": not planar")
+    if dot(n0, sub(centroid([p for t in tris for p in t]), behind)) <= 0:
+        errs.append(what + ": faces inward (towards the solid it stands for)")
+    edges = {}
+    for t in tris:
+        for i in range(3):
+            e = (t[i], t[(i + 1) % 3])
+            edges[e] = edges.get(e, 0) + 1
+    if any(k != 1 for k in edges.values()):
+        return errs + [what + ": an edge used twice in the same direction"]
+    nxt = {}
+    for (a, b) in edges:
+        if (b, a) not in edges:  # boundary edge
+            if a in nxt:
+                return errs + [what + ": boundary is not one simple loop"]
+            nxt[a] = b
+    loop = [next(iter(sorted(nxt)))] if nxt else []
+    while loop and nxt[loop[-1]] != loop[0] and len(loop) <= len(nxt):
+        loop.append(nxt[loop[-1]])
+    if not loop or len(loop) != len(nxt) or len(tris) != len(loop) - 2:
+        return errs + [what + ": not one polygon fan (boundary loop of %d edges, %d triangles)"
+                       % (len(nxt), len(tris))]
+    for i in range(len(loop)):
+        a, b, c = loop[i - 2], loop[i - 1], loop[i]
+        if dot(cross(sub(b, a), sub(c, b)), n0) < -1e-12:
+            errs.append(what + ": polygon not convex")
+            break
+    return errs
+
+
 def check_parts(m):
-    """In-memory checks on the final (normalized, rounded) parts: closed, outward, convex."""
+    """In-memory checks on the final (normalized, rounded) parts: closed, outward, convex;
+    decal parts (lod > 0): planar convex polygons facing outward."""
     errs = []
     for pi, (mat, tris) in enumerate(m.final):
+        if pi in m.final_decals:
+            errs += check_decal(pi, mat, tris, m.final_decals[pi])
+            continue
         pts = [p for t in tris for p in t]
         c = centroid(pts)
         edges = {}
@@ -790,8 +970,9 @@ def check_parts(m):
     return errs
 
 
-def check_file(path, budget, normalized):
-    """Checks on the written OBJ/MTL. Returns (errors, triangles, materials)."""
+def check_file(path, budget, normalized, within=False):
+    """Checks on the written OBJ/MTL (within: a class mesh's lod > 0, which must lie within the
+    unit box instead of spanning it). Returns (errors, triangles, materials, lo, hi, per_mat)."""
     errs = []
     d = os.path.dirname(path)
     vs, vns, mats_used, ntri, cur = [], [], [], 0, None
@@ -862,7 +1043,12 @@ def check_file(path, budget, normalized):
         errs.append("%d triangles > budget %d" % (ntri, budget))
     lo = tuple(min(v[i] for v in vs) for i in range(3))
     hi = tuple(max(v[i] for v in vs) for i in range(3))
-    if normalized:
+    if normalized and within:
+        for i in range(3):
+            if lo[i] < UNIT_BOX[i][0] or hi[i] > UNIT_BOX[i][1]:
+                errs.append("axis %s spans [%r, %r], not within the unit box"
+                            % ("xyz"[i], lo[i], hi[i]))
+    elif normalized:
         for i in range(3):
             if lo[i] != UNIT_BOX[i][0] or hi[i] != UNIT_BOX[i][1]:
                 errs.append("axis %s spans [%r, %r], not the unit box" % ("xyz"[i], lo[i], hi[i]))
@@ -874,18 +1060,28 @@ def run_checks(outdir, meshes=None):
     if names is None:
         names = sorted(f[:-4] for f in os.listdir(outdir) if f.endswith(".obj"))
     ok = True
-    print("%-18s %5s %6s  %-24s %s" % ("mesh", "tris", "budget", "extent (x y z)", "materials"))
+    print("%-19s %5s %6s  %-24s %s" % ("mesh", "tris", "budget", "extent (x y z)", "materials"))
     for name in names:
         normalized = name != "sentinel"
-        budget = 1500 if name == "sentinel" else (300 if name == "pedestrian" else 400)
+        lod1 = name.endswith("_lod1")
+        m = [mm for mm in meshes if mm.name == name][0] if meshes else None
+        if m is not None:
+            budget_ = m.budget
+        elif lod1:
+            base = name[:-5]
+            budget_ = budget(base, "house" if base.startswith("house") else "garage"
+                             if base.startswith("garage") else "car" if base.startswith("car")
+                             else "tree", 1)
+        else:
+            budget_ = 1500 if name == "sentinel" else (300 if name == "pedestrian" else 400)
         errs, ntri, mats, lo, hi, per_mat = check_file(
-            os.path.join(outdir, name + ".obj"), budget, normalized)
-        if meshes:
-            m = [mm for mm in meshes if mm.name == name][0]
+            os.path.join(outdir, name + ".obj"), budget_, normalized, within=lod1)
+        if m is not None:
             errs += check_parts(m)
         ext = " ".join("%.3f" % (hi[i] - lo[i]) for i in range(3))
-        print("%-18s %5d %6d  %-24s %s" % (name, ntri, budget, ext,
-                                            " ".join("%s(%d)" % (k, per_mat[k]) for k in mats)))
+        print("%-19s %5d %6d  %-24s %s%s" % (name, ntri, budget_, ext,
+                                             " ".join("%s(%d)" % (k, per_mat[k]) for k in mats),
+                                             "  [within the unit box]" if lod1 else ""))
         for e in errs[:10]:
             print("    ERROR: " + e)
         if errs:
@@ -917,17 +1113,16 @@ def main(argv):
         with tempfile.TemporaryDirectory() as tmp:
             for m in meshes:
                 m.write(tmp)
-                for ext in (".obj", ".mtl"):
-                    fn = m.name + ext
-                    old = os.path.join(outdir, fn)
-                    with open(os.path.join(tmp, fn), "rb") as f:
-                        want = f.read()
-                    have = None
-                    if os.path.exists(old):
-                        with open(old, "rb") as f:
-                            have = f.read()
-                    if have != want:
-                        stale.append(fn)
+            for fn in [m.name + ext for m in meshes for ext in (".obj", ".mtl")]:
+                old = os.path.join(outdir, fn)
+                with open(os.path.join(tmp, fn), "rb") as f:
+                    want = f.read()
+                have = None
+                if os.path.exists(old):
+                    with open(old, "rb") as f:
+                        have = f.read()
+                if have != want:
+                    stale.append(fn)
         ok = run_checks(outdir, meshes)
         for fn in stale:
             print("STALE: %s differs from what the script generates (regenerate)" % fn)
