@@ -38,7 +38,7 @@ double cpuSeconds() {
 
 struct Stages {
   double cull = 0, draw = 0, post = 0, readback = 0, boxes = 0;
-  double triangles = 0, instances = 0, boxes_count = 0;
+  double triangles = 0, instances = 0, lod_instances = 0, boxes_count = 0;
 };
 
 // The requests of frame set i of n: the UAV on the perception path, from the end of the climb to
@@ -70,15 +70,19 @@ std::vector<render::RenderRequest> frameSet(const scenario::SimConfig& cfg, int 
 int main(int argc, char** argv) {
   int frames = 100;
   std::string backend = "auto";
+  double lod_px = render::RendererOptions().lod_max_error_px;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--backend" && i + 1 < argc) {
       backend = argv[++i];
+    } else if (a == "--lod" && i + 1 < argc) {
+      lod_px = std::atof(argv[++i]);
     } else if (!a.empty() && a[0] != '-') {
       frames = std::max(1, std::atoi(a.c_str()));
     } else {
       std::fprintf(stderr,
-                   "usage: bench_render [frame_sets] [--backend auto|surfaceless|device]\n");
+                   "usage: bench_render [frame_sets] [--backend auto|surfaceless|device] "
+                   "[--lod MAX_ERROR_PX (0: full detail)]\n");
       return 2;
     }
   }
@@ -111,12 +115,15 @@ int main(int argc, char** argv) {
     render::RendererOptions opt;
     opt.backend = backend;
     opt.stage_timing = mode == 2;
+    opt.lod_max_error_px = lod_px;
     const auto c0 = Clock::now();
     render::Renderer r(world, cfg, opt);
     const double setup_ms = std::chrono::duration<double, std::milli>(Clock::now() - c0).count();
     if (mode == 0) {
       std::printf("GL_RENDERER: %s (EGL %s), renderer set-up %.0f ms\n", r.glRenderer().c_str(),
                   r.eglBackend().c_str(), setup_ms);
+      std::printf("level of detail: coarse meshes where their deviation is <= %.2f px%s\n", lod_px,
+                  lod_px > 0 ? "" : " (off: full detail)");
     }
     auto run = [&](const std::vector<render::RenderRequest>& reqs, std::vector<Stages>* st) {
       if (mode == 0) {
@@ -135,6 +142,7 @@ int main(int argc, char** argv) {
         x.boxes += s.boxes_ms;
         x.triangles += static_cast<double>(s.triangles);
         x.instances += static_cast<double>(s.instances);
+        x.lod_instances += static_cast<double>(s.lod_instances);
         x.boxes_count += static_cast<double>(out[c].boxes.size());
       }
     };
@@ -150,15 +158,17 @@ int main(int argc, char** argv) {
         "per frame set)\n",
         kModes[mode], frames, wall, frames / wall, 1e3 * wall / frames, 1e3 * cpu / frames);
     if (mode == 2) {
-      std::printf("  per frame (ms):  %12s %8s %8s %10s %8s %8s | %9s %9s %6s\n", "cull/upload",
-                  "draw", "post", "readback", "boxes", "total", "triangles", "instances", "boxes");
+      std::printf("  per frame (ms):  %12s %8s %8s %10s %8s %8s | %9s %9s %7s %6s\n", "cull/upload",
+                  "draw", "post", "readback", "boxes", "total", "triangles", "instances", "coarse",
+                  "boxes");
       for (std::size_t c = 0; c < per_camera.size(); ++c) {
         const Stages& st = per_camera[c];
         const double total = st.cull + st.draw + st.post + st.readback + st.boxes;
-        std::printf("  %-16s %12.2f %8.2f %8.2f %10.2f %8.2f %8.2f | %9.0f %9.0f %6.1f\n",
+        std::printf("  %-16s %12.2f %8.2f %8.2f %10.2f %8.2f %8.2f | %9.0f %9.0f %7.0f %6.1f\n",
                     cfg.uav.cameras[c].name.c_str(), st.cull / frames, st.draw / frames,
                     st.post / frames, st.readback / frames, st.boxes / frames, total / frames,
-                    st.triangles / frames, st.instances / frames, st.boxes_count / frames);
+                    st.triangles / frames, st.instances / frames, st.lod_instances / frames,
+                    st.boxes_count / frames);
       }
     }
   }

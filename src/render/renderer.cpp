@@ -175,6 +175,7 @@ struct Frame {
   std::vector<GLuint> base_instance;  // per model: first instance in the upload
   std::vector<GLsizei> count;         // per model: instances drawn
   std::vector<int> slot;              // per record: its index in the upload, or -1
+  std::vector<int> model;             // per uploaded record: the model it is drawn with
   std::vector<std::uint32_t> uploaded;
   std::vector<GpuInstance> upload;
   std::vector<std::uint8_t> color;              // read-back colour before the camera effects
@@ -190,6 +191,10 @@ struct Renderer::Impl {
         options(opt),
         scene(world, config, opt.models_dir.empty() ? defaultModelsDir() : opt.models_dir),
         egl(opt.backend) {
+    if (!std::isfinite(opt.lod_max_error_px) || opt.lod_max_error_px < 0) {
+      throw RenderError("RendererOptions.lod_max_error_px: expected a finite value >= 0, got " +
+                        num(opt.lod_max_error_px));
+    }
     for (std::size_t i = 0; i < scene.entityIds().size(); ++i) {
       if (!scene.entityIds()[i].empty() && static_cast<int>(i) != scene.uavInstanceId()) {
         by_id.emplace(scene.entityIds()[i], static_cast<int>(i));
@@ -407,6 +412,7 @@ struct Renderer::Impl {
                            static_cast<GLsizeiptr>(2 * records.size() * sizeof(GpuInstance)),
                            nullptr, GL_DYNAMIC_STORAGE_BIT);
       f->slot.assign(records.size(), -1);
+      f->model.assign(records.size(), -1);
       f->upload.reserve(records.size());
       f->uploaded.reserve(records.size());
       frames.push_back(std::move(f));
@@ -623,7 +629,8 @@ struct Renderer::Impl {
           const std::uint32_t i = cell_items[k];
           if (hidden[i]) continue;
           if (!sphereVisible(inst[i].center, inst[i].radius, !inside)) continue;
-          visible[static_cast<std::size_t>(m)].push_back(i);
+          visible[static_cast<std::size_t>(scene.modelFor(i, inst[i].center, inst[i].radius, lod))]
+              .push_back(i);
         }
       }
     }
@@ -631,7 +638,7 @@ struct Renderer::Impl {
       if (hidden[i]) continue;
       const auto& [c, radius] = mover_sphere[i];
       if (sphereVisible(c, radius, true))
-        visible[static_cast<std::size_t>(inst[i].model)].push_back(i);
+        visible[static_cast<std::size_t>(scene.modelFor(i, c, radius, lod))].push_back(i);
     }
     for (std::uint32_t i : always) {
       if (sphereVisible(inst[i].center, inst[i].radius, true)) {
@@ -651,6 +658,8 @@ struct Renderer::Impl {
           static_cast<GLsizei>(visible[static_cast<std::size_t>(m)].size());
       for (std::uint32_t i : visible[static_cast<std::size_t>(m)]) {
         f.slot[i] = static_cast<int>(f.upload.size());
+        f.model[i] = m;
+        if (i != uav_record && m != inst[i].model) ++f.stats.lod_instances;
         f.uploaded.push_back(i);
         f.upload.push_back(gpuInstance(records[i]));
       }
@@ -1010,7 +1019,7 @@ struct Renderer::Impl {
     for (std::size_t a = 0; a < n; ++a) {
       const auto rec =
           static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
-      box_rect[a] = projectedRect(f, scene.instances()[rec].model, f.slot[rec]);
+      box_rect[a] = projectedRect(f, f.model[rec], f.slot[rec]);
       for (int g = 0; g <= groups && box_group[a] < 0; ++g) {
         bool free = true;
         for (std::size_t b = 0; b < a && free; ++b) {
@@ -1053,7 +1062,7 @@ struct Renderer::Impl {
           if (box_group[a] != g) continue;
           const auto rec = static_cast<std::size_t>(
               instance_record[static_cast<std::size_t>(f.touched[a].first)]);
-          if (scene.instances()[rec].model != m) continue;
+          if (f.model[rec] != m) continue;
           box_upload.push_back(f.upload[static_cast<std::size_t>(f.slot[rec])]);
           ++group_count[static_cast<std::size_t>(m)];
           const auto& r = box_rect[a];
@@ -1155,6 +1164,7 @@ struct Renderer::Impl {
       camera = r.world_T_optical.translation();
       f.camera = camera;
       focal = std::max(r.intrinsics.fx, r.intrinsics.fy);
+      lod = LodView(r, options.lod_max_error_px);
       Eigen::Matrix4d full;
       projection(r, f.view_proj, &full);
       frustumPlanes(full);
@@ -1207,6 +1217,7 @@ struct Renderer::Impl {
       stats.readback_ms += f.stats.readback_ms;
       stats.boxes_ms += f.stats.boxes_ms;
       stats.instances += f.stats.instances;
+      stats.lod_instances += f.stats.lod_instances;
       stats.triangles += f.stats.triangles;
       stats.draw_calls += f.stats.draw_calls;
       f.request = nullptr;
@@ -1253,6 +1264,7 @@ struct Renderer::Impl {
   std::array<Plane, 6> planes{};
   Eigen::Vector3d camera{0, 0, 0};
   double focal = 1.0;
+  LodView lod;
   std::vector<std::pair<double, int>> cell_order;
   std::vector<std::vector<std::uint32_t>> visible;  // per model
   std::vector<std::uint8_t> hidden;                 // per record
@@ -1327,6 +1339,12 @@ std::string Renderer::eglBackend() const { return impl_->egl.platform(); }
 const RenderStats& Renderer::lastStats() const { return impl_->stats; }
 
 SceneTriangles Renderer::sceneTriangles(double time) const { return impl_->scene.triangles(time); }
+
+SceneTriangles Renderer::sceneTriangles(const RenderRequest& request) const {
+  impl_->validate(request);
+  const LodView lod(request, impl_->options.lod_max_error_px);
+  return impl_->scene.triangles(request.time, &lod);
+}
 
 std::string defaultModelsDir() { return std::string(HAMERITT_SOURCE_DIR) + "/models"; }
 

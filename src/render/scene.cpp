@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <unordered_map>
 
 #include "hameritt/scenario/trajectory.h"
@@ -159,9 +161,100 @@ void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][
   }
 }
 
+LodView::LodView(const RenderRequest& r, double max_error)
+    : eye(r.world_T_optical.translation()),
+      axis(r.world_T_optical.linear().col(2)),
+      max_error_px(max_error) {
+  const Intrinsics& k = r.intrinsics;
+  // The widest ray of the image: through the corner pixel edge farthest from the principal
+  // point.
+  const double tx = std::max(k.cx + 0.5, k.width - 0.5 - k.cx) / k.fx;
+  const double ty = std::max(k.cy + 0.5, k.height - 0.5 - k.cy) / k.fy;
+  focal = std::max(k.fx, k.fy);
+  max_angle = std::atan(std::sqrt(tx * tx + ty * ty));
+}
+
+bool LodView::coarse(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const {
+  if (max_error_px <= 0 || si.lod_deviation < 0) return false;
+  const Eigen::Vector3d v = center.cast<double>() - eye;
+  const double z = v.dot(axis);
+  const double z_min = z - radius;
+  if (z_min <= 0) return false;
+  const double dist = v.norm();
+  const double lateral = std::sqrt(std::max(0.0, dist * dist - z * z));
+  const double angle = std::min(std::atan2(lateral, z) + std::asin(std::min(1.0, radius / dist)),
+                                max_angle);
+  return focal * si.lod_deviation <= max_error_px * z_min * std::cos(angle);
+}
+
 int Scene::addModel(Mesh mesh) {
   models_.push_back(std::move(mesh));
   return static_cast<int>(models_.size()) - 1;
+}
+
+void Scene::loadLods(const std::string& dir,
+                     const std::unordered_map<std::string, int>& file_model) {
+  lod_model_.assign(models_.size(), -1);
+  lod_axis_error_.assign(models_.size(), Eigen::Vector3f::Zero());
+  const std::string path = dir + "lod.json";
+  std::ifstream in(path);
+  if (!in) return;  // no coarse meshes: every instance is drawn in full
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw RenderError(path + ": not valid JSON: " + e.what());
+  }
+  auto fail = [&path](const std::string& field, const std::string& expected) {
+    throw RenderError(path + ": " + field + ": expected " + expected);
+  };
+  if (!doc.is_object() || doc.value("schema", "") != "hameritt_mesh_lod") {
+    fail("schema", "\"hameritt_mesh_lod\"");
+  }
+  if (!doc.contains("schema_version") || doc["schema_version"] != 1) fail("schema_version", "1");
+  if (!doc.contains("meshes") || !doc["meshes"].is_array()) fail("meshes", "an array");
+  const auto& meshes = doc["meshes"];
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const auto& e = meshes[i];
+    const std::string at = "meshes[" + std::to_string(i) + "]";
+    if (!e.is_object()) fail(at, "an object");
+    if (!e.contains("mesh") || !e["mesh"].is_string()) fail(at + ".mesh", "a class mesh name");
+    const std::string name = e["mesh"].get<std::string>();
+    const auto it = file_model.find(name + ".obj");
+    if (it == file_model.end() || name == "sentinel") {
+      fail(at + ".mesh", "a class mesh name (house_1, car_sedan, ...), got '" + name + "'");
+    }
+    const int fine = it->second;
+    if (lod_model_[static_cast<std::size_t>(fine)] >= 0) fail(at + ".mesh", "each mesh once");
+    if (!e.contains("lod1") || !e["lod1"].is_string() || e["lod1"].get<std::string>().empty() ||
+        e["lod1"].get<std::string>().find('/') != std::string::npos) {
+      fail(at + ".lod1", "an OBJ file name in " + dir);
+    }
+    if (!e.contains("max_deviation_m") || !e["max_deviation_m"].is_number() ||
+        !std::isfinite(e["max_deviation_m"].get<double>()) ||
+        e["max_deviation_m"].get<double>() < 0) {
+      fail(at + ".max_deviation_m", "a finite number >= 0 (metres)");
+    }
+    const auto& size = e.contains("design_size_m") ? e["design_size_m"] : nlohmann::json();
+    bool size_ok = size.is_array() && size.size() == 3;
+    for (std::size_t a = 0; size_ok && a < 3; ++a) {
+      size_ok = size[a].is_number() && std::isfinite(size[a].get<double>()) &&
+                size[a].get<double>() > 0;
+    }
+    if (!size_ok) fail(at + ".design_size_m", "three numbers > 0 (metres)");
+    Mesh coarse = loadObjMesh(dir + e["lod1"].get<std::string>(), true);
+    // The canopy of both meshes is scaled about the same point.
+    coarse.canopy_center = models_[static_cast<std::size_t>(fine)].canopy_center;
+    const double dev = e["max_deviation_m"].get<double>();
+    const int m = addModel(std::move(coarse));
+    lod_model_.resize(models_.size(), -1);
+    lod_axis_error_.resize(models_.size(), Eigen::Vector3f::Zero());
+    lod_model_[static_cast<std::size_t>(fine)] = m;
+    for (int a = 0; a < 3; ++a) {
+      lod_axis_error_[static_cast<std::size_t>(fine)][a] =
+          static_cast<float>(dev / size[static_cast<std::size_t>(a)].get<double>());
+    }
+  }
 }
 
 Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
@@ -184,6 +277,7 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
         "pedestrian.obj", "sentinel.obj"}) {
     model(f);
   }
+  loadLods(dir, file_model);
   procedural_.uav = model("sentinel.obj");
   procedural_.ground = addModel(groundMesh(world.bounds()));
   procedural_.sidewalks = addModel(sidewalkMesh(world.blocks(), world.params().sidewalk_width));
@@ -191,6 +285,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       addModel(unitQuad("street", MaterialKind::kStreet, srgbToLinear(64, 65, 68)));
   procedural_.driveway =
       addModel(unitBox("driveway", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f)));
+  lod_model_.resize(models_.size(), -1);
+  lod_axis_error_.resize(models_.size(), Eigen::Vector3f::Zero());
 
   foliage_ = std::clamp(config.environment.foliage, 0.0, 1.0);
   const std::size_t n_world = world.entities().size();
@@ -297,6 +393,11 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
     const Eigen::Vector3f half = 0.5f * (mesh.max - mesh.min);
     si.radius = half.cwiseProduct(e.box.size.cast<float>()).norm();
+    if (lod_model_[static_cast<std::size_t>(si.model)] >= 0) {
+      si.lod_deviation = lod_axis_error_[static_cast<std::size_t>(si.model)]
+                             .cwiseProduct(e.box.size.cast<float>())
+                             .maxCoeff();
+    }
     const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
     for (int r = 0; r < 3; ++r) {
       si.center[r] = si.record.row[r][0] * c.x() + si.record.row[r][1] * c.y() +
@@ -341,7 +442,7 @@ InstanceRecord Scene::uavRecord(const Eigen::Isometry3d& world_T_uav) const {
   return r;
 }
 
-SceneTriangles Scene::triangles(double time) const {
+SceneTriangles Scene::triangles(double time, const LodView* lod) const {
   SceneTriangles out;
   for (std::size_t i = 0; i < instances_.size(); ++i) {
     InstanceRecord rec;
@@ -349,7 +450,8 @@ SceneTriangles Scene::triangles(double time) const {
     float radius;
     pose(i, time, &rec, &center, &radius);
     const SceneInstance& si = instances_[i];
-    const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
+    const int model = lod ? modelFor(i, center, radius, *lod) : si.model;
+    const Mesh& mesh = models_[static_cast<std::size_t>(model)];
     for (const Submesh& s : mesh.submeshes) {
       const bool canopy = s.kind == MaterialKind::kFoliage;
       if (canopy && foliage_ <= 0) continue;

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "hameritt/render/renderer.h"
@@ -33,6 +34,27 @@ struct SceneInstance {
   InstanceRecord record;      // at t = 0 for movers
   Eigen::Vector3f center{0, 0, 0};  // bounding sphere
   float radius = 0;
+  // Metres by which the coarse mesh of `model` (Scene::lodModel) may depart from it at this
+  // instance's size: the mesh's stated deviation scaled by the box (-1: no coarse mesh).
+  float lod_deviation = -1;
+};
+
+// The level-of-detail rule of one view: an instance is drawn with its model's coarse mesh when
+// the coarse mesh's deviation at the instance's size, projected anywhere on its bounding sphere
+// that the image shows, is at most max_error_px pixels. The bound is first order and
+// conservative: a displacement d at optical depth Z on a ray at angle t from the optical axis
+// moves the point's image by at most f |d| / (Z cos t) pixels (the norm of the projection's
+// Jacobian); Z is taken at the sphere's nearest depth and t at the sphere's widest ray, capped
+// by the image's widest ray.
+struct LodView {
+  Eigen::Vector3d eye{0, 0, 0};
+  Eigen::Vector3d axis{0, 0, 1};  // optical z in the world
+  double focal = 0;               // max(fx, fy)
+  double max_angle = 0;           // the image's widest ray from the optical axis (radians)
+  double max_error_px = 0;        // 0: never coarse
+  LodView() = default;
+  LodView(const RenderRequest& r, double max_error_px);
+  bool coarse(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const;
 };
 
 // Model indices of the procedural parts.
@@ -62,8 +84,19 @@ class Scene {
             float* radius) const;
   // The UAV's record at world_T_uav.
   InstanceRecord uavRecord(const Eigen::Isometry3d& world_T_uav) const;
-  // World-space triangles of every instance at `time` (what the geometry pass rasterizes).
-  SceneTriangles triangles(double time) const;
+  // World-space triangles of every instance at `time` (what the geometry pass rasterizes), each
+  // with its full mesh, or with the mesh `lod` picks for it.
+  SceneTriangles triangles(double time, const LodView* lod = nullptr) const;
+  // The coarse mesh of model m (models_dir/meshes/lod.json), or -1.
+  int lodModel(int m) const {
+    return m >= 0 && m < static_cast<int>(lod_model_.size()) ? lod_model_[static_cast<std::size_t>(m)]
+                                                              : -1;
+  }
+  // The model instance i is drawn with under `lod`.
+  int modelFor(std::size_t i, const Eigen::Vector3f& center, float radius, const LodView& lod) const {
+    const SceneInstance& si = instances_[i];
+    return lod.coarse(si, center, radius) ? lodModel(si.model) : si.model;
+  }
   // Indices of model m that are drawn: all, or without the canopy at foliage density 0.
   std::uint32_t drawnIndexCount(int m) const {
     const Mesh& mesh = models_[static_cast<std::size_t>(m)];
@@ -72,9 +105,13 @@ class Scene {
 
  private:
   int addModel(Mesh mesh);
+  // Reads dir/lod.json (when present) and loads the coarse meshes it names.
+  void loadLods(const std::string& dir, const std::unordered_map<std::string, int>& file_model);
 
   const scenario::SimConfig& config_;
   std::vector<Mesh> models_;
+  std::vector<int> lod_model_;                    // per model: its coarse mesh or -1
+  std::vector<Eigen::Vector3f> lod_axis_error_;   // per model: deviation / design size per axis
   SceneModels procedural_;
   std::vector<SceneInstance> instances_;
   std::vector<std::string> entity_ids_;

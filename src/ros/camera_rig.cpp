@@ -172,6 +172,7 @@ void CameraRig::run() {
     render::RendererOptions ro;
     ro.backend = options_.backend;
     ro.models_dir = options_.models_dir;
+    ro.lod_max_error_px = options_.lod_max_error_px;
     renderer = std::make_unique<render::Renderer>(world_, config_, ro);
     std::lock_guard<std::mutex> lock(mutex_);
     gl_renderer_ = renderer->glRenderer();

@@ -83,6 +83,11 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     pnh.param("camera_weather", co.weather, co.weather);
     pnh.param("camera_noise", co.noise, co.noise);
     pnh.param("render_queue_depth", co.queue_depth, co.queue_depth);
+    pnh.param("render_lod_px", co.lod_max_error_px, co.lod_max_error_px);
+    if (!std::isfinite(co.lod_max_error_px) || co.lod_max_error_px < 0) {
+      throw scenario::ConfigError("~render_lod_px: expected a number >= 0 (0: full detail), got " +
+                                  std::to_string(co.lod_max_error_px));
+    }
     pnh.param("record_image_rate", co.decimated_rate_hz, 0.0);
     if (co.queue_depth < 1) {
       throw scenario::ConfigError("~render_queue_depth: expected >= 1, got " + std::to_string(co.queue_depth));

@@ -4,6 +4,7 @@
 // one boxes.json for all cameras.
 //   hameritt_render --sim-config FILE --time T --out DIR [--camera NAME|all]
 //                   [--pose x,y,z,yaw] [--set KEY=VALUE ...] [--frame N] [--models DIR]
+//                   [--lod PX]
 // Exit codes: 0 success, 2 bad input or unwritable output, 1 rendering failure.
 
 #include <sys/stat.h>
@@ -37,6 +38,7 @@ namespace {
 const char* kUsage =
     "usage: hameritt_render --sim-config FILE --time T --out DIR [--camera NAME|all]\n"
     "                       [--pose x,y,z,yaw] [--set KEY=VALUE ...] [--frame N] [--models DIR]\n"
+    "                       [--lod PX]\n"
     "  --sim-config FILE  scenario sim_config.json\n"
     "  --time T           scenario time in seconds, 0..duration\n"
     "  --out DIR          output directory (created if missing)\n"
@@ -48,6 +50,8 @@ const char* kUsage =
     "                     (>= 0); noise=on|off, weather=on|off\n"
     "  --frame N          frame index (seeds the noise and the particles; default 0)\n"
     "  --models DIR       models directory (default: the package's models/)\n"
+    "  --lod PX           far instances drawn with coarse meshes whose deviation projects to at\n"
+    "                     most PX pixels (default 0.5; 0: every mesh in full detail)\n"
     "Writes per camera <camera>_{rgb,depth,segmentation,instances,boxes}.png and\n"
     "<camera>_camera_info.yaml, and boxes.json.\n";
 
@@ -87,6 +91,7 @@ struct Options {
   double pose[4] = {0, 0, 0, 0};
   std::vector<std::string> sets;
   std::uint64_t frame = 0;
+  double lod_px = render::RendererOptions().lod_max_error_px;
 };
 
 // Applies one --set KEY=VALUE.
@@ -161,6 +166,9 @@ Options parseArgs(int argc, char** argv, bool* help) {
       for (int k = 0; k < 4; ++k)
         o.pose[k] = parseNumber("--pose", parts[static_cast<std::size_t>(k)]);
       o.have_pose = true;
+    } else if (a == "--lod") {
+      o.lod_px = parseNumber("--lod", next());
+      if (o.lod_px < 0) throw ConfigError("--lod: expected a number of pixels >= 0");
     } else if (a == "--set") {
       o.sets.push_back(next());
     } else if (a == "--frame") {
@@ -355,6 +363,7 @@ int main(int argc, char** argv) {
     }
     render::RendererOptions ropt;
     ropt.models_dir = o.models.empty() ? render::defaultModelsDir() : o.models;
+    ropt.lod_max_error_px = o.lod_px;
     struct stat st {};
     if (::stat((ropt.models_dir + "/meshes").c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
       throw ConfigError("--models: " + ropt.models_dir + "/meshes is not a directory");

@@ -93,6 +93,55 @@ TEST(RenderErrors, MalformedOrMisfitModelsNameTheFile) {
   EXPECT_NE(e.find(m.mesh("pedestrian.obj")), std::string::npos) << e;
 }
 
+TEST(RenderErrors, BadLevelOfDetailIndexNamesTheFileAndField) {
+  ModelsCopy m;
+  const std::string lod = m.mesh("lod.json");
+  auto error = [&] {
+    return errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), in(m.dir())); });
+  };
+  m.write("lod.json", "{ not json");
+  std::string e = error();
+  EXPECT_NE(e.find(lod + ": not valid JSON"), std::string::npos) << e;
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 2, "meshes": []})");
+  e = error();
+  EXPECT_NE(e.find(lod + ": schema_version: expected 1"), std::string::npos) << e;
+  const std::string entry =
+      R"({"mesh": "house_1", "lod1": "house_1_lod1.obj", "design_size_m": [10, 11, 5.6], )";
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)" +
+                          entry + R"("max_deviation_m": -0.1}]})");
+  e = error();
+  EXPECT_NE(e.find(lod + ": meshes[0].max_deviation_m: expected a finite number >= 0"),
+            std::string::npos)
+      << e;
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)"
+                      R"({"mesh": "castle", "lod1": "castle_lod1.obj", "design_size_m": [1, 1, 1],)"
+                      R"( "max_deviation_m": 0.1}]})");
+  e = error();
+  EXPECT_NE(e.find(lod + ": meshes[0].mesh: expected a class mesh name"), std::string::npos) << e;
+  EXPECT_NE(e.find("'castle'"), std::string::npos) << e;
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)"
+                      R"({"mesh": "house_1", "lod1": "house_1_lod1.obj", "design_size_m": [10, 0, 5],)"
+                      R"( "max_deviation_m": 0.1}]})");
+  e = error();
+  EXPECT_NE(e.find(lod + ": meshes[0].design_size_m: expected three numbers > 0"),
+            std::string::npos)
+      << e;
+  // The coarse mesh it names is missing.
+  fs::remove(m.mesh("house_1_lod1.obj"));
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)" +
+                          entry + R"("max_deviation_m": 0.1}]})");
+  e = error();
+  EXPECT_NE(e.find(m.mesh("house_1_lod1.obj")), std::string::npos) << e;
+  // Without lod.json every instance is drawn in full.
+  fs::remove(lod);
+  e = error();
+  EXPECT_EQ(e, "no RenderError");
+  RendererOptions bad = in(m.dir());
+  bad.lod_max_error_px = -1;
+  e = errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), bad); });
+  EXPECT_NE(e.find("RendererOptions.lod_max_error_px"), std::string::npos) << e;
+}
+
 TEST(RenderErrors, BadEntityAttributesAndTooManyInstances) {
   scenario::SimConfig c = defaultSimConfig();
   c.entities[0].entity.attributes.set("color", std::string("mauve"));

@@ -69,6 +69,8 @@ TEST(RenderGroundTruth, DepthAndInstanceEqualRayCastsThroughPixelCentres) {
   int samples = 0, hits = 0, misses = 0, depth_bad = 0, instance_bad = 0, sky_bad = 0;
   for (const RenderRequest& req : depthViews()) {
     const FrameSet f = r.render(req);
+    // What this view's geometry pass draws: far instances with their coarse meshes.
+    const SceneRayCaster view_caster(r.sceneTriangles(req));
     const Intrinsics& k = req.intrinsics;
     const Eigen::Vector3d eye = req.world_T_optical.translation();
     for (int v = 5; v < k.height; v += 16) {
@@ -76,7 +78,7 @@ TEST(RenderGroundTruth, DepthAndInstanceEqualRayCastsThroughPixelCentres) {
         ++samples;
         const std::size_t i = static_cast<std::size_t>(v) * k.width + u;
         const Eigen::Vector3d ray = pixelRay(req, u, v);  // optical z = 1
-        const auto hit = caster().cast(eye, eye + req.far_clip * ray);
+        const auto hit = view_caster.cast(eye, eye + req.far_clip * ray);
         if (!hit.hit) {
           ++misses;
           if (!std::isinf(f.depth[i]) || f.instance[i] != 0 || f.semantic[i] != kSkySemantic)
@@ -109,9 +111,10 @@ TEST(RenderGroundTruth, DepthAndInstanceEqualRayCastsThroughPixelCentres) {
 
 // Centroids of visible, camera-facing triangles of an instance (well inside the triangle, so
 // not on an edge), with the optical z of each.
-std::vector<Eigen::Vector3d> visibleSurfacePoints(const RenderRequest& req, int instance,
+std::vector<Eigen::Vector3d> visibleSurfacePoints(const SceneRayCaster& caster,
+                                                  const RenderRequest& req, int instance,
                                                   std::size_t max) {
-  const SceneTriangles& t = caster().triangles();
+  const SceneTriangles& t = caster.triangles();
   const Eigen::Vector3d eye = req.world_T_optical.translation();
   std::vector<Eigen::Vector3d> out;
   for (std::size_t tri = 0; tri < t.triangle_instance.size() && out.size() < max; ++tri) {
@@ -123,7 +126,7 @@ std::vector<Eigen::Vector3d> visibleSurfacePoints(const RenderRequest& req, int 
     if (n.norm() < 0.05) continue;  // small: at most a few pixels
     const Eigen::Vector3d centroid = (a + b + c) / 3.0;
     if (n.dot(eye - centroid) <= 0) continue;
-    const auto hit = caster().cast(eye, eye + 1.02 * (centroid - eye));
+    const auto hit = caster.cast(eye, eye + 1.02 * (centroid - eye));
     if (!hit.hit || hit.triangle != static_cast<int>(tri)) continue;  // something in front
     out.push_back(centroid);
   }
@@ -139,6 +142,7 @@ TEST(RenderGroundTruth, ProjectedSurfacePointsLandOnTheirPixels) {
   req.time = kTime;
   req.world_T_optical = lookAt(c + Eigen::Vector3d(-14.0, -16.0, 12.0), c);
   const FrameSet f = r.render(req);
+  const SceneRayCaster view_caster(r.sceneTriangles(req));  // this view's levels of detail
   // The target car and the houses in view.
   std::set<int> instances = {r.instanceOf("car_706")};
   for (std::uint16_t id : f.instance) {
@@ -147,7 +151,7 @@ TEST(RenderGroundTruth, ProjectedSurfacePointsLandOnTheirPixels) {
   ASSERT_GE(instances.size(), 2u) << "a house in view";
   int points = 0, landed = 0;
   for (int id : instances) {
-    for (const Eigen::Vector3d& p : visibleSurfacePoints(req, id, 40)) {
+    for (const Eigen::Vector3d& p : visibleSurfacePoints(view_caster, req, id, 40)) {
       Eigen::Vector2d uv;
       ASSERT_TRUE(projectPoint(req.intrinsics, req.world_T_optical, p, &uv));
       const int u = static_cast<int>(std::lround(uv.x())),

@@ -111,6 +111,12 @@ struct RendererOptions {
   // Wait for the GL at the end of each stage so that Renderer::lastStats() splits the frame
   // time by stage (benchmarks); off, the stage times only count the calling thread's work.
   bool stage_timing = false;
+  // Level of detail: an instance whose class mesh has a coarse version (models/meshes/lod.json)
+  // is drawn with it when the coarse mesh's stated deviation from the full mesh, scaled to the
+  // instance and projected at the instance's nearest depth, is at most this many pixels
+  // anywhere in the image (first-order bound). Labels, depth and boxes are those of what is
+  // drawn. 0 draws every instance with its full mesh.
+  double lod_max_error_px = 0.5;
 };
 
 // What the last render() call did and where its time went (milliseconds of wall time; summed
@@ -122,6 +128,7 @@ struct RenderStats {
   double readback_ms = 0;      // colour, depth and labels read back and split
   double boxes_ms = 0;         // boxes: entities drawn alone and their pixels counted
   std::size_t instances = 0;   // instances drawn in the geometry pass
+  std::size_t lod_instances = 0;  // of which drawn with their coarse mesh
   std::size_t triangles = 0;   // triangles submitted to the geometry pass
   std::size_t draw_calls = 0;  // all passes
 };
@@ -164,9 +171,13 @@ class Renderer {
   const RenderStats& lastStats() const;
   // Instance id of an entity id (world or scenario), or 0.
   int instanceOf(const std::string& entity_id) const;
-  // Everything drawn at `time` except the UAV model, in world coordinates: the triangles the
-  // geometry pass rasterizes (same canopy scaling, same z offsets of the ground layers).
+  // Everything drawn at `time` except the UAV model, in world coordinates, every instance with
+  // its full mesh: the triangles a geometry pass with lod_max_error_px = 0 rasterizes (same
+  // canopy scaling, same z offsets of the ground layers).
   SceneTriangles sceneTriangles(double time) const;
+  // The triangles `request`'s geometry pass rasterizes: each instance with the mesh the level of
+  // detail picks for that view (RendererOptions::lod_max_error_px); culling is not applied.
+  SceneTriangles sceneTriangles(const RenderRequest& request) const;
 
  private:
   struct Impl;

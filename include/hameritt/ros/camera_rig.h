@@ -33,6 +33,8 @@ struct CameraRigOptions {
   std::string models_dir;        // "" = the package's models/
   bool weather = true;           // fog, dust, rain, snow effects on the colour image
   bool noise = true;             // sim_config camera noise
+  // Level of detail (render::RendererOptions::lod_max_error_px; 0 = every mesh in full).
+  double lod_max_error_px = 0.5;
   int queue_depth = 2;           // snapshots the physics loop may run ahead of the renderer
   double physics_rate_hz = 500;  // camera rates must divide it
   // Also publish every k-th frame's images on /uav/camera/<name>/decimated/<modality> at this
