@@ -866,32 +866,41 @@ def make_sentinel():
 
 
 # ----------------------------------------------------------------------------------------------
-def build_lod(lod):
-    """The class meshes at a level of detail; lod 1: only those that have a coarse mesh."""
-    meshes = [make_house("house_1", 1, lod), make_house("house_2", 2, lod),
-              make_garage("garage_1", 1, lod), make_garage("garage_2", 2, lod)]
-    if lod == 0:
-        meshes += [make_fence_wood(), make_fence_vinyl(), make_fence_chain_link()]
-    meshes.append(make_tree_deciduous(lod))
-    if lod == 0:
-        meshes.append(make_tree_pine())
-    for name, spec in CARS.items():
-        m = make_car(name, spec, lod)
-        if name == "car_pickup":
-            make_pickup_bed(m)
-        meshes.append(m)
-    if lod == 0:
-        meshes += [make_pedestrian(), make_sentinel()]
-    return meshes
+def make_car_named(name, lod):
+    m = make_car(name, CARS[name], lod)
+    if name == "car_pickup":
+        make_pickup_bed(m)
+    return m
+
+
+# (class mesh, builder(lod), its coarse levels), in the order of the files and of lod.json
+CLASS_MESHES = [
+    ("house_1", lambda lod: make_house("house_1", 1, lod), (1,)),
+    ("house_2", lambda lod: make_house("house_2", 2, lod), (1,)),
+    ("garage_1", lambda lod: make_garage("garage_1", 1, lod), (1,)),
+    ("garage_2", lambda lod: make_garage("garage_2", 2, lod), (1,)),
+    ("fence_wood", lambda lod: make_fence_wood(), ()),
+    ("fence_vinyl", lambda lod: make_fence_vinyl(), ()),
+    ("fence_chain_link", lambda lod: make_fence_chain_link(), ()),
+    ("tree_deciduous", make_tree_deciduous, (1,)),
+    ("tree_pine", lambda lod: make_tree_pine(), ()),
+] + [(name, lambda lod, name=name: make_car_named(name, lod), (1,)) for name in CARS] + [
+    ("pedestrian", lambda lod: make_pedestrian(), ()),
+    ("sentinel", lambda lod: make_sentinel(), ()),
+]
 
 
 def build_all():
-    """The fine meshes, then the lod1 meshes (each normalized with its fine mesh's bounds)."""
-    fine = build_lod(0)
-    by_name = {m.name: m for m in fine}
-    coarse = build_lod(1)
-    for m in coarse:
-        m.bounds_from = by_name[m.base]
+    """The fine meshes, then the lod1 meshes, then the lod2 meshes (each coarse mesh normalized
+    with its fine mesh's design bounds)."""
+    fine = [build(0) for _, build, _ in CLASS_MESHES]
+    coarse = []
+    for lod in (1, 2):
+        for f, (_, build, levels) in zip(fine, CLASS_MESHES):
+            if lod in levels:
+                m = build(lod)
+                m.bounds_from = f
+                coarse.append(m)
     return fine + coarse
 
 
@@ -1113,15 +1122,16 @@ def round_up_mm(x):
 
 
 LOD_NOTE = ("upper bound, in design metres, on the two-sided Hausdorff distance between the fine "
-            "and the lod1 surface as written (foliage to foliage and the rest to the rest, the "
-            "larger), rounded up to the millimetre; the renderer scales axis i by "
-            "box_i / design_size_m[i], so in its metres the bound is max_deviation_m * "
-            "max_i(box_i / design_size_m[i]) (foliage scaled by s <= 1 about the fine canopy "
-            "centre: times s or less)")
+            "mesh and the level's surface as written (foliage to foliage and the rest to the rest, "
+            "the larger), rounded up to the millimetre; every level is measured against the fine "
+            "mesh; the renderer scales axis i by box_i / design_size_m[i], so in its metres the "
+            "bound is max_deviation_m * max_i(box_i / design_size_m[i]) (foliage scaled by s <= 1 "
+            "about the fine canopy centre: times s or less)")
 
 
 def lod_table(meshes):
-    """[(fine, coarse, {"foliage"|"other": (upper, lower)})] for every lod1 mesh (finalized)."""
+    """[(fine, coarse, {"foliage"|"other": (upper, lower)})] for every coarse mesh (finalized),
+    in the order of `meshes`."""
     by_name = {m.name: m for m in meshes}
     return [(by_name[m.base], m, lod_deviation(by_name[m.base], m)) for m in meshes if m.lod]
 
@@ -1130,18 +1140,50 @@ def ntris(m):
     return sum(len(t) for _, t in m.final)
 
 
+def max_deviation(dev):
+    return round_up_mm(max(v[0] for v in dev.values()))
+
+
+def lod_levels(table):
+    """[(fine, [(coarse, dev), ...] finest level first)] in the order of the fine meshes'
+    first coarse level in `table`."""
+    out, index = [], {}
+    for fine, coarse, dev in table:
+        if fine.name not in index:
+            index[fine.name] = len(out)
+            out.append((fine, []))
+        out[index[fine.name]][1].append((coarse, dev))
+    for _, levels in out:
+        levels.sort(key=lambda cd: cd[0].lod)
+    return out
+
+
+def check_levels(table):
+    """Errors: a mesh whose levels do not have strictly fewer triangles and a strictly larger
+    deviation than the previous one (the fine mesh: deviation 0)."""
+    errs = []
+    for fine, levels in lod_levels(table):
+        tris, dev = ntris(fine), 0.0
+        for coarse, d in levels:
+            if not (ntris(coarse) < tris and max_deviation(d) > dev):
+                errs.append("%s: %d triangles, deviation %.3f m after %d, %.3f m"
+                            % (coarse.name, ntris(coarse), max_deviation(d), tris, dev))
+            tris, dev = ntris(coarse), max_deviation(d)
+    return errs
+
+
 def lod_json(table):
     """The text of models/meshes/lod.json (one mesh per line, deterministic)."""
     rows = []
-    for fine, coarse, dev in table:
+    for fine, levels in lod_levels(table):
         rows.append(json.dumps({
-            "mesh": fine.name, "lod1": coarse.name + ".obj", "triangles": ntris(fine),
-            "lod1_triangles": ntris(coarse),
+            "mesh": fine.name, "triangles": ntris(fine),
             "design_size_m": [round(x, 6) for x in fine.design_size],
-            "max_deviation_m": round_up_mm(max(v[0] for v in dev.values()))}))
+            "levels": [{"file": coarse.name + ".obj", "triangles": ntris(coarse),
+                        "max_deviation_m": max_deviation(dev)} for coarse, dev in levels]}))
     return ("{\n"
             '  "schema": "hameritt_mesh_lod",\n'
-            '  "schema_version": 1,\n'
+            '  "schema_version": 2,\n'
             '  "generator": "scripts/make_meshes.py",\n'
             '  "max_deviation_note": %s,\n'
             '  "meshes": [\n    %s\n  ]\n}\n' % (json.dumps(LOD_NOTE), ",\n    ".join(rows)))
@@ -1157,7 +1199,7 @@ def foliage_centre(m):
 
 
 def print_lod_table(table):
-    print("%-15s %5s %5s  %-9s %s" % ("mesh", "tris", "lod1", "deviation",
+    print("%-19s %5s %5s  %-9s %s" % ("level", "tris", "fine", "deviation",
                                       "(design m; found at a sample .. bound, per surface)"))
     for fine, coarse, dev in table:
         extra = ""
@@ -1165,8 +1207,8 @@ def print_lod_table(table):
         if fc is not None:
             extra = "; canopy centre offset %s m" % " ".join("%+.4f" % (cc[i] - fc[i])
                                                              for i in range(3))
-        print("%-15s %5d %5d  %-9.3f %s%s" % (
-            fine.name, ntris(fine), ntris(coarse), round_up_mm(max(v[0] for v in dev.values())),
+        print("%-19s %5d %5d  %-9.3f %s%s" % (
+            coarse.name, ntris(coarse), ntris(fine), max_deviation(dev),
             ", ".join("%s %.4f .. %.4f" % (k, v[1], v[0]) for k, v in sorted(dev.items())),
             extra))
 
@@ -1341,31 +1383,37 @@ def run_checks(outdir, meshes=None):
     print("%-19s %5s %6s  %-24s %s" % ("mesh", "tris", "budget", "extent (x y z)", "materials"))
     for name in names:
         normalized = name != "sentinel"
-        lod1 = name.endswith("_lod1")
+        base, _, level = name.partition("_lod")
+        coarse = bool(level)
         m = [mm for mm in meshes if mm.name == name][0] if meshes else None
         if m is not None:
             budget_ = m.budget
-        elif lod1:
-            base = name[:-5]
-            budget_ = budget(base, "house" if base.startswith("house") else "garage"
-                             if base.startswith("garage") else "car" if base.startswith("car")
-                             else "tree", 1)
+        elif coarse:
+            budget_ = budget(base, base.split("_")[0], int(level))
         else:
             budget_ = 1500 if name == "sentinel" else (300 if name == "pedestrian" else 400)
         errs, ntri, mats, lo, hi, per_mat = check_file(
-            os.path.join(outdir, name + ".obj"), budget_, normalized, within=lod1)
+            os.path.join(outdir, name + ".obj"), budget_, normalized, within=coarse)
         if m is not None:
             errs += check_parts(m)
         ext = " ".join("%.3f" % (hi[i] - lo[i]) for i in range(3))
         print("%-19s %5d %6d  %-24s %s%s" % (name, ntri, budget_, ext,
                                              " ".join("%s(%d)" % (k, per_mat[k]) for k in mats),
-                                             "  [within the unit box]" if lod1 else ""))
+                                             "  [within the unit box]" if coarse else ""))
         for e in errs[:10]:
             print("    ERROR: " + e)
         if errs:
             ok = False
     print("all checks passed" if ok else "CHECKS FAILED")
     return ok
+
+
+def report_levels(table):
+    """Prints the level-order errors of lod.json (check_levels); True if there are none."""
+    errs = check_levels(table)
+    for e in errs:
+        print("ERROR: lod.json levels: " + e)
+    return not errs
 
 
 def main(argv):
@@ -1405,6 +1453,7 @@ def main(argv):
                 if have != want:
                     stale.append(fn)
         ok = run_checks(outdir, meshes)
+        ok = report_levels(table) and ok
         for fn in stale:
             print("STALE: %s differs from what the script generates (regenerate)" % fn)
         return 0 if ok and not stale else 1
@@ -1417,7 +1466,8 @@ def main(argv):
         f.write(lod_json(table))
     print_lod_table(table)
     print()
-    return 0 if run_checks(outdir, meshes) else 1
+    ok = run_checks(outdir, meshes)
+    return 0 if report_levels(table) and ok else 1
 
 
 if __name__ == "__main__":
