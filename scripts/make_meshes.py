@@ -6,8 +6,8 @@
     /usr/bin/python3 scripts/make_meshes.py --out DIR  # write somewhere else
 
 Standard library only and deterministic: running it twice gives byte-identical files. Besides
-the fine meshes it writes one coarse level of detail of the heavy class meshes (<name>_lod1.obj,
-from the same builders with lod=1) and lod.json (an upper bound on each one's deviation).
+the fine meshes it writes one coarse level of detail of the class meshes (<name>_lod1.obj, from
+the same builders with lod=1) and lod.json (an upper bound on each one's deviation).
 
 Conventions (the renderer depends on them; see models/README.md):
 * triangles only, every face "f v//vn" with its own (flat) normal, counter-clockwise seen from
@@ -62,8 +62,9 @@ KD = {
 
 # Triangle budgets of the class meshes per level of detail (lod1: the coarse meshes; a mesh
 # name overrides its class). The pickup's open bed is three more boxes.
-LOD_BUDGET = {0: {"house": 400, "garage": 400, "tree": 400, "car": 400},
-              1: {"house": 150, "garage": 80, "tree": 150, "car": 200, "car_pickup": 230}}
+LOD_BUDGET = {0: {"house": 400, "garage": 400, "tree": 400, "car": 400, "fence": 400},
+              1: {"house": 150, "garage": 80, "tree": 150, "car": 200, "car_pickup": 230,
+                  "fence": 24, "tree_pine": 50}}
 
 
 def budget(name, cls, lod):
@@ -74,6 +75,11 @@ def budget(name, cls, lod):
 # the two-sided deviation of the lod1 canopy to the fine one (0.165 m; 0.314 m with the vertices
 # on the icosphere, scale 1.0). For a sphere the balance is 1.0777 (deviation 0.078 r).
 ICO_LOD_SCALE = 1.083
+
+# pine levels: trunk (sides, phase, radius scale), then per cone (sides, phase, radius scale);
+# chosen numerically (a small grid over phases and scales)
+LOD_PINE = {1: ((3, math.pi / 2, 1.33), [(10, 0.0, 1.0), (8, math.pi / 8, 1.02),
+                                         (6, math.pi / 12, 1.035)])}
 
 # ----------------------------------------------------------------------------------------------
 # Small vector helpers
@@ -580,9 +586,15 @@ def make_garage(name, doors, lod=0):
 # Fences: runs along x, every part spans the whole length (the renderer stretches x to 3-30 m)
 # except the two end posts.
 # ----------------------------------------------------------------------------------------------
-def make_fence_wood():
-    m = Mesh("fence_wood", 400, paint=(0.56, 0.40, 0.25))
+def make_fence_wood(lod=0):
+    """lod 1: one box (board panel, rails, trim board and posts are all paint), from the boards'
+    face to halfway between the boards' back and the posts' back, from halfway up the gap under
+    the boards."""
+    m = Mesh("fence_wood", budget("fence_wood", "fence", lod), paint=(0.56, 0.40, 0.25), lod=lod)
     hl, H = 5.0, 1.8
+    if lod:
+        m.box("paint", (-hl, -0.06, 0.025), (hl, 0.5 * (-0.035 + 0.06), H))
+        return m
     m.box("paint", (-hl, -0.06, 0.05), (hl, -0.035, H))              # board panel
     for z0 in (0.30, 1.38):                                          # two back rails
         m.box("paint", (-hl, -0.036, z0), (hl, 0.035, z0 + 0.10))
@@ -593,9 +605,18 @@ def make_fence_wood():
     return m
 
 
-def make_fence_vinyl():
-    m = Mesh("fence_vinyl", 400, paint=(0.95, 0.95, 0.93))
+def make_fence_vinyl(lod=0):
+    """lod 1: a paint box for panel, posts and bottom rail (halfway between the panel's and the
+    posts' thickness, from halfway up the bottom rail's gap) and a trim box for the cap rail
+    and post caps (the cap rail's width, up to halfway between their tops)."""
+    m = Mesh("fence_vinyl", budget("fence_vinyl", "fence", lod), paint=(0.95, 0.95, 0.93),
+             lod=lod)
     hl, H = 5.0, 1.8
+    if lod:
+        hw = 0.5 * (0.02 + 0.055)
+        m.box("paint", (-hl, -hw, 0.02), (hl, hw, 1.64))
+        m.box("trim", (-hl, -0.045, 1.62), (hl, 0.045, 0.5 * (1.72 + H)))
+        return m
     m.box("paint", (-hl, -0.02, 0.08), (hl, 0.02, 1.64))             # privacy panel
     m.box("trim", (-hl, -0.035, 0.04), (hl, 0.035, 0.14))             # bottom rail
     m.box("trim", (-hl, -0.045, 1.62), (hl, 0.045, 1.72))             # cap rail
@@ -606,9 +627,18 @@ def make_fence_vinyl():
     return m
 
 
-def make_fence_chain_link():
-    m = Mesh("fence_chain_link", 400, paint=(0.36, 0.37, 0.38))
+def make_fence_chain_link(lod=0):
+    """lod 1: a paint box for the mesh panel, wire and posts (halfway between the panel's and
+    the posts' thickness, from just under the wire) and a frame box for the top rail (up to
+    the posts' top)."""
+    m = Mesh("fence_chain_link", budget("fence_chain_link", "fence", lod),
+             paint=(0.36, 0.37, 0.38), lod=lod)
     hl, H = 5.0, 1.5
+    if lod:
+        hw = 0.5 * (0.006 + 0.06)
+        m.box("paint", (-hl, -hw, 0.015), (hl, hw, H - 0.07))
+        m.box("frame", (-hl, -hw, H - 0.07), (hl, hw, H))
+        return m
     m.box("paint", (-hl, -0.006, 0.04), (hl, 0.006, H - 0.06))        # mesh panel
     m.box("frame", (-hl, -0.025, H - 0.07), (hl, 0.025, H - 0.02))    # top rail
     m.box("frame", (-hl, -0.01, 0.03), (hl, 0.01, 0.06))              # bottom tension wire
@@ -651,17 +681,27 @@ def make_tree_deciduous(lod=0):
     return m
 
 
-def make_tree_pine():
-    m = Mesh("tree_pine", 400)
+def make_tree_pine(lod=0):
+    """lod 1: fewer trunk and cone sides (LOD_PINE: sides, phase and radius scale)."""
+    m = Mesh("tree_pine", budget("tree_pine", "tree", lod), lod=lod)
     m.kd_override["foliage"] = (0.13, 0.31, 0.16)
     D, H = 4.0, 10.0
     r = D / 2
-    m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22, 0.15, 8, phase=math.pi / 8)
+    if lod:
+        trunk, cones = LOD_PINE[lod]
+        n, ph, sc = trunk
+        m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22 * sc, 0.15 * sc, n, phase=ph)
+    else:
+        m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22, 0.15, 8, phase=math.pi / 8)
     # three stacked 12-sided cones; the bottom one has vertices on the axes (extent +-D/2)
-    for (zb, zt, rr, ph) in ((0.15 * H, 0.62 * H, r, 0.0),
-                             (0.38 * H, 0.82 * H, 0.78 * r, math.pi / 12),
-                             (0.60 * H, H, 0.55 * r, 0.0)):
-        m.cone("foliage", (0, 0, zb), (0, 0, zt), rr, 12, phase=ph)
+    for k, (zb, zt, rr, ph) in enumerate(((0.15 * H, 0.62 * H, r, 0.0),
+                                          (0.38 * H, 0.82 * H, 0.78 * r, math.pi / 12),
+                                          (0.60 * H, H, 0.55 * r, 0.0))):
+        if lod:
+            n, ph, sc = cones[k]
+            m.cone("foliage", (0, 0, zb), (0, 0, zt), rr * sc, n, phase=ph)
+        else:
+            m.cone("foliage", (0, 0, zb), (0, 0, zt), rr, 12, phase=ph)
     return m
 
 
@@ -879,11 +919,11 @@ CLASS_MESHES = [
     ("house_2", lambda lod: make_house("house_2", 2, lod), (1,)),
     ("garage_1", lambda lod: make_garage("garage_1", 1, lod), (1,)),
     ("garage_2", lambda lod: make_garage("garage_2", 2, lod), (1,)),
-    ("fence_wood", lambda lod: make_fence_wood(), ()),
-    ("fence_vinyl", lambda lod: make_fence_vinyl(), ()),
-    ("fence_chain_link", lambda lod: make_fence_chain_link(), ()),
+    ("fence_wood", make_fence_wood, (1,)),
+    ("fence_vinyl", make_fence_vinyl, (1,)),
+    ("fence_chain_link", make_fence_chain_link, (1,)),
     ("tree_deciduous", make_tree_deciduous, (1,)),
-    ("tree_pine", lambda lod: make_tree_pine(), ()),
+    ("tree_pine", make_tree_pine, (1,)),
 ] + [(name, lambda lod, name=name: make_car_named(name, lod), (1,)) for name in CARS] + [
     ("pedestrian", lambda lod: make_pedestrian(), ()),
     ("sentinel", lambda lod: make_sentinel(), ()),
@@ -1199,7 +1239,7 @@ def foliage_centre(m):
 
 
 def print_lod_table(table):
-    print("%-19s %5s %5s  %-9s %s" % ("level", "tris", "fine", "deviation",
+    print("%-21s %5s %5s  %-9s %s" % ("level", "tris", "fine", "deviation",
                                       "(design m; found at a sample .. bound, per surface)"))
     for fine, coarse, dev in table:
         extra = ""
@@ -1207,7 +1247,7 @@ def print_lod_table(table):
         if fc is not None:
             extra = "; canopy centre offset %s m" % " ".join("%+.4f" % (cc[i] - fc[i])
                                                              for i in range(3))
-        print("%-19s %5d %5d  %-9.3f %s%s" % (
+        print("%-21s %5d %5d  %-9.3f %s%s" % (
             coarse.name, ntris(coarse), ntris(fine), max_deviation(dev),
             ", ".join("%s %.4f .. %.4f" % (k, v[1], v[0]) for k, v in sorted(dev.items())),
             extra))
@@ -1380,7 +1420,7 @@ def run_checks(outdir, meshes=None):
     if names is None:
         names = sorted(f[:-4] for f in os.listdir(outdir) if f.endswith(".obj"))
     ok = True
-    print("%-19s %5s %6s  %-24s %s" % ("mesh", "tris", "budget", "extent (x y z)", "materials"))
+    print("%-21s %5s %6s  %-24s %s" % ("mesh", "tris", "budget", "extent (x y z)", "materials"))
     for name in names:
         normalized = name != "sentinel"
         base, _, level = name.partition("_lod")
@@ -1397,7 +1437,7 @@ def run_checks(outdir, meshes=None):
         if m is not None:
             errs += check_parts(m)
         ext = " ".join("%.3f" % (hi[i] - lo[i]) for i in range(3))
-        print("%-19s %5d %6d  %-24s %s%s" % (name, ntri, budget_, ext,
+        print("%-21s %5d %6d  %-24s %s%s" % (name, ntri, budget_, ext,
                                              " ".join("%s(%d)" % (k, per_mat[k]) for k in mats),
                                              "  [within the unit box]" if coarse else ""))
         for e in errs[:10]:
