@@ -6,14 +6,16 @@
     /usr/bin/python3 scripts/make_meshes.py --out DIR  # write somewhere else
 
 Standard library only and deterministic: running it twice gives byte-identical files. Besides
-the fine meshes it writes one coarse level of detail of the class meshes (<name>_lod1.obj, from
-the same builders with lod=1) and lod.json (an upper bound on each one's deviation).
+the fine meshes it writes coarse levels of detail of the class meshes (<name>_lod1.obj and, for
+the heaviest, <name>_lod2.obj, from the same builders with lod=1 or 2) and lod.json (an upper
+bound on each level's deviation from the fine mesh).
 
 Conventions (the renderer depends on them; see models/README.md):
 * triangles only, every face "f v//vn" with its own (flat) normal, counter-clockwise seen from
-  outside; every part is a closed convex solid (boxes, prisms, cylinders, cones, icospheres),
-  except the decals of lod1 meshes (the outer face of a thin slab alone: a planar convex polygon).
-* lod1 meshes are normalized with their fine mesh's bounds: they lie within the unit box.
+  outside; every part is a closed convex solid (boxes, prisms, cylinders, cones, icospheres;
+  at lod2 a few of them have faces of two materials), except the decals and sheets of coarse
+  meshes (one planar convex polygon seen from one side: a thin slab's outer face or mid-plane).
+* coarse meshes are normalized with their fine mesh's bounds: they lie within the unit box.
 * class meshes: x forward (heading), y left, z up, origin at the centre of the bottom face; the
   vertices span exactly [-0.5, 0.5] x [-0.5, 0.5] x [0, 1] (the renderer scales each axis by the
   entity's box). Each part is designed in metres at a typical real size, then normalized.
@@ -60,11 +62,12 @@ KD = {
 }
 
 
-# Triangle budgets of the class meshes per level of detail (lod1: the coarse meshes; a mesh
-# name overrides its class). The pickup's open bed is three more boxes.
+# Triangle budgets of the class meshes per level of detail (lod1, lod2: the coarse meshes; a
+# mesh name overrides its class). The pickup's open bed is three more boxes.
 LOD_BUDGET = {0: {"house": 400, "garage": 400, "tree": 400, "car": 400, "fence": 400},
               1: {"house": 150, "garage": 80, "tree": 150, "car": 200, "car_pickup": 230,
-                  "fence": 24, "tree_pine": 50}}
+                  "fence": 24, "tree_pine": 50},
+              2: {"house": 50, "garage": 30, "tree": 40, "car": 60, "tree_pine": 24}}
 
 
 def budget(name, cls, lod):
@@ -76,10 +79,39 @@ def budget(name, cls, lod):
 # on the icosphere, scale 1.0). For a sphere the balance is 1.0777 (deviation 0.078 r).
 ICO_LOD_SCALE = 1.083
 
-# pine levels: trunk (sides, phase, radius scale), then per cone (sides, phase, radius scale);
-# chosen numerically (a small grid over phases and scales)
+# lod2 canopy: per icosphere of the deciduous canopy (in make_tree_deciduous's order), a
+# polyhedron in the icosphere's unit frame (then scaled by its radii): ("octahedron", rotation,
+# vertex radii of its three axes) or ("bipyramid", sides, rotation, ring radius, pole radius,
+# ring phase); rotation (ax, ay, az): Rz(az) Ry(ay) Rx(ax), its columns the polyhedron's axes.
+# Found by a random search that minimised each one's sampled two-sided distance to its
+# icosphere, within the unit box (crown 0.43 m with a pentagonal bipyramid, 0.49 m with the best
+# octahedron found; the others 0.41-0.43 m).
+LOD2_CANOPY = [("bipyramid", 5, (0.9816, -0.4301, -0.3465), 1.1917, 1.1904, -1.1382),
+               ("octahedron", (-0.5765, 0.9542, 0.5369), (1.2271, 1.2206, 1.2574)),
+               ("octahedron", (-0.3875, 0.7604, 0.325), (1.22, 1.22, 1.22)),
+               ("octahedron", (-0.3875, 0.7604, 0.325), (1.22, 1.22, 1.22))]
+
+# lod2 roof sheets (houses, garages): the roof slab collapsed to one plane per slope, this
+# fraction of the slab thickness below its top at the ridge and at the eaves (the ridge cap
+# stands above the ridge, the fascia hangs below the eaves).
+LOD2_ROOF_SHEET = (0.32, 0.625)
+# lod2 cars: the body's front and rear faces move this far inside the bumpers' outer faces
+# (halfway through the 0.2 m bumpers, which are dropped), and the cabin's bottom reaches this
+# far below the simplified body's top (so that no crack opens between them).
+LOD2_BUMPER_INSET = 0.1
+LOD2_CABIN_SINK = 0.02
+# lod2 trunks (deciduous, pine): a triangular pyramid, base corner radius / the fine trunk's
+# base radius, apex height / the fine trunk's height
+LOD2_TRUNK = (1.33, 1.0)
+# pine levels: trunk (sides, phase, radius scale; None: lod2_trunk), then per cone (sides,
+# phase, radius scale); chosen numerically (a small grid over phases and scales)
 LOD_PINE = {1: ((3, math.pi / 2, 1.33), [(10, 0.0, 1.0), (8, math.pi / 8, 1.02),
-                                         (6, math.pi / 12, 1.035)])}
+                                         (6, math.pi / 12, 1.035)]),
+            2: (None, [(4, math.pi / 4, 1.15), (4, 0.0, 1.15), (4, math.pi / 4, 1.15)])}
+# lod2 cars that keep their mirrors (as sheets on the mirrors' mid-planes, facing out)
+LOD2_MIRRORS = ("car_sedan", "car_suv", "car_hatchback", "car_van")
+# lod2 wheels: square sheets on the tyre's two faces, half-size / tyre radius
+LOD2_WHEEL = 0.9
 
 # ----------------------------------------------------------------------------------------------
 # Small vector helpers
@@ -136,7 +168,8 @@ def rnd(v):
 
 # ----------------------------------------------------------------------------------------------
 # Mesh: a list of parts; each part is one closed convex solid of one material (or, lod > 0, a
-# decal: the outer face of a thin slab alone).
+# decal or sheet: one planar convex polygon seen from one side). A closed convex solid with faces
+# of two materials (lod2) is one part per material, tied together in `groups`.
 # ----------------------------------------------------------------------------------------------
 class Mesh:
     def __init__(self, name, budget, normalized=True, paint=(0.8, 0.8, 0.8), lod=0):
@@ -149,6 +182,7 @@ class Mesh:
         self.kd_override = {}
         self.parts = []  # (material, [triangles (p0, p1, p2)])
         self.decals = {}  # part index -> a point behind the decal (centre of the solid it replaces)
+        self.groups = {}  # part index -> index of the first part of its multi-material solid
         self.bounds_from = None  # lod > 0: the fine Mesh whose design bounds normalize this one
 
     # -- the one primitive everything is built from -------------------------------------------
@@ -160,6 +194,39 @@ class Mesh:
         for poly in polygons:
             tris += outward_fan(poly, c)
         self.parts.append((mat, tris))
+
+    def solid_mats(self, mats, polygons):
+        """A closed convex solid whose face polygons[i] has material mats[i] (one part per
+        material, in order of first use, checked together as one solid)."""
+        c = centroid([p for poly in polygons for p in poly])
+        first = len(self.parts)
+        for mat in [mt for i, mt in enumerate(mats) if mt not in mats[:i]]:
+            tris = []
+            for mt, poly in zip(mats, polygons):
+                if mt == mat:
+                    tris += outward_fan(poly, c)
+            self.groups[len(self.parts)] = first
+            self.parts.append((mat, tris))
+
+    def sheet(self, mat, poly, behind):
+        """Level of detail > 0: one planar convex polygon facing away from the point `behind`
+        (the centre of what it stands for): a thin slab's outer face (a decal) or mid-plane, or a
+        face of a part whose other faces are dropped. Seen from behind it is culled."""
+        self.decals[len(self.parts)] = behind
+        self.parts.append((mat, outward_fan(poly, behind)))
+
+    def box_sheet(self, mat, lo, hi, face, frac):
+        """A sheet parallel to the box face `face` ("x"|"y"|"z", +1|-1), `frac` of the box's
+        thickness out from the opposite face (0.5: the mid-plane; 1: the face itself), facing
+        that way."""
+        axis, sg = face
+        i = "xyz".index(axis)
+        poly = box_faces(lo, hi, (self.name, mat))[BOX_FACE[face]]
+        w = lo[i] + (hi[i] - lo[i]) * (frac if sg > 0 else 1.0 - frac)
+        poly = [tuple(w if j == i else p[j] for j in range(3)) for p in poly]
+        behind = [0.5 * (lo[j] + hi[j]) for j in range(3)]
+        behind[i] = lo[i] if sg > 0 else hi[i]
+        self.sheet(mat, poly, tuple(behind))
 
     def decal(self, mat, polygons, k):
         """Level of detail > 0: instead of the closed convex solid `polygons` (a thin slab on a
@@ -228,12 +295,14 @@ class Mesh:
 
         self.hexa(mat, quad(a, wa, ha), quad(b, wb, hb))
 
-    def ellipsoid(self, mat, c, radii):
+    def ellipsoid(self, mat, c, radii, lod2_shape=None):
         """Icosphere (one subdivision, 80 triangles) scaled to the radii; it has vertices on
-        the six axis points, so its extents are exactly c +- radii. Level of detail > 0: the
-        base icosahedron (20 triangles) scaled by ICO_LOD_SCALE (extents +-0.8507 * that)."""
+        the six axis points, so its extents are exactly c +- radii. Level of detail 1: the
+        base icosahedron (20 triangles) scaled by ICO_LOD_SCALE (extents +-0.8507 * that);
+        2: the polyhedron lod2_shape (see LOD2_CANOPY)."""
         faces = []
-        for tri in (icosahedron(ICO_LOD_SCALE) if self.lod else icosphere1()):
+        for tri in (unit_polyhedron(lod2_shape) if self.lod >= 2 else
+                    icosahedron(ICO_LOD_SCALE) if self.lod else icosphere1()):
             faces.append([add(c, (p[0] * radii[0], p[1] * radii[1], p[2] * radii[2]))
                           for p in tri])
         self.solid(mat, faces)
@@ -414,6 +483,32 @@ def icosahedron(scale):
     return [tuple(mul(vs[i], scale) for i in f) for f in fs]
 
 
+def rotation_axes(ax, ay, az):
+    """The columns of Rz(az) Ry(ay) Rx(ax)."""
+    cx, sx, cy, sy, cz, sz = (math.cos(ax), math.sin(ax), math.cos(ay), math.sin(ay),
+                              math.cos(az), math.sin(az))
+    r = [[cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx],
+         [sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx],
+         [-sy, cy * sx, cy * cx]]
+    return [(r[0][k], r[1][k], r[2][k]) for k in range(3)]
+
+
+def unit_polyhedron(shape):
+    """Triangles of a LOD2_CANOPY polyhedron (unit frame, any winding)."""
+    if shape[0] == "octahedron":
+        _, angles, radii = shape
+        vs = []
+        for d, r in zip(rotation_axes(*angles), radii):
+            vs += [mul(d, r), mul(d, -r)]
+        return [(vs[i], vs[j], vs[k]) for i in (0, 1) for j in (2, 3) for k in (4, 5)]
+    _, n, angles, r_ring, r_pole, phase = shape
+    u, v, w = rotation_axes(*angles)
+    ring = [add(mul(u, r_ring * math.cos(phase + 2 * math.pi * k / n)),
+                mul(v, r_ring * math.sin(phase + 2 * math.pi * k / n))) for k in range(n)]
+    return [(ring[k], ring[(k + 1) % n], mul(w, sg * r_pole)) for sg in (1.0, -1.0)
+            for k in range(n)]
+
+
 def icosphere1():
     global _ICO
     if _ICO is None:
@@ -451,7 +546,9 @@ def sub_quad(A, B, C, D, u0, u1, v0, v1):
 # ----------------------------------------------------------------------------------------------
 def gable_building(m, along, half_across_wall, half_along_wall, half_across_roof, half_along_roof,
                    wall_h, height, roof_t, fascia=0.04, ridge_cap=True):
-    """lod > 0: the fascia boards become decals on their outer (eave) faces, no ridge cap."""
+    """lod 1: the fascia boards become decals on their outer (eave) faces, no ridge cap.
+    lod 2: each roof slab and its fascia become one sheet from the ridge to the eaves,
+    LOD2_ROOF_SHEET of the slab's thickness below its top (no fascia, no ridge cap)."""
     def P(a, b, z):  # (across, along, z) -> (x, y, z)
         return (a, b, z) if along == "y" else (b, a, z)
 
@@ -462,6 +559,13 @@ def gable_building(m, along, half_across_wall, half_along_wall, half_across_roof
     prof = [(-wa, 0.0), (wa, 0.0), (wa, wall_h), (0.0, ridge_under), (-wa, wall_h)]
     m.extrude("paint", [P(a, -wb, z) for a, z in prof], P(0.0, 2 * wb, 0.0))
     ra, rb = half_across_roof, half_along_roof
+    if m.lod >= 2:
+        z_ridge = height - LOD2_ROOF_SHEET[0] * roof_t
+        z_eave = height - s * ra - LOD2_ROOF_SHEET[1] * roof_t
+        for sg in (-1.0, 1.0):
+            m.sheet("roof", [P(0.0, -rb, z_ridge), P(sg * ra, -rb, z_eave), P(sg * ra, rb, z_eave),
+                             P(0.0, rb, z_ridge)], P(0.0, 0.0, 0.0))
+        return s
     slab_end = ra - fascia
     for sg in (-1.0, 1.0):
         def top(a):
@@ -502,7 +606,32 @@ def wall_slab(m, mat, face, center, w, z0, z1, proud, inset=0.03):
         m.box_or_decal(mat, (center - w / 2, lo_o, z0), (center + w / 2, hi_o, z1), (axis, sg))
 
 
+# lod2 windows: per (wall, row), groups of windows (indices into that row's list) each drawn as
+# ONE decal of the same total area (width: the group's window widths added up, centred on the
+# mean of their centres, the row's height); a window in no group is dropped. Rows are merged
+# where the gaps are about a window width (house_1); house_2 (19 windows, 12 triangles left for
+# them) keeps one band per storey and wall where it can and drops its front's lone downstairs
+# window and its gable ends' upstairs windows.
+LOD2_WINDOWS = {
+    "house_1": {("front", 0): [(0,), (1, 2)], ("back", 0): [(0, 1, 2, 3)],
+                ("left", 0): [(0,), (1,)], ("right", 0): [(0,), (1,)]},
+    "house_2": {("front", 0): [(1, 2)], ("front", 1): [(0, 1, 2, 3)],
+                ("back", 0): [(0, 1, 2)], ("back", 1): [(0, 1, 2)],
+                ("left", 0): [(0, 1)], ("right", 0): [(0, 1)]},
+}
+
+
+def house_windows(storeys, ri):
+    """Window centres along the wall of row ri: front (y), back (y), gable ends (x)."""
+    fy = [-3.5, 1.3, 3.5] if ri == 0 else [-3.5, -0.9, 1.3, 3.5]  # beside/above the door
+    by = [-3.6, -1.2, 1.2, 3.6] if storeys == 1 else [-3.3, 0.0, 3.3]
+    sx = [-2.2, 2.2] if ri == 0 else [0.0]
+    return fy, by, sx
+
+
 def make_house(name, storeys, lod=0):
+    """lod 2: walls, roof sheets, the lod1 chimney, the door and merged window decals, the
+    step and house_2's belt course as sheets at mid-height (no trim, no corner boards)."""
     m = Mesh(name, budget(name, "house", lod), paint=(0.86, 0.82, 0.70), lod=lod)
     L, W = 10.0, 11.0
     H = 5.2 if storeys == 1 else 8.0
@@ -514,33 +643,45 @@ def make_house(name, storeys, lod=0):
     left, right = ("y", wy, 1.0), ("y", -wy, -1.0)
     # front door, its frame and a step (door faces the street, -x)
     door_y = -0.9
-    wall_slab(m, "trim", front, door_y, 1.3, 0.15, 2.35, 0.03)
+    step = ((-rx, door_y - 0.85, 0.0), (-wx + 0.01, door_y + 0.85, 0.18))
+    if lod < 2:
+        wall_slab(m, "trim", front, door_y, 1.3, 0.15, 2.35, 0.03)
     wall_slab(m, "door", front, door_y, 1.0, 0.18, 2.25, 0.06)
-    m.box("trim", (-rx, door_y - 0.85, 0.0), (-wx + 0.01, door_y + 0.85, 0.18))
+    if lod < 2:
+        m.box("trim", *step)
+    else:
+        m.box_sheet("trim", step[0], step[1], ("z", 1), 0.5)
     rows = [(0.9, 2.2)] if storeys == 1 else [(0.95, 2.25), (3.75, 5.0)]
     win_w = 1.2
     for ri, (z0, z1) in enumerate(rows):
-        # front: windows beside the door (and above it upstairs)
-        fy = [-3.5, 1.3, 3.5] if ri == 0 else [-3.5, -0.9, 1.3, 3.5]
+        fy, by, sx = house_windows(storeys, ri)
+        if lod >= 2:
+            for wall, face, cs in (("front", front, fy), ("back", back, by), ("left", left, sx),
+                                   ("right", right, sx)):
+                for group in LOD2_WINDOWS[name].get((wall, ri), []):
+                    c = sum(cs[i] for i in group) / len(group)
+                    wall_slab(m, "window", face, c, win_w * len(group), z0, z1, 0.045)
+            continue
         for y in fy:
             if storeys == 1:  # one-storey: trimmed front windows
                 wall_slab(m, "trim", front, y, win_w + 0.2, z0 - 0.12, z1 + 0.1, 0.025)
             wall_slab(m, "window", front, y, win_w, z0, z1, 0.045)
-        by = [-3.6, -1.2, 1.2, 3.6] if storeys == 1 else [-3.3, 0.0, 3.3]
         for y in by:
             wall_slab(m, "window", back, y, win_w, z0, z1, 0.045)
-        sx = [-2.2, 2.2] if ri == 0 else [0.0]
         for x in sx:
             wall_slab(m, "window", left, x, win_w, z0, z1, 0.045)
             wall_slab(m, "window", right, x, win_w, z0, z1, 0.045)
-    if storeys == 1:  # corner boards
+    belt = ((-wx - 0.04, -wy - 0.04, 2.75), (wx + 0.04, wy + 0.04, 2.95))
+    if storeys == 1 and lod < 2:  # corner boards
         for sx_ in (-1, 1):
             for sy_ in (-1, 1):
                 x0, x1 = sorted((sx_ * (wx + 0.05), sx_ * (wx - 0.18)))
                 y0, y1 = sorted((sy_ * (wy + 0.05), sy_ * (wy - 0.18)))
                 m.box("trim", (x0, y0, 0.0), (x1, y1, wall_h - 0.02))
-    else:  # belt course between the storeys
-        m.box("trim", (-wx - 0.04, -wy - 0.04, 2.75), (wx + 0.04, wy + 0.04, 2.95))
+    elif storeys != 1 and lod < 2:  # belt course between the storeys
+        m.box("trim", *belt)
+    elif storeys != 1:  # (lod2: its mid-plane; its top and bottom run through the whole house)
+        m.box_sheet("trim", belt[0], belt[1], ("z", 1), 0.5)
     # chimney on the back slope, through the ridge height, with a cap
     cx0, cx1, cy0, cy1 = 1.3, 2.0, 3.0, 3.8
     z_in = H - s * cx1 - 0.6
@@ -554,6 +695,7 @@ def make_house(name, storeys, lod=0):
 
 
 def make_garage(name, doors, lod=0):
+    """lod 2: walls, roof sheets, the lod1 door, garage door and window decals, no trim."""
     m = Mesh(name, budget(name, "garage", lod), paint=(0.86, 0.82, 0.70), lod=lod)
     L = 6.7
     W = 3.9 if doors == 1 else 6.6
@@ -566,7 +708,8 @@ def make_garage(name, doors, lod=0):
     gap, dz, nslab = 0.035, 2.2, 4
     sh = (dz - gap * (nslab - 1)) / nslab
     for yc in centres:
-        wall_slab(m, "trim", front, yc, door_w + 0.16, 0.0, dz + 0.1, 0.03)
+        if lod < 2:
+            wall_slab(m, "trim", front, yc, door_w + 0.16, 0.0, dz + 0.1, 0.03)
         if lod:  # one decal over the panels (the 3.5 cm gaps between them are sub-pixel)
             wall_slab(m, "garage_door", front, yc, door_w, 0.01, dz, 0.07)
             continue
@@ -575,7 +718,8 @@ def make_garage(name, doors, lod=0):
             wall_slab(m, "garage_door", front, yc, door_w, z0 + (0.01 if k == 0 else 0.0),
                       z0 + sh, 0.07)
     # side door near the back and a window on the +y wall, a window on the back wall
-    wall_slab(m, "trim", ("y", wy, 1.0), 1.9, 1.05, 0.0, 2.15, 0.03)
+    if lod < 2:
+        wall_slab(m, "trim", ("y", wy, 1.0), 1.9, 1.05, 0.0, 2.15, 0.03)
     wall_slab(m, "door", ("y", wy, 1.0), 1.9, 0.9, 0.01, 2.05, 0.06)
     wall_slab(m, "window", ("y", wy, 1.0), -0.8, 1.0, 1.1, 1.9, 0.045)
     wall_slab(m, "window", ("x", wx, 1.0), 0.0, 1.0, 1.1, 1.9, 0.045)
@@ -652,10 +796,15 @@ def make_fence_chain_link(lod=0):
 # Trees
 # ----------------------------------------------------------------------------------------------
 def make_tree_deciduous(lod=0):
+    """lod 1: square trunk, triangular branches, icosahedra. lod 2: a triangular pyramid trunk
+    (lod2_trunk), each branch one triangle (a sheet through its axis, facing up), the canopy
+    an octahedron or bipyramid per icosphere (LOD2_CANOPY)."""
     m = Mesh("tree_deciduous", budget("tree_deciduous", "tree", lod), lod=lod)
     D, H = 5.0, 9.0
     r_tr = 0.06 * D / math.cos(math.pi / 8)   # octagon across flats = 12% of the width
-    if lod:  # square trunk with the octagon's corner radius
+    if lod >= 2:
+        lod2_trunk(m, 0.45 * H * LOD2_TRUNK[1], r_tr * LOD2_TRUNK[0])
+    elif lod:  # square trunk with the octagon's corner radius
         m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), r_tr, r_tr * 0.8, 4, phase=math.pi / 4)
     else:
         m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), r_tr, r_tr * 0.8, 8, phase=math.pi / 8)
@@ -664,7 +813,13 @@ def make_tree_deciduous(lod=0):
         a = math.radians(ang)
         d = (math.cos(a), math.sin(a), 0.0)
         tip = (reach * d[0], reach * d[1], z1)
-        if lod:  # triangular, with the square beam's corner radius
+        if lod >= 2:
+            side = (-d[1] * 0.11, d[0] * 0.11, 0.0)
+            base = (0.0, 0.0, z0)
+            up = unit(cross(sub(tip, base), side))
+            m.sheet("trunk", [sub(base, side), add(base, side), tip],
+                    sub(lerp(base, tip, 0.5), mul(up, 0.1)))
+        elif lod:  # triangular, with the square beam's corner radius
             m.frustum("trunk", (0.0, 0.0, z0), tip, 0.11 * math.sqrt(2.0), 0.06 * math.sqrt(2.0), 3,
                       u_hint=(-d[1], d[0], 0.0))
         else:
@@ -676,21 +831,34 @@ def make_tree_deciduous(lod=0):
              ((1.05, 0.30, 5.4), (h - 1.05, 1.45, 1.9)),     # max x
              ((-0.15, 1.10, 5.25), (1.40, h - 1.10, 1.85)),  # max y
              ((0.25, -1.05, 5.0), (1.45, h - 1.05, 1.85))]   # min y, bottom (3.15 = 35%)
-    for c, r in blobs:
-        m.ellipsoid("foliage", c, r)
+    for (c, r), shape in zip(blobs, LOD2_CANOPY):
+        m.ellipsoid("foliage", c, r, shape)
     return m
 
 
+def lod2_trunk(m, height, r):
+    """A triangular pyramid standing on the ground, base corner radius r, as three side sheets
+    facing out (its base would lie on the ground, never seen)."""
+    base = [(r * math.cos(math.pi / 2 + 2 * math.pi * k / 3),
+             r * math.sin(math.pi / 2 + 2 * math.pi * k / 3), 0.0) for k in range(3)]
+    for k in range(3):
+        m.sheet("trunk", [base[k], base[(k + 1) % 3], (0.0, 0.0, height)], (0.0, 0.0, height / 3))
+
+
 def make_tree_pine(lod=0):
-    """lod 1: fewer trunk and cone sides (LOD_PINE: sides, phase and radius scale)."""
+    """lod 1, 2: fewer trunk and cone sides (LOD_PINE: sides, phase and radius scale); lod 2:
+    the trunk a triangular pyramid (lod2_trunk)."""
     m = Mesh("tree_pine", budget("tree_pine", "tree", lod), lod=lod)
     m.kd_override["foliage"] = (0.13, 0.31, 0.16)
     D, H = 4.0, 10.0
     r = D / 2
     if lod:
         trunk, cones = LOD_PINE[lod]
-        n, ph, sc = trunk
-        m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22 * sc, 0.15 * sc, n, phase=ph)
+        if trunk is None:
+            lod2_trunk(m, 0.45 * H * LOD2_TRUNK[1], 0.22 * LOD2_TRUNK[0])
+        else:
+            n, ph, sc = trunk
+            m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22 * sc, 0.15 * sc, n, phase=ph)
     else:
         m.frustum("trunk", (0, 0, 0), (0, 0, 0.45 * H), 0.22, 0.15, 8, phase=math.pi / 8)
     # three stacked 12-sided cones; the bottom one has vertices on the axes (extent +-D/2)
@@ -709,10 +877,32 @@ def make_tree_pine(lod=0):
 # Cars. Body: a convex side profile (x, z) extruded across the width; cabin: a tapered
 # hexahedron; glass slabs on the cabin faces; 10-sided wheels touching z = 0.
 # ----------------------------------------------------------------------------------------------
+def lod2_body(spec):
+    """The lod2 car body profile: a quadrilateral. Its front and rear faces are
+    LOD2_BUMPER_INSET inside the bumpers' outer faces (unless the body ends before that: the
+    pickup's cab); their tops lie on the hood line (profile points 3-4) and the deck line (4-5)
+    extended, so the nose and tail chamfers and the cowl (point 4) are cut straight."""
+    body, L = spec["body"], spec["L"]
+    zb = min(z for _, z in body)
+    xf = min(max(x for x, _ in body), L / 2 - LOD2_BUMPER_INSET)
+    xr = max(min(x for x, _ in body), -L / 2 + LOD2_BUMPER_INSET)
+
+    def line_z(a, b, x):
+        return a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0])
+
+    return [(xr, zb), (xf, zb), (xf, line_z(body[3], body[4], xf)),
+            (xr, line_z(body[4], body[5], xr))]
+
+
 def make_car(name, spec, lod=0):
+    """lod 2: the body a quadrilateral prism (lod2_body), the cabin with glass sides and a paint
+    roof, each wheel a square sheet on both tyre faces; no glass slabs, bumpers, lights,
+    mirrors (unless LOD2_MIRRORS: a sheet on each one's mid-plane) or roof rails."""
     m = Mesh(name, budget(name, "car", lod), paint=(0.72, 0.12, 0.10), lod=lod)
     L, W = spec["L"], spec["W"]
     hb = W / 2 - 0.05            # body half-width (mirrors reach W/2)
+    if lod >= 2:
+        return make_car_lod2(m, spec, hb)
     body = spec["body"]
     m.extrude("paint", [(x, -hb, z) for x, z in body], (0.0, 2 * hb, 0.0))
     for x0, x1, z0, z1 in spec.get("extra_body", []):
@@ -773,6 +963,40 @@ def make_car(name, spec, lod=0):
     return m
 
 
+def make_car_lod2(m, spec, hb):
+    """make_car's lod 2 (see there); hb: the body's half-width."""
+    L, W = spec["L"], spec["W"]
+    body = lod2_body(spec)
+    m.extrude("paint", [(x, -hb, z) for x, z in body], (0.0, 2 * hb, 0.0))
+    for x0, x1, z0, z1 in spec.get("extra_body", []):
+        m.box("paint", (max(x0, -L / 2 + LOD2_BUMPER_INSET), -hb, z0),
+              (min(x1, L / 2 - LOD2_BUMPER_INSET), hb, z1))
+    # cabin: glass sides, paint roof; its bottom lowered to LOD2_CABIN_SINK below the body's
+    # (straight) top under it
+    (xr0, xf0, z0, hw0), (xr1, xf1, z1, hw1) = spec["cabin"]
+    (_, _), (_, _), (xf, zf), (xr, zr) = body
+    zc = min(z0, min(zf + (zr - zf) * (x - xf) / (xr - xf) for x in (xr0, xf0)) - LOD2_CABIN_SINK)
+    cb = [(xr0, -hw0, zc), (xf0, -hw0, zc), (xf0, hw0, zc), (xr0, hw0, zc)]
+    ct = [(xr1, -hw1, z1), (xf1, -hw1, z1), (xf1, hw1, z1), (xr1, hw1, z1)]
+    m.solid_mats(["paint", "paint", "glass", "glass", "glass", "glass"], hexa_faces(cb, ct))
+    # wheels: a square sheet on each tyre face, facing away from the tyre's centre
+    r, tw = spec["wheel_r"], 0.23
+    yo = W / 2 - 0.03
+    a = LOD2_WHEEL * r
+    for xw in spec["wheel_x"]:
+        for sg in (-1.0, 1.0):
+            c = (xw, sg * (yo - tw / 2), r)
+            for y in (sg * yo, sg * (yo - tw)):
+                m.sheet("tire", [(xw - a, y, r - a), (xw + a, y, r - a), (xw + a, y, r + a),
+                                 (xw - a, y, r + a)], c)
+    if m.base in LOD2_MIRRORS:
+        mx, mz = spec["mirror"]
+        for sg in (-1.0, 1.0):
+            y0, y1 = sorted((sg * (hw0 - 0.06), sg * W / 2))
+            m.box_sheet("paint", (mx - 0.07, y0, mz), (mx + 0.07, y1, mz + 0.13), ("y", sg), 0.5)
+    return m
+
+
 CARS = {
     "car_sedan": dict(
         L=4.9, W=1.85,
@@ -823,12 +1047,19 @@ CARS = {
 
 
 def make_pickup_bed(m):
-    """Open bed of the pickup: side walls and tailgate on the chassis (bed floor z = 0.85)."""
+    """Open bed of the pickup: side walls and tailgate on the chassis (bed floor z = 0.85).
+    lod 2: each wall a sheet on its mid-plane, facing out of the bed."""
     hb = 2.05 / 2 - 0.05
     for sg in (-1.0, 1.0):
         y0, y1 = sorted((sg * (hb - 0.09), sg * hb))
-        m.box("paint", (-2.91, y0, 0.84), (-0.70, y1, 1.24))
-    m.box("paint", (-2.91, -hb + 0.08, 0.84), (-2.82, hb - 0.08, 1.21))
+        if m.lod >= 2:
+            m.box_sheet("paint", (-2.91, y0, 0.84), (-0.70, y1, 1.24), ("y", sg), 0.5)
+        else:
+            m.box("paint", (-2.91, y0, 0.84), (-0.70, y1, 1.24))
+    if m.lod >= 2:
+        m.box_sheet("paint", (-2.91, -hb + 0.08, 0.84), (-2.82, hb - 0.08, 1.21), ("x", -1), 0.5)
+    else:
+        m.box("paint", (-2.91, -hb + 0.08, 0.84), (-2.82, hb - 0.08, 1.21))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -915,16 +1146,16 @@ def make_car_named(name, lod):
 
 # (class mesh, builder(lod), its coarse levels), in the order of the files and of lod.json
 CLASS_MESHES = [
-    ("house_1", lambda lod: make_house("house_1", 1, lod), (1,)),
-    ("house_2", lambda lod: make_house("house_2", 2, lod), (1,)),
-    ("garage_1", lambda lod: make_garage("garage_1", 1, lod), (1,)),
-    ("garage_2", lambda lod: make_garage("garage_2", 2, lod), (1,)),
+    ("house_1", lambda lod: make_house("house_1", 1, lod), (1, 2)),
+    ("house_2", lambda lod: make_house("house_2", 2, lod), (1, 2)),
+    ("garage_1", lambda lod: make_garage("garage_1", 1, lod), (1, 2)),
+    ("garage_2", lambda lod: make_garage("garage_2", 2, lod), (1, 2)),
     ("fence_wood", make_fence_wood, (1,)),
     ("fence_vinyl", make_fence_vinyl, (1,)),
     ("fence_chain_link", make_fence_chain_link, (1,)),
-    ("tree_deciduous", make_tree_deciduous, (1,)),
-    ("tree_pine", make_tree_pine, (1,)),
-] + [(name, lambda lod, name=name: make_car_named(name, lod), (1,)) for name in CARS] + [
+    ("tree_deciduous", make_tree_deciduous, (1, 2)),
+    ("tree_pine", make_tree_pine, (1, 2)),
+] + [(name, lambda lod, name=name: make_car_named(name, lod), (1, 2)) for name in CARS] + [
     ("pedestrian", lambda lod: make_pedestrian(), ()),
     ("sentinel", lambda lod: make_sentinel(), ()),
 ]
@@ -1302,13 +1533,21 @@ def check_decal(pi, mat, tris, behind):
 
 
 def check_parts(m):
-    """In-memory checks on the final (normalized, rounded) parts: closed, outward, convex;
-    decal parts (lod > 0): planar convex polygons facing outward."""
+    """In-memory checks on the final (normalized, rounded) parts: closed, outward, convex
+    (the parts of a multi-material solid together); decal and sheet parts (lod > 0): planar
+    convex polygons facing outward."""
     errs = []
+    solids = {}
     for pi, (mat, tris) in enumerate(m.final):
         if pi in m.final_decals:
             errs += check_decal(pi, mat, tris, m.final_decals[pi])
             continue
+        g = m.groups.get(pi, pi)
+        if g in solids:
+            solids[g] = (solids[g][0] + "+" + mat, solids[g][1] + tris)
+        else:
+            solids[g] = (mat, list(tris))
+    for pi, (mat, tris) in sorted(solids.items()):
         pts = [p for t in tris for p in t]
         c = centroid(pts)
         edges = {}
