@@ -38,7 +38,7 @@ double cpuSeconds() {
 
 struct Stages {
   double cull = 0, draw = 0, post = 0, readback = 0, boxes = 0;
-  double triangles = 0, instances = 0, lod_instances = 0, boxes_count = 0;
+  double triangles = 0, instances = 0, lod_instances = 0, boxes_count = 0, box_groups = 0;
 };
 
 // The requests of frame set i of n: the UAV on the perception path, from the end of the climb to
@@ -143,6 +143,7 @@ int main(int argc, char** argv) {
         x.triangles += static_cast<double>(s.triangles);
         x.instances += static_cast<double>(s.instances);
         x.lod_instances += static_cast<double>(s.lod_instances);
+        x.box_groups += static_cast<double>(s.box_groups);
         x.boxes_count += static_cast<double>(out[c].boxes.size());
       }
     };
@@ -158,17 +159,17 @@ int main(int argc, char** argv) {
         "per frame set)\n",
         kModes[mode], frames, wall, frames / wall, 1e3 * wall / frames, 1e3 * cpu / frames);
     if (mode == 2) {
-      std::printf("  per frame (ms):  %12s %8s %8s %10s %8s %8s | %9s %9s %7s %6s\n", "cull/upload",
+      std::printf("  per frame (ms):  %12s %8s %8s %10s %8s %8s | %9s %9s %7s %6s %6s\n", "cull/upload",
                   "draw", "post", "readback", "boxes", "total", "triangles", "instances", "coarse",
-                  "boxes");
+                  "boxes", "groups");
       for (std::size_t c = 0; c < per_camera.size(); ++c) {
         const Stages& st = per_camera[c];
         const double total = st.cull + st.draw + st.post + st.readback + st.boxes;
-        std::printf("  %-16s %12.2f %8.2f %8.2f %10.2f %8.2f %8.2f | %9.0f %9.0f %7.0f %6.1f\n",
+        std::printf("  %-16s %12.2f %8.2f %8.2f %10.2f %8.2f %8.2f | %9.0f %9.0f %7.0f %6.1f %6.1f\n",
                     cfg.uav.cameras[c].name.c_str(), st.cull / frames, st.draw / frames,
                     st.post / frames, st.readback / frames, st.boxes / frames, total / frames,
                     st.triangles / frames, st.instances / frames, st.lod_instances / frames,
-                    st.boxes_count / frames);
+                    st.boxes_count / frames, st.box_groups / frames);
       }
     }
   }

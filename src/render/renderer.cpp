@@ -1033,6 +1033,7 @@ struct Renderer::Impl {
       }
       groups = std::max(groups, box_group[a] + 1);
     }
+    f.stats.box_groups = static_cast<std::size_t>(groups);
     setFrameUniforms(f);
     glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
     glViewport(0, 0, t.width, t.height);
@@ -1218,6 +1219,7 @@ struct Renderer::Impl {
       stats.boxes_ms += f.stats.boxes_ms;
       stats.instances += f.stats.instances;
       stats.lod_instances += f.stats.lod_instances;
+      stats.box_groups += f.stats.box_groups;
       stats.triangles += f.stats.triangles;
       stats.draw_calls += f.stats.draw_calls;
       f.request = nullptr;

@@ -174,17 +174,23 @@ LodView::LodView(const RenderRequest& r, double max_error)
   max_angle = std::atan(std::sqrt(tx * tx + ty * ty));
 }
 
-bool LodView::coarse(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const {
-  if (max_error_px <= 0 || si.lod_deviation < 0) return false;
+int LodView::level(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const {
+  if (max_error_px <= 0 || si.lod_levels == 0) return 0;
   const Eigen::Vector3d v = center.cast<double>() - eye;
   const double z = v.dot(axis);
   const double z_min = z - radius;
-  if (z_min <= 0) return false;
+  if (z_min <= 0) return 0;
   const double dist = v.norm();
   const double lateral = std::sqrt(std::max(0.0, dist * dist - z * z));
   const double angle = std::min(std::atan2(lateral, z) + std::asin(std::min(1.0, radius / dist)),
                                 max_angle);
-  return focal * si.lod_deviation <= max_error_px * z_min * std::cos(angle);
+  // Deviations grow with the level: the last one within the budget.
+  const double budget = max_error_px * z_min * std::cos(angle) / focal;
+  int level = 0;
+  while (level < si.lod_levels && si.lod_deviation[static_cast<std::size_t>(level)] <= budget) {
+    ++level;
+  }
+  return level;
 }
 
 int Scene::addModel(Mesh mesh) {
@@ -194,8 +200,8 @@ int Scene::addModel(Mesh mesh) {
 
 void Scene::loadLods(const std::string& dir,
                      const std::unordered_map<std::string, int>& file_model) {
-  lod_model_.assign(models_.size(), -1);
-  lod_axis_error_.assign(models_.size(), Eigen::Vector3f::Zero());
+  lod_models_.assign(models_.size(), {});
+  lod_axis_error_.assign(models_.size(), {});
   const std::string path = dir + "lod.json";
   std::ifstream in(path);
   if (!in) return;  // no coarse meshes: every instance is drawn in full
@@ -211,7 +217,7 @@ void Scene::loadLods(const std::string& dir,
   if (!doc.is_object() || doc.value("schema", "") != "hameritt_mesh_lod") {
     fail("schema", "\"hameritt_mesh_lod\"");
   }
-  if (!doc.contains("schema_version") || doc["schema_version"] != 1) fail("schema_version", "1");
+  if (!doc.contains("schema_version") || doc["schema_version"] != 2) fail("schema_version", "2");
   if (!doc.contains("meshes") || !doc["meshes"].is_array()) fail("meshes", "an array");
   const auto& meshes = doc["meshes"];
   for (std::size_t i = 0; i < meshes.size(); ++i) {
@@ -225,16 +231,7 @@ void Scene::loadLods(const std::string& dir,
       fail(at + ".mesh", "a class mesh name (house_1, car_sedan, ...), got '" + name + "'");
     }
     const int fine = it->second;
-    if (lod_model_[static_cast<std::size_t>(fine)] >= 0) fail(at + ".mesh", "each mesh once");
-    if (!e.contains("lod1") || !e["lod1"].is_string() || e["lod1"].get<std::string>().empty() ||
-        e["lod1"].get<std::string>().find('/') != std::string::npos) {
-      fail(at + ".lod1", "an OBJ file name in " + dir);
-    }
-    if (!e.contains("max_deviation_m") || !e["max_deviation_m"].is_number() ||
-        !std::isfinite(e["max_deviation_m"].get<double>()) ||
-        e["max_deviation_m"].get<double>() < 0) {
-      fail(at + ".max_deviation_m", "a finite number >= 0 (metres)");
-    }
+    if (!lod_models_[static_cast<std::size_t>(fine)].empty()) fail(at + ".mesh", "each mesh once");
     const auto& size = e.contains("design_size_m") ? e["design_size_m"] : nlohmann::json();
     bool size_ok = size.is_array() && size.size() == 3;
     for (std::size_t a = 0; size_ok && a < 3; ++a) {
@@ -242,18 +239,46 @@ void Scene::loadLods(const std::string& dir,
                 size[a].get<double>() > 0;
     }
     if (!size_ok) fail(at + ".design_size_m", "three numbers > 0 (metres)");
-    Mesh coarse = loadObjMesh(dir + e["lod1"].get<std::string>(), true);
-    // The canopy of both meshes is scaled about the same point.
-    coarse.canopy_center = models_[static_cast<std::size_t>(fine)].canopy_center;
-    const double dev = e["max_deviation_m"].get<double>();
-    const int m = addModel(std::move(coarse));
-    lod_model_.resize(models_.size(), -1);
-    lod_axis_error_.resize(models_.size(), Eigen::Vector3f::Zero());
-    lod_model_[static_cast<std::size_t>(fine)] = m;
-    for (int a = 0; a < 3; ++a) {
-      lod_axis_error_[static_cast<std::size_t>(fine)][a] =
-          static_cast<float>(dev / size[static_cast<std::size_t>(a)].get<double>());
+    if (!e.contains("levels") || !e["levels"].is_array() || e["levels"].empty() ||
+        e["levels"].size() > static_cast<std::size_t>(kMaxLodLevels)) {
+      fail(at + ".levels", "an array of 1 to " + std::to_string(kMaxLodLevels) + " levels");
     }
+    double previous = -1.0;
+    std::vector<int> levels;
+    std::vector<Eigen::Vector3f> errors;
+    for (std::size_t l = 0; l < e["levels"].size(); ++l) {
+      const auto& level = e["levels"][l];
+      const std::string lat = at + ".levels[" + std::to_string(l) + "]";
+      if (!level.is_object()) fail(lat, "an object");
+      if (!level.contains("file") || !level["file"].is_string() ||
+          level["file"].get<std::string>().empty() ||
+          level["file"].get<std::string>().find('/') != std::string::npos) {
+        fail(lat + ".file", "an OBJ file name in " + dir);
+      }
+      if (!level.contains("max_deviation_m") || !level["max_deviation_m"].is_number() ||
+          !std::isfinite(level["max_deviation_m"].get<double>()) ||
+          level["max_deviation_m"].get<double>() < 0) {
+        fail(lat + ".max_deviation_m", "a finite number >= 0 (metres)");
+      }
+      const double dev = level["max_deviation_m"].get<double>();
+      if (dev <= previous) {
+        fail(lat + ".max_deviation_m", "more than the previous level's (levels go from fine to coarse)");
+      }
+      previous = dev;
+      Mesh coarse = loadObjMesh(dir + level["file"].get<std::string>(), true);
+      // The canopy of every level is scaled about the same point.
+      coarse.canopy_center = models_[static_cast<std::size_t>(fine)].canopy_center;
+      levels.push_back(addModel(std::move(coarse)));
+      Eigen::Vector3f axis_error;
+      for (int a = 0; a < 3; ++a) {
+        axis_error[a] = static_cast<float>(dev / size[static_cast<std::size_t>(a)].get<double>());
+      }
+      errors.push_back(axis_error);
+    }
+    lod_models_.resize(models_.size());
+    lod_axis_error_.resize(models_.size());
+    lod_models_[static_cast<std::size_t>(fine)] = std::move(levels);
+    lod_axis_error_[static_cast<std::size_t>(fine)] = std::move(errors);
   }
 }
 
@@ -285,8 +310,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       addModel(unitQuad("street", MaterialKind::kStreet, srgbToLinear(64, 65, 68)));
   procedural_.driveway =
       addModel(unitBox("driveway", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f)));
-  lod_model_.resize(models_.size(), -1);
-  lod_axis_error_.resize(models_.size(), Eigen::Vector3f::Zero());
+  lod_models_.resize(models_.size());
+  lod_axis_error_.resize(models_.size());
 
   foliage_ = std::clamp(config.environment.foliage, 0.0, 1.0);
   const std::size_t n_world = world.entities().size();
@@ -393,10 +418,10 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
     const Eigen::Vector3f half = 0.5f * (mesh.max - mesh.min);
     si.radius = half.cwiseProduct(e.box.size.cast<float>()).norm();
-    if (lod_model_[static_cast<std::size_t>(si.model)] >= 0) {
-      si.lod_deviation = lod_axis_error_[static_cast<std::size_t>(si.model)]
-                             .cwiseProduct(e.box.size.cast<float>())
-                             .maxCoeff();
+    const auto& level_errors = lod_axis_error_[static_cast<std::size_t>(si.model)];
+    si.lod_levels = static_cast<int>(level_errors.size());
+    for (std::size_t l = 0; l < level_errors.size(); ++l) {
+      si.lod_deviation[l] = level_errors[l].cwiseProduct(e.box.size.cast<float>()).maxCoeff();
     }
     const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
     for (int r = 0; r < 3; ++r) {

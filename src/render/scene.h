@@ -4,6 +4,7 @@
 // are posed per frame from their trajectories.
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
@@ -22,6 +23,9 @@ struct InstanceRecord {
   float canopy = 1.0f;      // canopy scale about the mesh's canopy centre
 };
 
+// Coarser versions of a class mesh (models/meshes/lod.json) the renderer may draw instead.
+constexpr int kMaxLodLevels = 4;
+
 // One drawn object.
 struct SceneInstance {
   int model = 0;        // index into Scene::models()
@@ -34,9 +38,11 @@ struct SceneInstance {
   InstanceRecord record;      // at t = 0 for movers
   Eigen::Vector3f center{0, 0, 0};  // bounding sphere
   float radius = 0;
-  // Metres by which the coarse mesh of `model` (Scene::lodModel) may depart from it at this
-  // instance's size: the mesh's stated deviation scaled by the box (-1: no coarse mesh).
-  float lod_deviation = -1;
+  // Levels of detail of `model` (Scene::lodModel): how many, and the metres by which each may
+  // depart from the full mesh at this instance's size (the level's stated deviation scaled by
+  // the box), increasing with the level.
+  int lod_levels = 0;
+  std::array<float, kMaxLodLevels> lod_deviation{};
 };
 
 // The level-of-detail rule of one view: an instance is drawn with its model's coarse mesh when
@@ -54,7 +60,8 @@ struct LodView {
   double max_error_px = 0;        // 0: never coarse
   LodView() = default;
   LodView(const RenderRequest& r, double max_error_px);
-  bool coarse(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const;
+  // The coarsest level of detail allowed for the instance (0: its full mesh).
+  int level(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const;
 };
 
 // Model indices of the procedural parts.
@@ -87,15 +94,15 @@ class Scene {
   // World-space triangles of every instance at `time` (what the geometry pass rasterizes), each
   // with its full mesh, or with the mesh `lod` picks for it.
   SceneTriangles triangles(double time, const LodView* lod = nullptr) const;
-  // The coarse mesh of model m (models_dir/meshes/lod.json), or -1.
-  int lodModel(int m) const {
-    return m >= 0 && m < static_cast<int>(lod_model_.size()) ? lod_model_[static_cast<std::size_t>(m)]
-                                                              : -1;
+  // Level `level` (1, 2, ...) of model m (models_dir/meshes/lod.json); m itself for level 0.
+  int lodModel(int m, int level) const {
+    if (level == 0) return m;
+    return lod_models_[static_cast<std::size_t>(m)][static_cast<std::size_t>(level - 1)];
   }
   // The model instance i is drawn with under `lod`.
   int modelFor(std::size_t i, const Eigen::Vector3f& center, float radius, const LodView& lod) const {
     const SceneInstance& si = instances_[i];
-    return lod.coarse(si, center, radius) ? lodModel(si.model) : si.model;
+    return lodModel(si.model, lod.level(si, center, radius));
   }
   // Indices of model m that are drawn: all, or without the canopy at foliage density 0.
   std::uint32_t drawnIndexCount(int m) const {
@@ -110,8 +117,9 @@ class Scene {
 
   const scenario::SimConfig& config_;
   std::vector<Mesh> models_;
-  std::vector<int> lod_model_;                    // per model: its coarse mesh or -1
-  std::vector<Eigen::Vector3f> lod_axis_error_;   // per model: deviation / design size per axis
+  // Per model: its coarser levels (models), and per level the deviation / design size per axis.
+  std::vector<std::vector<int>> lod_models_;
+  std::vector<std::vector<Eigen::Vector3f>> lod_axis_error_;
   SceneModels procedural_;
   std::vector<SceneInstance> instances_;
   std::vector<std::string> entity_ids_;

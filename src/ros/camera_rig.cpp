@@ -6,7 +6,6 @@
 
 #include <array>
 #include <cmath>
-#include <cstring>
 
 #include "hameritt/BoundingBoxArray.h"
 #include "hameritt/render/renderer.h"
@@ -249,8 +248,9 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
     m->encoding = encoding;
     m->is_bigendian = 0;
     m->step = static_cast<std::uint32_t>(w * bytes_per_pixel);
-    m->data.resize(static_cast<std::size_t>(w) * h * bytes_per_pixel);
-    std::memcpy(m->data.data(), data, m->data.size());
+    // One copy, no zero-fill first.
+    const auto* bytes = static_cast<const std::uint8_t*>(data);
+    m->data.assign(bytes, bytes + static_cast<std::size_t>(w) * h * bytes_per_pixel);
     return m;
   };
   const bool decimated =

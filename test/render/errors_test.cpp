@@ -99,37 +99,46 @@ TEST(RenderErrors, BadLevelOfDetailIndexNamesTheFileAndField) {
   auto error = [&] {
     return errorOf([&] { Renderer r(defaultWorld(), defaultSimConfig(), in(m.dir())); });
   };
+  // One house entry with the given design size and levels.
+  auto index = [&](const std::string& size, const std::string& levels) {
+    m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 2, "meshes": [)"
+                        R"({"mesh": "house_1", "design_size_m": )" + size +
+                            R"(, "levels": )" + levels + "}]}");
+  };
+  const std::string level1 = R"({"file": "house_1_lod1.obj", "max_deviation_m": 0.1})";
   m.write("lod.json", "{ not json");
   std::string e = error();
   EXPECT_NE(e.find(lod + ": not valid JSON"), std::string::npos) << e;
-  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 2, "meshes": []})");
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": []})");
   e = error();
-  EXPECT_NE(e.find(lod + ": schema_version: expected 1"), std::string::npos) << e;
-  const std::string entry =
-      R"({"mesh": "house_1", "lod1": "house_1_lod1.obj", "design_size_m": [10, 11, 5.6], )";
-  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)" +
-                          entry + R"("max_deviation_m": -0.1}]})");
+  EXPECT_NE(e.find(lod + ": schema_version: expected 2"), std::string::npos) << e;
+  index("[10, 11, 5.6]", R"([{"file": "house_1_lod1.obj", "max_deviation_m": -0.1}])");
   e = error();
-  EXPECT_NE(e.find(lod + ": meshes[0].max_deviation_m: expected a finite number >= 0"),
+  EXPECT_NE(e.find(lod + ": meshes[0].levels[0].max_deviation_m: expected a finite number >= 0"),
             std::string::npos)
       << e;
-  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)"
-                      R"({"mesh": "castle", "lod1": "castle_lod1.obj", "design_size_m": [1, 1, 1],)"
-                      R"( "max_deviation_m": 0.1}]})");
+  index("[10, 11, 5.6]", "[" + level1 + R"(, {"file": "house_1_lod1.obj", "max_deviation_m": 0.05}])");
+  e = error();
+  EXPECT_NE(e.find(lod + ": meshes[0].levels[1].max_deviation_m: expected more than the previous"),
+            std::string::npos)
+      << e;
+  index("[10, 11, 5.6]", "[]");
+  e = error();
+  EXPECT_NE(e.find(lod + ": meshes[0].levels: expected an array of 1 to"), std::string::npos) << e;
+  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 2, "meshes": [)"
+                      R"({"mesh": "castle", "design_size_m": [1, 1, 1], "levels": [)" +
+                          level1 + "]}]}");
   e = error();
   EXPECT_NE(e.find(lod + ": meshes[0].mesh: expected a class mesh name"), std::string::npos) << e;
   EXPECT_NE(e.find("'castle'"), std::string::npos) << e;
-  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)"
-                      R"({"mesh": "house_1", "lod1": "house_1_lod1.obj", "design_size_m": [10, 0, 5],)"
-                      R"( "max_deviation_m": 0.1}]})");
+  index("[10, 0, 5]", "[" + level1 + "]");
   e = error();
   EXPECT_NE(e.find(lod + ": meshes[0].design_size_m: expected three numbers > 0"),
             std::string::npos)
       << e;
-  // The coarse mesh it names is missing.
+  // The coarse mesh a level names is missing.
   fs::remove(m.mesh("house_1_lod1.obj"));
-  m.write("lod.json", R"({"schema": "hameritt_mesh_lod", "schema_version": 1, "meshes": [)" +
-                          entry + R"("max_deviation_m": 0.1}]})");
+  index("[10, 11, 5.6]", "[" + level1 + "]");
   e = error();
   EXPECT_NE(e.find(m.mesh("house_1_lod1.obj")), std::string::npos) << e;
   // Without lod.json every instance is drawn in full.

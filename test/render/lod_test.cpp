@@ -120,20 +120,26 @@ TEST(RenderLod, StatedDeviationsBoundTheSampledDistancesBetweenFullAndCoarseMesh
   for (const auto& e : index["meshes"]) {
     const std::string name = e["mesh"];
     const Mesh fine = loadObjMesh(dir + name + ".obj", true);
-    const Mesh coarse = loadObjMesh(dir + e["lod1"].get<std::string>(), true);
     const Eigen::Vector3d size(e["design_size_m"][0], e["design_size_m"][1], e["design_size_m"][2]);
-    const double stated = e["max_deviation_m"];
-    double measured = 0.0;
-    for (bool foliage : {false, true}) {
-      const auto a = designTriangles(fine, size, foliage);
-      const auto b = designTriangles(coarse, size, foliage);
-      measured = std::max({measured, sampledDistance(a, b, 0.05), sampledDistance(b, a, 0.05)});
+    std::size_t previous = fine.indices.size();
+    for (const auto& level : e["levels"]) {
+      const Mesh coarse = loadObjMesh(dir + level["file"].get<std::string>(), true);
+      const double stated = level["max_deviation_m"];
+      double measured = 0.0;
+      for (bool foliage : {false, true}) {
+        const auto a = designTriangles(fine, size, foliage);
+        const auto b = designTriangles(coarse, size, foliage);
+        measured = std::max({measured, sampledDistance(a, b, 0.05), sampledDistance(b, a, 0.05)});
+      }
+      const std::string file = level["file"];
+      std::printf("%-22s %4zu -> %4zu triangles, deviation stated %.3f m, sampled %.3f m\n",
+                  file.c_str(), fine.indices.size() / 3, coarse.indices.size() / 3, stated,
+                  measured);
+      EXPECT_LE(measured, stated + 1e-6) << file;
+      EXPECT_LE(coarse.indices.size(), previous * 7 / 10) << file << ": 30% fewer triangles";
+      EXPECT_LT(stated, 1.0) << file << ": within a metre of the full mesh";
+      previous = coarse.indices.size();
     }
-    std::printf("%-16s %4zu -> %4zu triangles, deviation stated %.3f m, sampled %.3f m\n",
-                name.c_str(), fine.indices.size() / 3, coarse.indices.size() / 3, stated, measured);
-    EXPECT_LE(measured, stated + 1e-6) << name;
-    EXPECT_LE(coarse.indices.size(), fine.indices.size() * 6 / 10) << name << ": 40% fewer triangles";
-    EXPECT_LT(stated, 0.5) << name << ": a coarse mesh within half a metre";
   }
 }
 
@@ -238,7 +244,10 @@ TEST(RenderLod, CoarseFrameDiffersFromTheFullOneOnlyOnSilhouettes) {
       EXPECT_LE(std::abs(ba.x_max - bb.x_max), 1) << ba.entity_id;
       EXPECT_LE(std::abs(ba.y_min - bb.y_min), 1) << ba.entity_id;
       EXPECT_LE(std::abs(ba.y_max - bb.y_max), 1) << ba.entity_id;
-      EXPECT_LE(std::abs(ba.visible_pixels - bb.visible_pixels), 2 + bb.visible_pixels / 10)
+      // An outline that moves by at most half a pixel changes the area by at most half its
+      // perimeter (bounded by the box's).
+      const int half_perimeter = (bb.x_max - bb.x_min + 1) + (bb.y_max - bb.y_min + 1);
+      EXPECT_LE(std::abs(ba.visible_pixels - bb.visible_pixels), half_perimeter + 2)
           << ba.entity_id;
     }
     EXPECT_GE(compared, 3);

@@ -128,7 +128,8 @@ struct RenderStats {
   double readback_ms = 0;      // colour, depth and labels read back and split
   double boxes_ms = 0;         // boxes: entities drawn alone and their pixels counted
   std::size_t instances = 0;   // instances drawn in the geometry pass
-  std::size_t lod_instances = 0;  // of which drawn with their coarse mesh
+  std::size_t lod_instances = 0;  // of which drawn with a coarser level of detail
+  std::size_t box_groups = 0;     // boxes: groups of entities drawn alone
   std::size_t triangles = 0;   // triangles submitted to the geometry pass
   std::size_t draw_calls = 0;  // all passes
 };
