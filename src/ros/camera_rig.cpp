@@ -90,13 +90,20 @@ CameraRig::CameraRig(ros::NodeHandle& nh, const scenario::World& world,
     cameras_.push_back(std::move(cam));
   }
   if (cameras_.empty()) return;
-  // The renderer (and its EGL context) lives on the render thread; wait until it is up.
-  thread_ = std::thread([this] { run(); });
+  if (options_.render_threads < 1) {
+    throw scenario::ConfigError("~render_threads: expected >= 1, got " +
+                                std::to_string(options_.render_threads));
+  }
+  // Each renderer (and its EGL context) lives on its render thread; wait until all are up.
+  const int n = options_.render_threads;
+  for (int w = 0; w < n; ++w) threads_.emplace_back([this, w] { run(w); });
   std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [this] { return ready_; });
+  cv_.wait(lock, [this, n] { return ready_ == n; });
   if (!error_.empty()) {
+    stop_ = true;
     lock.unlock();
-    thread_.join();
+    cv_.notify_all();
+    for (auto& t : threads_) t.join();
     throw render::RenderError(error_);
   }
 }
@@ -107,7 +114,9 @@ CameraRig::~CameraRig() {
     stop_ = true;
   }
   cv_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  for (auto& t : threads_) {
+    if (t.joinable()) t.join();
+  }
 }
 
 std::vector<std::pair<std::string, Eigen::Isometry3d>> CameraRig::opticalMounts() const {
@@ -136,6 +145,7 @@ void CameraRig::afterStep(std::int64_t step, const sim::UavState& uav) {
   cv_.wait(lock, [this] {
     return static_cast<int>(queue_.size()) < std::max(1, options_.queue_depth) || stop_;
   });
+  job.seq = next_seq_++;
   queue_.push_back(std::move(job));
   lock.unlock();
   cv_.notify_all();
@@ -143,7 +153,7 @@ void CameraRig::afterStep(std::int64_t step, const sim::UavState& uav) {
 
 void CameraRig::flush() {
   std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || stop_; });
+  cv_.wait(lock, [this] { return (queue_.empty() && busy_ == 0) || stop_; });
 }
 
 std::uint64_t CameraRig::framesPublished() const {
@@ -165,7 +175,7 @@ std::string CameraRig::glRenderer() const {
   return gl_renderer_;
 }
 
-void CameraRig::run() {
+void CameraRig::run(int worker) {
   std::unique_ptr<render::Renderer> renderer;
   try {
     render::RendererOptions ro;
@@ -174,12 +184,12 @@ void CameraRig::run() {
     ro.lod_max_error_px = options_.lod_max_error_px;
     renderer = std::make_unique<render::Renderer>(world_, config_, ro);
     std::lock_guard<std::mutex> lock(mutex_);
-    gl_renderer_ = renderer->glRenderer();
-    ready_ = true;
+    if (worker == 0) gl_renderer_ = renderer->glRenderer();
+    ++ready_;
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lock(mutex_);
-    error_ = e.what();
-    ready_ = true;
+    if (error_.empty()) error_ = e.what();
+    ++ready_;
   }
   cv_.notify_all();
   if (!renderer) return;
@@ -194,7 +204,7 @@ void CameraRig::run() {
       if (stop_) return;
       job = std::move(queue_.front());
       queue_.pop_front();
-      busy_ = true;
+      ++busy_;
     }
     cv_.notify_all();
     requests.clear();
@@ -216,19 +226,30 @@ void CameraRig::run() {
       }
       requests.push_back(req);
     }
+    bool rendered = false;
     try {
       // One batch: the GL rasterizes one camera while the CPU finishes another.
       renderer->render(requests, &frames);
-      for (std::size_t i = 0; i < job.shots.size(); ++i) {
-        const Camera& cam = *cameras_[static_cast<std::size_t>(job.shots[i].first)];
-        publish(cam, job.shots[i].second, job.time, frames[i]);
-      }
+      rendered = true;
     } catch (const std::exception& e) {
       ROS_ERROR_THROTTLE(5.0, "simulator: cameras: %s", e.what());
     }
     {
+      // Publish in the order the physics produced the frame sets.
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [this, &job] { return next_publish_ == job.seq || stop_; });
+      if (stop_) return;
+    }
+    if (rendered) {
+      for (std::size_t i = 0; i < job.shots.size(); ++i) {
+        const Camera& cam = *cameras_[static_cast<std::size_t>(job.shots[i].first)];
+        publish(cam, job.shots[i].second, job.time, frames[i]);
+      }
+    }
+    {
       std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
+      ++next_publish_;
+      --busy_;
       published_ += job.shots.size();
     }
     cv_.notify_all();

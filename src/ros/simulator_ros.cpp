@@ -84,11 +84,16 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     pnh.param("camera_noise", co.noise, co.noise);
     pnh.param("render_queue_depth", co.queue_depth, co.queue_depth);
     pnh.param("render_lod_px", co.lod_max_error_px, co.lod_max_error_px);
+    pnh.param("render_threads", co.render_threads, co.render_threads);
     if (!std::isfinite(co.lod_max_error_px) || co.lod_max_error_px < 0) {
       throw scenario::ConfigError("~render_lod_px: expected a number >= 0 (0: full detail), got " +
                                   std::to_string(co.lod_max_error_px));
     }
     pnh.param("record_image_rate", co.decimated_rate_hz, 0.0);
+    if (co.render_threads < 1 || co.render_threads > 8) {
+      throw scenario::ConfigError("~render_threads: expected 1..8, got " +
+                                  std::to_string(co.render_threads));
+    }
     if (co.queue_depth < 1) {
       throw scenario::ConfigError("~render_queue_depth: expected >= 1, got " + std::to_string(co.queue_depth));
     }

@@ -1,4 +1,5 @@
-// The simulator's payload cameras through ROS, in lock-step: one frame set per camera period,
+// The simulator's payload cameras through ROS, in lock-step: one frame set per camera period
+// (also when several are rendered concurrently by the render threads, published in order),
 // stamped with the sim time of the physics state shown, images of the advertised size and
 // encoding, CameraInfo equal to the renderer's intrinsics, boxes that agree pixel for pixel with
 // the instances image, and the ADK's perfect perception reporting exactly the boxes with enough
@@ -95,14 +96,19 @@ TEST(SimulatorCameras, FramesStampsIntrinsicsBoxesAndPerfectPerception) {
     sim.step(50);
     ASSERT_TRUE(col.waitFor(static_cast<std::size_t>(i))) << "frame " << i;
   }
+  // Then 8 frame sets from one step call: the render threads (render_threads, default 2)
+  // render them concurrently and must publish them complete and in order.
+  const int batch = 8;
+  sim.step(50 * batch);
+  ASSERT_TRUE(col.waitFor(static_cast<std::size_t>(frames + batch)));
   for (int i = 0; i < 50; ++i) ros::spinOnce(), ros::WallDuration(0.002).sleep();
 
   int boxes_seen = 0;
   for (const auto& spec : config.uav.cameras) {
     const auto& t = col.cams[spec.name];
     const auto k = hameritt::render::intrinsicsFromHfov(spec.width, spec.height, spec.hfov_deg);
-    ASSERT_EQ(t.rgb.size(), static_cast<std::size_t>(frames)) << spec.name;
-    for (int i = 0; i < frames; ++i) {
+    ASSERT_EQ(t.rgb.size(), static_cast<std::size_t>(frames + batch)) << spec.name;
+    for (int i = 0; i < frames + batch; ++i) {
       const double stamp = 0.1 * (i + 1);
       for (const auto* img : {&t.rgb[i], &t.depth[i], &t.seg[i], &t.inst[i]}) {
         EXPECT_NEAR(img->header.stamp.toSec(), stamp, 1e-9) << spec.name;

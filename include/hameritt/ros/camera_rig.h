@@ -36,6 +36,10 @@ struct CameraRigOptions {
   // Level of detail (render::RendererOptions::lod_max_error_px; 0 = every mesh in full).
   double lod_max_error_px = 0.5;
   int queue_depth = 2;           // snapshots the physics loop may run ahead of the renderer
+  // Render threads, each with its own renderer (EGL context): consecutive frame sets render
+  // concurrently and are published in order. Two fill the gaps where one thread waits for the
+  // rasterizer and the rasterizer for it.
+  int render_threads = 2;
   double physics_rate_hz = 500;  // camera rates must divide it
   // Also publish every k-th frame's images on /uav/camera/<name>/decimated/<modality> at this
   // rate (Hz of sim time; 0 = off; must divide the camera rate): the compact training stream
@@ -72,12 +76,13 @@ class CameraRig {
   struct Camera;
   // The cameras due at one physics step, rendered as one batch.
   struct Job {
+    std::uint64_t seq = 0;                              // order of publication
     std::vector<std::pair<int, std::uint64_t>> shots;  // (camera, frame index)
     double time = 0;
     Eigen::Isometry3d world_T_base = Eigen::Isometry3d::Identity();
     Eigen::Vector3d velocity{0, 0, 0};
   };
-  void run();
+  void run(int worker);
   void publish(const Camera& cam, std::uint64_t frame, double time, const render::FrameSet& fs);
 
   const scenario::World& world_;
@@ -85,13 +90,15 @@ class CameraRig {
   CameraRigOptions options_;
   std::vector<std::unique_ptr<Camera>> cameras_;
 
-  std::thread thread_;
+  std::vector<std::thread> threads_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<Job> queue_;
-  bool busy_ = false;
+  std::uint64_t next_seq_ = 0;      // the next job's sequence number
+  std::uint64_t next_publish_ = 0;  // the job whose frames are published next
+  int busy_ = 0;                    // jobs taken by a render thread, not yet published
   bool stop_ = false;
-  bool ready_ = false;
+  int ready_ = 0;                   // render threads that have built their renderer (or failed)
   std::string error_;
   std::string gl_renderer_;
   std::uint64_t published_ = 0;

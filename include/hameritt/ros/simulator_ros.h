@@ -29,7 +29,8 @@ namespace hameritt::ros_wrappers {
 //   ~cameras (true: render and publish the payload cameras), ~render_backend (auto |
 //   surfaceless | device), ~camera_weather (true), ~camera_noise (true), ~render_queue_depth (2),
 //   ~render_lod_px (0.5: far instances drawn with coarse meshes whose deviation projects to at
-//   most this many pixels; 0 = full detail),
+//   most this many pixels; 0 = full detail), ~render_threads (2: frame sets rendered
+//   concurrently, each thread with its own renderer, published in order),
 //   ~record_image_rate (0: also publish camera images decimated to this rate for recording),
 //   ~wait_for (comma-separated topics of this node; the clock starts once each has a
 //   subscriber, or after ~wait_timeout wall seconds, 60).
