@@ -3,7 +3,6 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -34,17 +33,6 @@ std::vector<std::string> split(const std::string& line) {
     start = comma + 1;
   }
   return out;
-}
-
-// The whole field as a finite double, or false.
-bool parseNumber(const std::string& s, double* out) {
-  if (s.empty()) return false;
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v)) return false;
-  *out = v;
-  return true;
 }
 
 std::string shortest(double v) {
@@ -92,7 +80,7 @@ std::vector<PathSample> parsePathCsv(const std::string& text, const std::string&
     }
     double v[4];
     for (int c = 0; c < 4; ++c) {
-      if (!parseNumber(fields[static_cast<std::size_t>(c)], &v[c])) {
+      if (!scenario::parseNumber(fields[static_cast<std::size_t>(c)], &v[c])) {
         throw ConfigError(where + "column " + std::to_string(c + 1) + " (" + kRequired[c] +
                           "): expected a finite number, got '" +
                           fields[static_cast<std::size_t>(c)] + "'");

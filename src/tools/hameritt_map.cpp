@@ -23,14 +23,8 @@ const char* kUsage =
     "  --full        draw the whole neighborhood instead of cropping to the mission area\n";
 
 double parsePositive(const std::string& flag, const std::string& v) {
-  std::size_t used = 0;
   double x = 0.0;
-  try {
-    x = std::stod(v, &used);
-  } catch (...) {
-    used = 0;
-  }
-  if (used != v.size() || v.empty() || !std::isfinite(x) || x <= 0.0) {
+  if (!hameritt::scenario::parseNumber(v, &x) || x <= 0.0) {
     throw ConfigError(flag + ": expected a positive number, got '" + v + "'");
   }
   return x;

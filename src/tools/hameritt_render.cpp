@@ -56,14 +56,8 @@ const char* kUsage =
     "<camera>_camera_info.yaml, and boxes.json.\n";
 
 double parseNumber(const std::string& what, const std::string& v) {
-  std::size_t used = 0;
   double x = 0.0;
-  try {
-    x = std::stod(v, &used);
-  } catch (...) {
-    used = 0;
-  }
-  if (v.empty() || used != v.size() || !std::isfinite(x)) {
+  if (!scenario::parseNumber(v, &x)) {
     throw ConfigError(what + ": expected a number, got '" + v + "'");
   }
   return x;
