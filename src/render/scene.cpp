@@ -200,8 +200,7 @@ int Scene::addModel(Mesh mesh) {
 
 void Scene::loadLods(const std::string& dir,
                      const std::unordered_map<std::string, int>& file_model) {
-  lod_models_.assign(models_.size(), {});
-  lod_axis_error_.assign(models_.size(), {});
+  lods_.assign(models_.size(), {});
   const std::string path = dir + "lod.json";
   std::ifstream in(path);
   if (!in) return;  // no coarse meshes: every instance is drawn in full
@@ -231,7 +230,7 @@ void Scene::loadLods(const std::string& dir,
       fail(at + ".mesh", "a class mesh name (house_1, car_sedan, ...), got '" + name + "'");
     }
     const int fine = it->second;
-    if (!lod_models_[static_cast<std::size_t>(fine)].empty()) fail(at + ".mesh", "each mesh once");
+    if (!lods_[static_cast<std::size_t>(fine)].empty()) fail(at + ".mesh", "each mesh once");
     const auto& size = e.contains("design_size_m") ? e["design_size_m"] : nlohmann::json();
     bool size_ok = size.is_array() && size.size() == 3;
     for (std::size_t a = 0; size_ok && a < 3; ++a) {
@@ -244,8 +243,7 @@ void Scene::loadLods(const std::string& dir,
       fail(at + ".levels", "an array of 1 to " + std::to_string(kMaxLodLevels) + " levels");
     }
     double previous = -1.0;
-    std::vector<int> levels;
-    std::vector<Eigen::Vector3f> errors;
+    std::vector<LodLevel> levels;
     for (std::size_t l = 0; l < e["levels"].size(); ++l) {
       const auto& level = e["levels"][l];
       const std::string lat = at + ".levels[" + std::to_string(l) + "]";
@@ -268,17 +266,15 @@ void Scene::loadLods(const std::string& dir,
       Mesh coarse = loadObjMesh(dir + level["file"].get<std::string>(), true);
       // The canopy of every level is scaled about the same point.
       coarse.canopy_center = models_[static_cast<std::size_t>(fine)].canopy_center;
-      levels.push_back(addModel(std::move(coarse)));
-      Eigen::Vector3f axis_error;
+      LodLevel level_of;
+      level_of.model = addModel(std::move(coarse));
       for (int a = 0; a < 3; ++a) {
-        axis_error[a] = static_cast<float>(dev / size[static_cast<std::size_t>(a)].get<double>());
+        level_of.axis_error[a] =
+            static_cast<float>(dev / size[static_cast<std::size_t>(a)].get<double>());
       }
-      errors.push_back(axis_error);
+      levels.push_back(level_of);
     }
-    lod_models_.resize(models_.size());
-    lod_axis_error_.resize(models_.size());
-    lod_models_[static_cast<std::size_t>(fine)] = std::move(levels);
-    lod_axis_error_[static_cast<std::size_t>(fine)] = std::move(errors);
+    lods_[static_cast<std::size_t>(fine)] = std::move(levels);
   }
 }
 
@@ -310,8 +306,7 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       addModel(unitQuad("street", MaterialKind::kStreet, srgbToLinear(64, 65, 68)));
   procedural_.driveway =
       addModel(unitBox("driveway", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f)));
-  lod_models_.resize(models_.size());
-  lod_axis_error_.resize(models_.size());
+  lods_.resize(models_.size());  // the coarse and procedural models have no levels
 
   foliage_ = std::clamp(config.environment.foliage, 0.0, 1.0);
   const std::size_t n_world = world.entities().size();
@@ -418,10 +413,10 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
     const Eigen::Vector3f half = 0.5f * (mesh.max - mesh.min);
     si.radius = half.cwiseProduct(e.box.size.cast<float>()).norm();
-    const auto& level_errors = lod_axis_error_[static_cast<std::size_t>(si.model)];
-    si.lod_levels = static_cast<int>(level_errors.size());
-    for (std::size_t l = 0; l < level_errors.size(); ++l) {
-      si.lod_deviation[l] = level_errors[l].cwiseProduct(e.box.size.cast<float>()).maxCoeff();
+    const auto& levels = lods_[static_cast<std::size_t>(si.model)];
+    si.lod_levels = static_cast<int>(levels.size());
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+      si.lod_deviation[l] = levels[l].axis_error.cwiseProduct(e.box.size.cast<float>()).maxCoeff();
     }
     const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
     for (int r = 0; r < 3; ++r) {

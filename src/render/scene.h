@@ -45,9 +45,9 @@ struct SceneInstance {
   std::array<float, kMaxLodLevels> lod_deviation{};
 };
 
-// The level-of-detail rule of one view: an instance is drawn with its model's coarse mesh when
-// the coarse mesh's deviation at the instance's size, projected anywhere on its bounding sphere
-// that the image shows, is at most max_error_px pixels. The bound is first order and
+// The level-of-detail rule of one view: an instance is drawn with the coarsest level of its
+// model whose deviation at the instance's size, projected anywhere on its bounding sphere that
+// the image shows, is at most max_error_px pixels. The bound is first order and
 // conservative: a displacement d at optical depth Z on a ray at angle t from the optical axis
 // moves the point's image by at most f |d| / (Z cos t) pixels (the norm of the projection's
 // Jacobian); Z is taken at the sphere's nearest depth and t at the sphere's widest ray, capped
@@ -97,7 +97,7 @@ class Scene {
   // Level `level` (1, 2, ...) of model m (models_dir/meshes/lod.json); m itself for level 0.
   int lodModel(int m, int level) const {
     if (level == 0) return m;
-    return lod_models_[static_cast<std::size_t>(m)][static_cast<std::size_t>(level - 1)];
+    return lods_[static_cast<std::size_t>(m)][static_cast<std::size_t>(level - 1)].model;
   }
   // The model instance i is drawn with under `lod`.
   int modelFor(std::size_t i, const Eigen::Vector3f& center, float radius, const LodView& lod) const {
@@ -117,9 +117,12 @@ class Scene {
 
   const scenario::SimConfig& config_;
   std::vector<Mesh> models_;
-  // Per model: its coarser levels (models), and per level the deviation / design size per axis.
-  std::vector<std::vector<int>> lod_models_;
-  std::vector<std::vector<Eigen::Vector3f>> lod_axis_error_;
+  // Per model: its coarser levels, from fine to coarse.
+  struct LodLevel {
+    int model = 0;               // index into models_
+    Eigen::Vector3f axis_error;  // stated deviation / design size, per axis
+  };
+  std::vector<std::vector<LodLevel>> lods_;
   SceneModels procedural_;
   std::vector<SceneInstance> instances_;
   std::vector<std::string> entity_ids_;

@@ -90,8 +90,8 @@ CameraRig::CameraRig(ros::NodeHandle& nh, const scenario::World& world,
     cameras_.push_back(std::move(cam));
   }
   if (cameras_.empty()) return;
-  if (options_.render_threads < 1) {
-    throw scenario::ConfigError("~render_threads: expected >= 1, got " +
+  if (options_.render_threads < 1 || options_.render_threads > 8) {
+    throw scenario::ConfigError("~render_threads: expected 1..8, got " +
                                 std::to_string(options_.render_threads));
   }
   // Each renderer (and its EGL context) lives on its render thread; wait until all are up.

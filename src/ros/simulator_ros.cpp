@@ -90,10 +90,6 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                                   std::to_string(co.lod_max_error_px));
     }
     pnh.param("record_image_rate", co.decimated_rate_hz, 0.0);
-    if (co.render_threads < 1 || co.render_threads > 8) {
-      throw scenario::ConfigError("~render_threads: expected 1..8, got " +
-                                  std::to_string(co.render_threads));
-    }
     if (co.queue_depth < 1) {
       throw scenario::ConfigError("~render_queue_depth: expected >= 1, got " + std::to_string(co.queue_depth));
     }
