@@ -3,35 +3,11 @@
 # violation times against an independent line-intersection computation in Python, the report
 # on stdout equal to --out, and errors that name the file, line and column with nothing
 # written.
-set -u
-BIN="${HAMERITT_BIN_DIR:?}"
-SRC="${HAMERITT_SOURCE_DIR:?}"
-T="$(mktemp -d /tmp/hameritt_check_path.XXXXXX)"
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+source "$(dirname "$0")/cli_lib.sh" check_path
 
 C="$BIN/hameritt_check_path"
 M="$SRC/scenarios/default/mission.json"
 MW="$SRC/test/data/adk_windows_mission.json"
-
-# expect CODE PATTERN CMD...: exit code CODE and stderr matching PATTERN.
-expect() {
-  local code="$1" pattern="$2"
-  shift 2
-  local err rc
-  err="$("$@" 2>&1 >/dev/null)"
-  rc=$?
-  if [[ $rc -ne $code ]]; then
-    bad "'$*' exited $rc, expected $code: $err"
-  elif [[ -n "$pattern" && ! "$err" =~ $pattern ]]; then
-    bad "'$*' stderr does not match /$pattern/: $err"
-  else
-    ok
-  fi
-}
 
 # A clean flight far from every keep-out zone: climb at the start, fly east.
 cat >"$T/clean.csv" <<'CSV'

@@ -2,31 +2,7 @@
 # Command-line behaviour of the tools, judged from outside: exit codes, error messages that
 # name the file and field, no partial output, determinism across --jobs, and the shipped
 # scenario regenerating byte for byte from its class and seed.
-set -u
-BIN="${HAMERITT_BIN_DIR:?}"
-SRC="${HAMERITT_SOURCE_DIR:?}"
-T="$(mktemp -d /tmp/hameritt_cli.XXXXXX)"
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
-
-# expect CODE PATTERN CMD...: the command exits with CODE and its stderr matches PATTERN.
-expect() {
-  local code="$1" pattern="$2"
-  shift 2
-  local err rc
-  err="$("$@" 2>&1 >/dev/null)"
-  rc=$?
-  if [[ $rc -ne $code ]]; then
-    bad "'$*' exited $rc, expected $code: $err"
-  elif [[ -n "$pattern" && ! "$err" =~ $pattern ]]; then
-    bad "'$*' stderr does not match /$pattern/: $err"
-  else
-    ok
-  fi
-}
+source "$(dirname "$0")/cli_lib.sh" cli
 
 G="$BIN/hameritt_generate"
 V="$BIN/hameritt_validate"

@@ -3,34 +3,10 @@
 # to the camera's size, boxes.json and camera_info agree with the intrinsics, options select
 # cameras, poses and weather, and bad input exits 2 with a message naming the flag, file or
 # field and leaves nothing behind.
-set -u
-BIN="${HAMERITT_BIN_DIR:?}"
-SRC="${HAMERITT_SOURCE_DIR:?}"
-T="$(mktemp -d /tmp/hameritt_render_cli.XXXXXX)"
-trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-ok() { pass=$((pass + 1)); }
-bad() { fail=$((fail + 1)); echo "FAIL: $*"; }
+source "$(dirname "$0")/cli_lib.sh" render_cli
 
 R="$BIN/hameritt_render"
 CFG="$SRC/scenarios/default/sim_config.json"
-
-# expect CODE PATTERN CMD...: the command exits with CODE and its stderr matches PATTERN.
-expect() {
-  local code="$1" pattern="$2"
-  shift 2
-  local err rc
-  err="$("$@" 2>&1 >/dev/null)"
-  rc=$?
-  if [[ $rc -ne $code ]]; then
-    bad "'$*' exited $rc, expected $code: $err"
-  elif [[ -n "$pattern" && ! "$err" =~ $pattern ]]; then
-    bad "'$*' stderr does not match /$pattern/: $err"
-  else
-    ok
-  fi
-}
 
 # check_png FILE W H: a valid PNG (signature, chunk CRCs, zlib stream) of W x H RGB pixels.
 check_png() {
