@@ -8,6 +8,7 @@
 //
 // Usage: bench_render [frame_sets] [--backend auto|surfaceless|device]
 
+#include "hameritt/build_paths.h"
 #include <sys/resource.h>
 
 #include <algorithm>

@@ -6,6 +6,7 @@
 //
 // Usage: bench_sim [seconds_per_case]
 
+#include "hameritt/build_paths.h"
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>

@@ -1,3 +1,4 @@
+#include "hameritt/build_paths.h"
 #include "hameritt/render/renderer.h"
 
 #include <algorithm>

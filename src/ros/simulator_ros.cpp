@@ -1,3 +1,4 @@
+#include "hameritt/build_paths.h"
 #include "hameritt/ros/simulator_ros.h"
 
 #include <ros/callback_queue.h>

@@ -1,3 +1,4 @@
+#include "hameritt/build_paths.h"
 #include "hameritt/scenario/params_table.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+#include "hameritt/build_paths.h"
 #include "hameritt/sim/quadrotor.h"
 
 #include <tinyxml2.h>

@@ -1,6 +1,7 @@
 #pragma once
 // Shared fixtures of the ADK tests: small hand-made missions and the shipped scenario.
 
+#include "hameritt/build_paths.h"
 #include <cstdint>
 #include <string>
 

@@ -7,6 +7,7 @@
 //
 // HAMERITT_MEASURE=1 prints per-frame HSV percentiles of the target's and confusers' pixels
 // (from the instance mask) and of the background, and every blob the detector measured.
+#include "hameritt/build_paths.h"
 #include <gtest/gtest.h>
 
 #include <algorithm>

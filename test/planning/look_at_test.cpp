@@ -1,3 +1,4 @@
+#include "hameritt/build_paths.h"
 #include "hameritt/planning/look_at.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+#include "hameritt/build_paths.h"
 #include "hameritt/scenario/mission_io.h"
 
 #include <gtest/gtest.h>

@@ -2,6 +2,7 @@
 // Shared fixtures of the planning tests: the shipped world and mission, and an independent
 // checker of timed paths built only on the geometry core (not on the planner's WorldValidity).
 
+#include "hameritt/build_paths.h"
 #include <gtest/gtest.h>
 
 #include <string>

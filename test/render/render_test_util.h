@@ -3,6 +3,7 @@
 // renderer for it (built once per test binary), camera poses, and a Bullet ray caster over the
 // renderer's own scene triangles.
 
+#include "hameritt/build_paths.h"
 #include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <btBulletCollisionCommon.h>
 

@@ -2,6 +2,7 @@
 // reported by the adk node with the exact entry time and the window's closing time; flights
 // through a zone whose window has not opened are not; hameritt_check_path on the same samples
 // written as CSV agrees with the node.
+#include "hameritt/build_paths.h"
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 

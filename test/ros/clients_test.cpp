@@ -2,6 +2,7 @@
 // planner and simulator (it reaches the first area of interest inside its window and sweeps part
 // of it, clear of keep-out zones, without a crash), and in maneuver-only mode turns a perfect
 // perception report into one claim for the target, none for a look-alike, and then hovers.
+#include "hameritt/build_paths.h"
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>

@@ -3,6 +3,7 @@
 // and matching rgb8 / 32FC1 frames of a synthetic scene at the shipped scenario's target: the
 // white RAV4 at the target's place is claimed once (the same frame again is no new claim), the
 // same car 11 m down the street (not next to the target's tree) never.
+#include "hameritt/build_paths.h"
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>

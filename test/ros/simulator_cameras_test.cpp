@@ -4,6 +4,7 @@
 // encoding, CameraInfo equal to the renderer's intrinsics, boxes that agree pixel for pixel with
 // the instances image, and the ADK's perfect perception reporting exactly the boxes with enough
 // visible pixels.
+#include "hameritt/build_paths.h"
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>

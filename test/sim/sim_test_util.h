@@ -2,6 +2,7 @@
 // Shared fixtures of the simulator tests: the shipped world, model and default scenario (built
 // once), and small scenario builders.
 
+#include "hameritt/build_paths.h"
 #include <string>
 
 #include "hameritt/scenario/generator.h"
