@@ -317,6 +317,19 @@ class GenerationCampaignTest(unittest.TestCase):
         self.assertEqual(rc, 2)
         self.assertIn("--local is required", msg)
 
+    def test_generate_first_flag(self):
+        gen = os.path.join(os.environ["HAMERITT_BIN_DIR"], "hameritt_generate")
+        out = os.path.join(self.d, "g")
+        for extra, want in ((["--count", "1", "--seed", "1", "--first", "-1"], "--first"),
+                            (["--count", "1", "--seed", "1", "--first", "x"], "--first"),
+                            (["--scenario-seed", "3", "--first", "2"], "--scenario-seed")):
+            r = subprocess.run([gen, "--class", "all", "--out", out] + extra,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               universal_newlines=True)
+            self.assertEqual(r.returncode, 2, extra)
+            self.assertIn(want, r.stderr.splitlines()[0], extra)
+        self.assertFalse(os.path.exists(os.path.join(out, "manifest.json")))
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
