@@ -912,39 +912,42 @@ def cmd_compare(args):
 # ---------------------------------------------------------------------------- main
 
 
+FLAG = {"action": "store_true"}
+# The subcommands: name, function, help, arguments (name, argparse keywords).
+COMMANDS = [
+    ("plan", "cmd_plan", "write DIR/plan.json from a config",
+     [("config", {}), ("--out", {"required": True, "help": "campaign directory"})]),
+    ("run", "cmd_run", "run shards on this machine",
+     [("dir", {}), ("--local", FLAG),
+      ("--jobs", {"type": int, "default": 1, "help": "shards at a time (default 1)"}),
+      ("--shard", {"type": int, "action": "append", "help": "only this shard (repeatable)"})]),
+    ("run-shard", "cmd_run_shard", "run one shard (what a Slurm array task runs)",
+     [("dir", {}), ("--shard", {"type": int, "help": "default: $SLURM_ARRAY_TASK_ID"})]),
+    ("submit", "cmd_submit", "submit a Slurm job array, one task per shard",
+     [("dir", {}), ("--slurm", FLAG),
+      ("--resubmit-missing", dict(FLAG, help="only the shards with incomplete units")),
+      ("--dry-run", dict(FLAG, help="write the sbatch script only"))]),
+    ("status", "cmd_status", "units complete and missing, Slurm tasks queued",
+     [("dir", {}),
+      ("--wait", {"type": float, "nargs": "?", "const": 86400.0, "default": 0.0,
+                  "help": "first wait (at most SECONDS) until no task of the campaign is queued"}),
+      ("--json", FLAG)]),
+    ("merge", "cmd_merge", "one manifest over all shards in DIR/merged", [("dir", {})]),
+    ("compare", "cmd_compare", "compare two merged manifests",
+     [("a", {}), ("b", {}),
+      ("--nondeterministic", {"default": "", "help": "more comma-separated mission fields to "
+                              "check for presence only (always: %s)"
+                              % ", ".join(RUN_DEPENDENT_MISSION_FIELDS)})]),
+]
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(prog="hameritt_campaign", description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="cmd")
-    a = sub.add_parser("plan", help="write DIR/plan.json from a config")
-    a.add_argument("config")
-    a.add_argument("--out", required=True, help="campaign directory")
-    a = sub.add_parser("run", help="run shards on this machine")
-    a.add_argument("dir")
-    a.add_argument("--local", action="store_true")
-    a.add_argument("--jobs", type=int, default=1, help="shards at a time (default 1)")
-    a.add_argument("--shard", type=int, action="append", help="only this shard (repeatable)")
-    a = sub.add_parser("run-shard", help="run one shard (what a Slurm array task runs)")
-    a.add_argument("dir")
-    a.add_argument("--shard", type=int, help="default: $SLURM_ARRAY_TASK_ID")
-    a = sub.add_parser("submit", help="submit a Slurm job array, one task per shard")
-    a.add_argument("dir")
-    a.add_argument("--slurm", action="store_true")
-    a.add_argument("--resubmit-missing", action="store_true",
-                   help="only the shards with incomplete units")
-    a.add_argument("--dry-run", action="store_true", help="write the sbatch script only")
-    a = sub.add_parser("status", help="units complete and missing, Slurm tasks queued")
-    a.add_argument("dir")
-    a.add_argument("--wait", type=float, nargs="?", const=86400.0, default=0.0,
-                   help="first wait (at most SECONDS) until no task of the campaign is queued")
-    a.add_argument("--json", action="store_true")
-    a = sub.add_parser("merge", help="one manifest over all shards in DIR/merged")
-    a.add_argument("dir")
-    a = sub.add_parser("compare", help="compare two merged manifests")
-    a.add_argument("a")
-    a.add_argument("b")
-    a.add_argument("--nondeterministic", default="",
-                   help="more comma-separated mission fields to check for presence only "
-                   "(always: %s)" % ", ".join(RUN_DEPENDENT_MISSION_FIELDS))
+    for name, _, help_text, arguments in COMMANDS:
+        a = sub.add_parser(name, help=help_text)
+        for arg, kw in arguments:
+            a.add_argument(arg, **kw)
     args = p.parse_args(argv)
     if args.cmd is None:
         p.print_help()
@@ -956,8 +959,7 @@ def main(argv=None):
     for k in ("dir", "out"):
         if getattr(args, k, None):
             setattr(args, k, os.path.abspath(getattr(args, k)))
-    fn = {"plan": cmd_plan, "run": cmd_run, "run-shard": cmd_run_shard, "submit": cmd_submit,
-          "status": cmd_status, "merge": cmd_merge, "compare": cmd_compare}[args.cmd]
+    fn = globals()[{c[0]: c[1] for c in COMMANDS}[args.cmd]]
     try:
         return fn(args)
     except CampaignError as e:
