@@ -615,11 +615,24 @@ def cmd_status(args):
 # ---------------------------------------------------------------------------- slurm
 
 
+def array_spec(tasks):
+    """Slurm's --array list of task ids, runs of consecutive ids as ranges: 0-3,7,9-10."""
+    parts, run = [], []
+    for t in sorted(tasks):
+        if run and t != run[-1] + 1:
+            parts.append(str(run[0]) if len(run) == 1 else "%d-%d" % (run[0], run[-1]))
+            run = []
+        run.append(t)
+    if run:
+        parts.append(str(run[0]) if len(run) == 1 else "%d-%d" % (run[0], run[-1]))
+    return ",".join(parts)
+
+
 def sbatch_script(cdir, cfg, tasks):
     """The sbatch script of a job array over the shards `tasks` (array task id = shard)."""
     cdir = os.path.abspath(cdir)
     s = cfg["slurm"]
-    spec = ",".join(str(t) for t in tasks)
+    spec = array_spec(tasks)
     if s["max_parallel"]:
         spec += "%%%d" % s["max_parallel"]
     lines = ["#!/bin/bash",

@@ -69,7 +69,7 @@ else
   echo "$out"
   job="$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[0]['job_id'])" \
          "$C/slurm/jobs.json")"
-  grep -q -- "--array=0,1,2,3$" "$C/slurm/campaign-0.sbatch" && ok || bad "array spec"
+  grep -q -- "--array=0-3$" "$C/slurm/campaign-0.sbatch" && ok || bad "array spec"
   # Shard 1 holds gen-000001 and mission-000001-maneuver_only: cancel it mid-mission.
   killed=0
   for _ in $(seq 1 600); do

@@ -179,6 +179,8 @@ class UnitFilesTest(unittest.TestCase):
                      "run-shard %s --shard \"$SLURM_ARRAY_TASK_ID\"" % self.d]:
             self.assertIn(want, s)
         self.assertTrue(s.startswith("#!/bin/bash\n"))
+        self.assertEqual(hc.array_spec([3, 0, 1, 2, 7, 9, 10]), "0-3,7,9-10")
+        self.assertEqual(hc.array_spec([5]), "5")
 
 
 def mission(cls, mode, outcome, ttd, koz, **kw):
