@@ -79,7 +79,9 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
   if (req.count < 1) throw ConfigError("--count: expected a positive number of scenarios, got " + std::to_string(req.count));
   if (req.jobs < 1) throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
   if (req.out_dir.empty()) throw ConfigError("--out: an output directory is required");
-  if (req.first < 0) throw ConfigError("--first: expected a non-negative index, got " + std::to_string(req.first));
+  if (req.first < 0) {
+    throw ConfigError("--first: expected a non-negative index, got " + std::to_string(req.first));
+  }
   if (req.exact_seed && req.first != 0) {
     throw ConfigError("--first: cannot be combined with --scenario-seed");
   }

@@ -68,7 +68,9 @@ int main(int argc, char** argv) {
       else if (a == "--scenario-seed") seed = parseUnsigned(a, next()), have_seed = exact = true;
       else if (a == "--first") {
         const std::uint64_t k = parseUnsigned(a, next());
-        if (k > 10000000) throw ConfigError("--first: expected 0 to 10000000, got " + std::to_string(k));
+        if (k > 10000000) {
+          throw ConfigError("--first: expected 0 to 10000000, got " + std::to_string(k));
+        }
         first = static_cast<long>(k);
       } else if (a == "--out") out = next();
       else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
