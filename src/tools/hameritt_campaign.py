@@ -24,6 +24,7 @@ import json
 import math
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -393,6 +394,40 @@ def filter_cameras(sim_config, cameras):
     return out
 
 
+def stop_group(proc, grace=15.0):
+    """SIGINT to the process group (roslaunch shuts its nodes down), SIGKILL after `grace`."""
+    for sig, wait in ((signal.SIGINT, grace), (signal.SIGKILL, 5.0)):
+        try:
+            os.killpg(proc.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            proc.wait(timeout=wait)
+            # The leader is gone; its nodes may linger a moment: SIGKILL the rest.
+            os.killpg(proc.pid, signal.SIGKILL)
+            return
+        except subprocess.TimeoutExpired:
+            continue
+        except ProcessLookupError:
+            return
+
+
+def run_process_group(cmd, out, env, timeout, grace=15.0):
+    """Runs cmd in its own process group; returns its exit code, or None when it ran past
+    `timeout` seconds. On a timeout or an exception (SIGTERM, Ctrl-C) the whole group is
+    stopped (SIGINT, SIGKILL after `grace` s), so that no ROS node outlives its unit."""
+    proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, env=env,
+                            start_new_session=True)
+    try:
+        return proc.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        stop_group(proc, grace)
+        return None
+    except BaseException:
+        stop_group(proc, min(grace, 5.0))
+        raise
+
+
 def run_mission_unit(cfg, unit, work, log, task_id, slot):
     m = cfg["missions"]
     scen_dir = os.path.join(work, "scenario")
@@ -433,18 +468,17 @@ def run_mission_unit(cfg, unit, work, log, task_id, slot):
         log.write(("port %d: %s\n" % (port, " ".join(cmd))).encode())
         log.flush()
         with open(launch_log, "wb") as ll:
-            try:
-                r = subprocess.run(cmd, stdout=ll, stderr=subprocess.STDOUT, env=env,
-                                   timeout=m["timeout"])
-            except subprocess.TimeoutExpired:
-                raise RuntimeError("roslaunch ran past missions.timeout (%g s)" % m["timeout"])
+            rc = run_process_group(cmd, ll, env, m["timeout"])
+        if rc is None:
+            raise RuntimeError("roslaunch ran past missions.timeout (%g s); its process group "
+                               "was stopped" % m["timeout"])
         with open(launch_log, "rb") as ll:
             text = ll.read()
-        if r.returncode != 0 and b"Address already in use" in text:
+        if rc != 0 and b"Address already in use" in text:
             continue  # another process took the port between the bind test and the launch
         break
-    if r.returncode != 0:
-        raise RuntimeError("roslaunch exited %d (log: %s)" % (r.returncode, launch_log))
+    if rc != 0:
+        raise RuntimeError("roslaunch exited %d (log: %s)" % (rc, launch_log))
     metrics_path = os.path.join(out, "metrics.json")
     if not os.path.exists(metrics_path):
         raise RuntimeError("the mission wrote no metrics.json")
@@ -504,7 +538,13 @@ def run_shard(cdir, shard, task_id=None, job=""):
     return failed
 
 
+def _exit_on_sigterm(signum, frame):
+    raise SystemExit(128 + signum)
+
+
 def cmd_run_shard(args):
+    # Slurm ends a task (scancel, time limit, requeue) with SIGTERM: stop the unit's ROS graph.
+    signal.signal(signal.SIGTERM, _exit_on_sigterm)
     task = os.environ.get("SLURM_ARRAY_TASK_ID")
     shard = args.shard if args.shard is not None else (int(task) if task else None)
     if shard is None:

@@ -12,6 +12,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 from contextlib import redirect_stderr, redirect_stdout
 
@@ -181,6 +182,29 @@ class UnitFilesTest(unittest.TestCase):
         self.assertTrue(s.startswith("#!/bin/bash\n"))
         self.assertEqual(hc.array_spec([3, 0, 1, 2, 7, 9, 10]), "0-3,7,9-10")
         self.assertEqual(hc.array_spec([5]), "5")
+
+
+class ProcessGroupTest(unittest.TestCase):
+    def test_a_timeout_stops_the_whole_group(self):
+        d = tempfile.mkdtemp(prefix="campaign_pg_")
+        try:
+            pidfile = os.path.join(d, "child")
+            # A parent that ignores SIGINT and a child: both must be gone after the timeout.
+            cmd = ["/bin/bash", "-c", "trap '' INT; sleep 60 & echo $! > %s; wait" % pidfile]
+            with open(os.path.join(d, "log"), "wb") as out:
+                rc = hc.run_process_group(cmd, out, dict(os.environ), 1.0, grace=1.0)
+            self.assertIsNone(rc)
+            child = int(rd(pidfile))
+            for _ in range(50):  # its reaping by init may take a moment
+                if not hc.pid_alive(child):
+                    break
+                time.sleep(0.1)
+            self.assertFalse(hc.pid_alive(child), "the group's child outlived the timeout")
+            with open(os.path.join(d, "log"), "wb") as out:
+                self.assertEqual(hc.run_process_group(["/bin/sh", "-c", "exit 3"], out,
+                                                      dict(os.environ), 10.0), 3)
+        finally:
+            shutil.rmtree(d)
 
 
 def mission(cls, mode, outcome, ttd, koz, **kw):
