@@ -28,6 +28,8 @@ HAMERITT_PACKAGES=(
   # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
   # assimp for the meshes.
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
+  # hameritt_campaign: its YAML config, and the single-node Slurm cluster of its test.
+  python3-yaml slurm-wlm munge
 )
 
 install_deps() {

@@ -51,6 +51,7 @@ std::string manifestJson(const World& world, const BatchRequest& req,
   w.key("schema_version").value(kSchemaVersion);
   w.key("seed").value(req.seed);
   w.key("count").value(req.count);
+  if (req.first != 0) w.key("first").value(req.first);
   w.key("classes").beginArray();
   for (auto c : req.classes) w.value(toString(c));
   w.endArray();
@@ -78,6 +79,12 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
   if (req.count < 1) throw ConfigError("--count: expected a positive number of scenarios, got " + std::to_string(req.count));
   if (req.jobs < 1) throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
   if (req.out_dir.empty()) throw ConfigError("--out: an output directory is required");
+  if (req.first < 0) {
+    throw ConfigError("--first: expected a non-negative index, got " + std::to_string(req.first));
+  }
+  if (req.exact_seed && req.first != 0) {
+    throw ConfigError("--first: cannot be combined with --scenario-seed");
+  }
   if (req.exact_seed && req.count != 1) {
     throw ConfigError("--scenario-seed: generates exactly one scenario; --count must be 1");
   }
@@ -104,9 +111,10 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
       if (i >= req.count || failed.load()) return;
       try {
         ManifestEntry& e = entries[static_cast<std::size_t>(i)];
-        e.index = i;
-        e.cls = req.classes[static_cast<std::size_t>(i) % req.classes.size()];
-        e.seed = req.exact_seed ? req.seed : batchSeed(req.seed, static_cast<std::uint64_t>(i));
+        const int index = req.first + i;  // index in the whole batch
+        e.index = index;
+        e.cls = req.classes[static_cast<std::size_t>(index) % req.classes.size()];
+        e.seed = req.exact_seed ? req.seed : batchSeed(req.seed, static_cast<std::uint64_t>(index));
         const Scenario s = generateScenario(world, config, e.cls, e.seed);
         e.id = s.mission.scenario_id;
         writeScenarioDir(req.out_dir, s);

@@ -1,6 +1,6 @@
 // hameritt_generate: random scenarios as mission.json + sim_config.json, with a manifest.
 //   hameritt_generate --class area_search|route_search|pursuit|all --count N --seed S --out DIR
-//                     [--jobs J] [--world-config FILE] [--generator-config FILE]
+//                     [--first K] [--jobs J] [--world-config FILE] [--generator-config FILE]
 //   hameritt_generate --class CLASS --scenario-seed S --out DIR   (regenerates one scenario)
 // Exit codes: 0 success, 2 bad input or unwritable output, 1 generation failure.
 
@@ -19,11 +19,12 @@ using namespace hameritt::scenario;
 namespace {
 
 const char* kUsage =
-    "usage: hameritt_generate --class CLASS --count N --seed S --out DIR [--jobs J]\n"
+    "usage: hameritt_generate --class CLASS --count N --seed S --out DIR [--first K] [--jobs J]\n"
     "                         [--world-config FILE] [--generator-config FILE] [--quiet]\n"
     "       hameritt_generate --class CLASS --scenario-seed S --out DIR   (one scenario, seed S)\n"
     "  CLASS: area_search, route_search, pursuit, all, or a comma-separated list\n"
-    "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n";
+    "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n"
+    "  --first K: write only indices K..K+N-1 of the batch (a shard), byte-identical to them.\n";
 
 std::uint64_t parseUnsigned(const std::string& flag, const std::string& v) {
   if (v.empty() || v[0] == '-' || v.find_first_not_of("0123456789") != std::string::npos) {
@@ -50,7 +51,7 @@ long parseCount(const std::string& flag, const std::string& v) {
 int main(int argc, char** argv) {
   std::string cls, out, world_cfg = defaultConfigDir() + "/world.json";
   std::string gen_cfg = defaultConfigDir() + "/generator.json";
-  long count = -1;
+  long count = -1, first = 0;
   std::uint64_t seed = 0;
   bool have_seed = false, quiet = false, exact = false;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -65,7 +66,13 @@ int main(int argc, char** argv) {
       else if (a == "--count") count = parseCount(a, next());
       else if (a == "--seed") seed = parseUnsigned(a, next()), have_seed = true;
       else if (a == "--scenario-seed") seed = parseUnsigned(a, next()), have_seed = exact = true;
-      else if (a == "--out") out = next();
+      else if (a == "--first") {
+        const std::uint64_t k = parseUnsigned(a, next());
+        if (k > 10000000) {
+          throw ConfigError("--first: expected 0 to 10000000, got " + std::to_string(k));
+        }
+        first = static_cast<long>(k);
+      } else if (a == "--out") out = next();
       else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
       else if (a == "--world-config") world_cfg = next();
       else if (a == "--generator-config") gen_cfg = next();
@@ -86,6 +93,7 @@ int main(int argc, char** argv) {
     BatchRequest req;
     req.classes = parseClassList(cls);
     req.count = static_cast<int>(count);
+    req.first = static_cast<int>(first);
     req.seed = seed;
     req.out_dir = out;
     req.jobs = jobs;

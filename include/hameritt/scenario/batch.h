@@ -13,6 +13,9 @@ namespace hameritt::scenario {
 struct BatchRequest {
   std::vector<ScenarioClass> classes;  // scenario i has class classes[i % classes.size()]
   int count = 1;
+  // Batch index of the first scenario: indices first..first+count-1 of the batch seeded with
+  // `seed`, byte-identical to the same indices of the whole batch (sharded generation).
+  int first = 0;
   std::uint64_t seed = 1;
   std::string out_dir;
   int jobs = 1;
