@@ -28,6 +28,8 @@ HAMERITT_PACKAGES=(
   # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
   # assimp for the meshes.
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
+  # Dataset export (hameritt_export): the rosbag C++ API; its test reads PNGs with OpenCV.
+  librosbag-storage-dev python3-opencv python3-numpy python3-yaml
 )
 
 install_deps() {

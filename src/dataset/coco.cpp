@@ -89,7 +89,7 @@ std::string cocoJson(const std::vector<const FrameRecord*>& frames,
     w.key("width").value(f->width);
     w.key("height").value(f->height);
     w.key("extra").beginObject();
-    w.key("sim_time").value(static_cast<double>(f->stamp_ns) * 1e-9);
+    w.key("sim_time").value(static_cast<double>(f->stamp_ns) / 1e9);
     w.key("stamp_ns").value(static_cast<std::int64_t>(f->stamp_ns));
     w.key("camera").value(f->camera);
     w.key("scenario_id").value(ctx.scenario_id);

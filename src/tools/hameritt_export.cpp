@@ -407,9 +407,15 @@ class Exporter {
   Exporter(const Options& o, const fs::path& tmp) : o_(o), tmp_(tmp) {
     categories_ = dataset::entityCategories();
     class_index_ = dataset::yoloClassIndex(categories_);
-    // No parameters: OpenCV's fast path, 2-3x faster than any explicit level (which switches
-    // libpng to adaptive filtering) at similar sizes (BENCHMARKS.md "Dataset export").
-    if (o.png_level >= 0) png_params_ = {cv::IMWRITE_PNG_COMPRESSION, o.png_level};
+    // fast: OpenCV's default path (SUB filter, zlib level 1, RLE strategy) for RGB and
+    // segmentation, 2-3x faster than any explicit level (which turns on libpng's adaptive
+    // filters) at similar sizes; zlib's default strategy for the 16-bit images, faster and
+    // smaller there (measured per modality, BENCHMARKS.md "Dataset export").
+    if (o.png_level >= 0) {
+      png_params_ = png16_params_ = {cv::IMWRITE_PNG_COMPRESSION, o.png_level};
+    } else {
+      png16_params_ = {cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_DEFAULT};
+    }
     jpg_params_ = {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality};
     for (const auto& s : o.splits) {
       for (const char* d : {"images", "depth", "segmentation", "instances"}) {
@@ -433,7 +439,7 @@ class Exporter {
   fs::path tmp_;
   std::vector<dataset::Category> categories_;
   std::map<std::string, int> class_index_;
-  std::vector<int> png_params_, jpg_params_;
+  std::vector<int> png_params_, png16_params_, jpg_params_;
   std::vector<dataset::SceneContext> contexts_;
   std::vector<CameraTopics> cameras_;  // of the current bag
   std::vector<std::int64_t> camera_counter_;
@@ -660,8 +666,11 @@ void Exporter::dispatch(FrameSet&& set, const std::string& bag) {
   rec->camera = cameras_[set.camera].name;
   rec->stamp_ns = set.stamp_ns;
   rec->context = static_cast<int>(contexts_.size()) - 1;
-  // All cameras of one instant of one scenario share a split (no near-duplicate leaks).
-  const std::string key = bag + "@" + std::to_string(set.stamp_ns);
+  // All cameras of one instant of one scenario share a split (no near-duplicate leaks); the key
+  // names the scenario (the bag's file name before its /mission), not where the bag lies.
+  const std::string& scenario_id = contexts_.back().scenario_id;
+  const std::string key = (scenario_id.empty() ? fs::path(bag).filename().string() : scenario_id) +
+                          "@" + std::to_string(set.stamp_ns);
   rec->split = dataset::assignSplit(o_.splits, o_.seed, key);
   char name[64];
   std::snprintf(name, sizeof(name), "%06lld_", static_cast<long long>(rec->image_id));
@@ -704,7 +713,7 @@ void Exporter::encode(FrameSet& set, dataset::FrameRecord& rec, const std::strin
   rec.annotations = dataset::annotateFrame(reinterpret_cast<const std::uint16_t*>(inst.data),
                                            inst.cols, inst.rows, set.boxes, &skipped);
   skipped_annotations_ += skipped;
-  writeImage(tmp_ / rec.instances_file, inst, png_params_);
+  writeImage(tmp_ / rec.instances_file, inst, png16_params_);
   if (set.images[0].present()) {
     cv::Mat rgb = decode(set.images[0], where + " image_raw", &enc);
     check_size(rgb, "image_raw");
@@ -736,7 +745,7 @@ void Exporter::encode(FrameSet& set, dataset::FrameRecord& rec, const std::strin
     } else {
       throw std::runtime_error(where + ": depth image is " + enc + ", expected 32FC1 or 16UC1");
     }
-    writeImage(tmp_ / rec.depth_file, mm, png_params_);
+    writeImage(tmp_ / rec.depth_file, mm, png16_params_);
   }
   if (!rec.segmentation_file.empty()) {
     cv::Mat seg = decode(set.images[2], where + " segmentation", &enc);
@@ -853,6 +862,8 @@ int preview(const Options& o) {
       cv::addWeighted(overlay, 0.5, bgr, 0.5, 0.0, bgr);
       for (const auto& [r, text] : labels) {
         cv::rectangle(bgr, r, cv::Scalar(255, 255, 255), 1);
+        // Text only on boxes tall enough to read it next to (far instances would hide the rest).
+        if (r.height < 12) continue;
         cv::putText(bgr, text, cv::Point(r.x, std::max(10, r.y - 3)), cv::FONT_HERSHEY_SIMPLEX,
                     0.35, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
       }
