@@ -14,12 +14,13 @@ using scenario::JsonWriter;
 std::vector<Category> entityCategories() {
   using scenario::EntityClass;
   std::vector<Category> out;
-  for (EntityClass c : {EntityClass::kStreet, EntityClass::kDriveway, EntityClass::kHouse,
-                        EntityClass::kGarage, EntityClass::kFence, EntityClass::kTree,
-                        EntityClass::kCar, EntityClass::kPedestrian}) {
+  for (EntityClass c :
+       {EntityClass::kStreet, EntityClass::kDriveway, EntityClass::kHouse, EntityClass::kGarage,
+        EntityClass::kFence, EntityClass::kTree, EntityClass::kCar, EntityClass::kPedestrian}) {
     out.push_back({scenario::semanticId(c), scenario::toString(c)});
   }
-  std::sort(out.begin(), out.end(), [](const Category& a, const Category& b) { return a.id < b.id; });
+  std::sort(out.begin(), out.end(),
+            [](const Category& a, const Category& b) { return a.id < b.id; });
   return out;
 }
 

@@ -36,9 +36,8 @@ std::map<std::uint16_t, MaskExtent> instanceExtents(const std::uint16_t* instanc
   return out;
 }
 
-std::vector<InstanceAnnotation> annotateFrame(const std::uint16_t* instances, int width,
-                                              int height, const std::vector<BoxMeta>& boxes,
-                                              int* skipped) {
+std::vector<InstanceAnnotation> annotateFrame(const std::uint16_t* instances, int width, int height,
+                                              const std::vector<BoxMeta>& boxes, int* skipped) {
   const auto extents = instanceExtents(instances, width, height);
   std::vector<InstanceAnnotation> out;
   std::set<std::uint16_t> done;

@@ -4,11 +4,11 @@
 
 namespace hameritt::dataset {
 
-std::vector<std::uint32_t> encodeInstanceMask(const std::uint16_t* instances, int width,
-                                              int height, std::uint16_t id,
-                                              const MaskExtent& extent) {
+std::vector<std::uint32_t> encodeInstanceMask(const std::uint16_t* instances, int width, int height,
+                                              std::uint16_t id, const MaskExtent& extent) {
   std::vector<std::uint32_t> counts;
-  const std::uint64_t total = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+  const std::uint64_t total =
+      static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
   if (total > 0xffffffffull) throw RleError("mask of " + std::to_string(total) + " pixels");
   if (extent.empty()) {
     counts.push_back(static_cast<std::uint32_t>(total));

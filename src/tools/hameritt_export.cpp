@@ -151,8 +151,8 @@ Options parseArgs(int argc, char** argv) {
   auto integer = [&](const std::string& flag, const std::string& v, long long lo, long long hi) {
     long long x = 0;
     if (!parseInt(v, lo, hi, &x)) {
-      throw ExitError(kExitFlags, flag + ": expected an integer in " + std::to_string(lo) +
-                                      ".." + std::to_string(hi) + ", got '" + v + "'");
+      throw ExitError(kExitFlags, flag + ": expected an integer in " + std::to_string(lo) + ".." +
+                                      std::to_string(hi) + ", got '" + v + "'");
     }
     return x;
   };
@@ -281,7 +281,6 @@ struct CameraTopics {
   std::string topic[kNumModalities];
   std::string boxes_topic;
 };
-
 
 // The decoded image (as a Mat over the message's data, or a decoded copy) and its encoding.
 cv::Mat decode(const ImageInput& in, const std::string& what, std::string* encoding) {
@@ -476,7 +475,9 @@ void Exporter::exportBag(std::size_t bag_index, const std::string& path) {
     std::smatch m;
     if (std::regex_match(t, m, cam_re)) found[m[1]].name = m[1];
   }
-  auto has = [&](const std::string& t) { return topics.count(t) || topics.count(t + "/compressed"); };
+  auto has = [&](const std::string& t) {
+    return topics.count(t) || topics.count(t + "/compressed");
+  };
   cameras_.clear();
   for (auto& [name, cam] : found) {
     const std::string base = "/uav/camera/" + name + "/";
@@ -510,8 +511,10 @@ void Exporter::exportBag(std::size_t bag_index, const std::string& path) {
     cameras_ = chosen;
   }
   if (cameras_.empty()) {
-    throw ExitError(kExitEmpty, path + ": no camera with /uav/camera/<c>/boxes and an instances "
-                                       "image topic (" + o_.stream + " stream)");
+    throw ExitError(kExitEmpty, path +
+                                    ": no camera with /uav/camera/<c>/boxes and an instances "
+                                    "image topic (" +
+                                    o_.stream + " stream)");
   }
   camera_counter_.assign(cameras_.size(), 0);
   contexts_.push_back({});
@@ -565,8 +568,8 @@ void Exporter::exportBag(std::size_t bag_index, const std::string& path) {
         ctx.scenario_id = m->scenario_id;
         ctx.relations.clear();
         for (const auto& r : m->relations) {
-          ctx.relations.push_back(
-              {r.target_id, r.op, static_cast<bool>(r.eventually), r.related_id, r.related_class, r.text});
+          ctx.relations.push_back({r.target_id, r.op, static_cast<bool>(r.eventually), r.related_id,
+                                   r.related_class, r.text});
         }
         continue;
       }
@@ -598,7 +601,8 @@ void Exporter::exportBag(std::size_t bag_index, const std::string& path) {
         std::int64_t stamp = 0;
         if (topic.size() > 11 && topic.compare(topic.size() - 11, 11, "/compressed") == 0) {
           in.compressed = mi.instantiate<sensor_msgs::CompressedImage>();
-          if (!in.compressed) throw std::runtime_error(topic + ": not a sensor_msgs/CompressedImage");
+          if (!in.compressed)
+            throw std::runtime_error(topic + ": not a sensor_msgs/CompressedImage");
           stamp = static_cast<std::int64_t>(in.compressed->header.stamp.toNSec());
         } else {
           in.raw = mi.instantiate<sensor_msgs::Image>();
@@ -652,8 +656,10 @@ void Exporter::exportBag(std::size_t bag_index, const std::string& path) {
   incomplete_ += static_cast<int>(pending.size());
   auto& ctx = contexts_[context];
   if (ctx.scenario_id.empty()) {
-    std::fprintf(stderr, "hameritt_export: warning: %s has no /mission message; scenario id and "
-                         "relations are empty\n", path.c_str());
+    std::fprintf(stderr,
+                 "hameritt_export: warning: %s has no /mission message; scenario id and "
+                 "relations are empty\n",
+                 path.c_str());
   }
   ctx.target_ids.assign(target_ids.begin(), target_ids.end());
   (void)bag_index;
@@ -693,8 +699,8 @@ void Exporter::dispatch(FrameSet&& set, const std::string& bag) {
 
 void Exporter::encode(FrameSet& set, dataset::FrameRecord& rec, const std::string& bag) {
   std::string enc;
-  const std::string where = bag + ": camera " + rec.camera + " at stamp " +
-                            std::to_string(set.stamp_ns) + " ns";
+  const std::string where =
+      bag + ": camera " + rec.camera + " at stamp " + std::to_string(set.stamp_ns) + " ns";
   cv::Mat inst = decode(set.images[kInstances], where + " instances", &enc);
   if (inst.type() != CV_16UC1) {
     throw std::runtime_error(where + ": instances image is " + enc + ", expected 16UC1");
@@ -770,8 +776,9 @@ void Exporter::finish() {
     if (!err.empty()) throw ExitError(pool_->errorCode(), err);
   }
   if (frames_.empty()) {
-    throw ExitError(kExitEmpty, "no complete camera frame (every image modality, instances and "
-                                "boxes with one stamp) in the bags");
+    throw ExitError(kExitEmpty,
+                    "no complete camera frame (every image modality, instances and "
+                    "boxes with one stamp) in the bags");
   }
   std::map<std::string, std::vector<const dataset::FrameRecord*>> by_split;
   for (const auto& f : frames_) by_split[f->split].push_back(f.get());
@@ -794,7 +801,8 @@ void Exporter::finish() {
   }
   std::printf("hameritt_export: %zu images, %zu annotations (", frames_.size(), annotations);
   bool first = true;
-  for (const auto& [c, n] : per_class) std::printf("%s%s %d", first ? "" : ", ", c.c_str(), n), first = false;
+  for (const auto& [c, n] : per_class)
+    std::printf("%s%s %d", first ? "" : ", ", c.c_str(), n), first = false;
   std::printf(")\nsplits:");
   for (const auto& s : names) std::printf(" %s %zu", s.c_str(), by_split[s].size());
   std::printf("\n");
@@ -841,7 +849,7 @@ int preview(const Options& o) {
         const auto mask = dataset::decodeRuns(
             dataset::countsFromString(seg.at("counts").get<std::string>()), w, h);
         const bool target = a.at("extra").at("is_target").get<bool>();
-        const cv::Scalar colour = target ? cv::Scalar(0, 0, 255)
+        const cv::Scalar colour = target                              ? cv::Scalar(0, 0, 255)
                                   : cat[a.at("category_id")] == "car" ? cv::Scalar(255, 160, 0)
                                                                       : cv::Scalar(0, 220, 0);
         for (int y = 0; y < h && y < overlay.rows; ++y) {

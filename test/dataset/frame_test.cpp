@@ -1,11 +1,12 @@
 // Frame annotations (boxes = mask extents, area = pixel count, skipped boxes), YOLO labels,
 // depth conversion, split parsing and the seeded split assignment, COCO document structure.
+#include "hameritt/dataset/frame.h"
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
 #include "hameritt/dataset/coco.h"
-#include "hameritt/dataset/frame.h"
 
 namespace hameritt::dataset {
 namespace {
@@ -37,10 +38,10 @@ TEST(Frame, BoxesAreMaskExtentsAndAreasPixelCounts) {
   img.fill(0, 6, 9, 7, 9);  // touches left, right and bottom borders: 20 pixels
   img.px[5 * 10 + 8] = 4;   // a stray pixel of 4 widens its extent
   int skipped = 0;
-  const auto anns = annotateFrame(img.px.data(), img.w, img.h,
-                                  {box("car_1", 4), box("ped_2", 9, "pedestrian", "target"),
-                                   box("gone", 13), box("zero", 0)},
-                                  &skipped);
+  const auto anns = annotateFrame(
+      img.px.data(), img.w, img.h,
+      {box("car_1", 4), box("ped_2", 9, "pedestrian", "target"), box("gone", 13), box("zero", 0)},
+      &skipped);
   ASSERT_EQ(anns.size(), 2u);
   EXPECT_EQ(skipped, 2);
   EXPECT_EQ(anns[0].meta.entity_id, "car_1");
@@ -78,8 +79,8 @@ TEST(Frame, SplitParsing) {
   ASSERT_EQ(s.size(), 2u);
   EXPECT_EQ(s[1].name, "val");
   EXPECT_DOUBLE_EQ(s[0].fraction, 0.8);
-  for (const char* bad : {"", "train", "train=0.5", "train=0.8,val=0.3", "=1", "a=1,a=0",
-                          "train=x", "tr ain=1", "train=0.8,", "a=-0.5,b=1.5"}) {
+  for (const char* bad : {"", "train", "train=0.5", "train=0.8,val=0.3", "=1", "a=1,a=0", "train=x",
+                          "tr ain=1", "train=0.8,", "a=-0.5,b=1.5"}) {
     EXPECT_THROW(parseSplits(bad), std::invalid_argument) << bad;
   }
 }
@@ -113,8 +114,8 @@ TEST(Coco, DocumentStructure) {
   f.height = img.h;
   f.stamp_ns = 12500000000;
   f.image_file = "images/train/000003_down.png";
-  f.annotations = annotateFrame(img.px.data(), img.w, img.h,
-                                {box("car_706", 4, "car", "target")}, nullptr);
+  f.annotations =
+      annotateFrame(img.px.data(), img.w, img.h, {box("car_706", 4, "car", "target")}, nullptr);
   SceneContext ctx;
   ctx.scenario_id = "sc1";
   ctx.target_ids = {"car_706"};

@@ -1,12 +1,13 @@
 // COCO RLE: the encoder against a naive column-major encoder written from pycocotools'
 // rleEncode, the compressed string against values worked out by hand from rleToString, and the
 // round trip string -> runs -> mask.
+#include "hameritt/dataset/rle.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "hameritt/dataset/frame.h"
-#include "hameritt/dataset/rle.h"
 
 namespace hameritt::dataset {
 namespace {
@@ -51,7 +52,7 @@ void expectRoundTrip(const std::vector<std::uint16_t>& inst, int w, int h, std::
 TEST(Rle, StringMatchesPycocotoolsByHand) {
   EXPECT_EQ(countsToString({3, 1}), "31");
   EXPECT_EQ(countsToString({0, 4}), "04");
-  EXPECT_EQ(countsToString({100}), "T3");  // 100 = 3 * 32 + 4: '0' + (4 | 0x20), '0' + 3
+  EXPECT_EQ(countsToString({100}), "T3");           // 100 = 3 * 32 + 4: '0' + (4 | 0x20), '0' + 3
   EXPECT_EQ(countsToString({1, 2, 3, 1}), "123O");  // 1 - 2 = -1 -> 0x1f, no continuation
   EXPECT_EQ(countsFromString("123O"), (std::vector<std::uint32_t>{1, 2, 3, 1}));
   EXPECT_EQ(countsFromString("T3"), (std::vector<std::uint32_t>{100}));
@@ -82,7 +83,7 @@ TEST(Rle, MasksTouchingBorders) {
   const int w = 8, h = 6;
   std::vector<std::uint16_t> inst(w * h, 0);
   for (int y = 0; y < h; ++y) inst[y * w + 0] = 1, inst[y * w + w - 1] = 2;  // left, right
-  for (int x = 1; x < w - 1; ++x) inst[x] = 3, inst[(h - 1) * w + x] = 4;      // top, bottom
+  for (int x = 1; x < w - 1; ++x) inst[x] = 3, inst[(h - 1) * w + x] = 4;    // top, bottom
   for (std::uint16_t id = 1; id <= 4; ++id) expectRoundTrip(inst, w, h, id);
 }
 
@@ -107,8 +108,8 @@ TEST(Rle, LargeCountsRoundTrip) {
 }
 
 TEST(Rle, BadInputThrows) {
-  EXPECT_THROW(countsFromString("0 1"), RleError);  // ' ' < '0'
-  EXPECT_THROW(countsFromString("T"), RleError);    // continuation bit, then the end
+  EXPECT_THROW(countsFromString("0 1"), RleError);   // ' ' < '0'
+  EXPECT_THROW(countsFromString("T"), RleError);     // continuation bit, then the end
   EXPECT_THROW(decodeRuns({3, 2}, 2, 2), RleError);  // sums to 5, not 4
   EXPECT_THROW(decodeRuns({1, 2}, 2, 2), RleError);  // sums to 3
   std::vector<std::uint16_t> inst(4, 1);

@@ -42,9 +42,8 @@ std::map<std::uint16_t, MaskExtent> instanceExtents(const std::uint16_t* instanc
 // Annotations of a frame, in the order of `boxes`: one per box whose instance id has at least
 // one pixel in the image. Boxes whose id is 0 or absent from the image are counted in
 // `*skipped` (may be null).
-std::vector<InstanceAnnotation> annotateFrame(const std::uint16_t* instances, int width,
-                                              int height, const std::vector<BoxMeta>& boxes,
-                                              int* skipped);
+std::vector<InstanceAnnotation> annotateFrame(const std::uint16_t* instances, int width, int height,
+                                              const std::vector<BoxMeta>& boxes, int* skipped);
 
 // YOLO label lines "class cx cy w h" (normalised to the image, 6 decimals) of annotations;
 // `class_index` maps an entity class to its YOLO class index (classes absent are left out).

@@ -27,9 +27,8 @@ struct MaskExtent {
 // The column-major runs of the mask (instances == id) of a width x height instance image
 // (row-major, 16 bit), scanning only the columns of `extent` (the mask's extent, or an empty
 // extent for an empty mask). Sums to width * height.
-std::vector<std::uint32_t> encodeInstanceMask(const std::uint16_t* instances, int width,
-                                              int height, std::uint16_t id,
-                                              const MaskExtent& extent);
+std::vector<std::uint32_t> encodeInstanceMask(const std::uint16_t* instances, int width, int height,
+                                              std::uint16_t id, const MaskExtent& extent);
 
 // pycocotools' rleToString: the compressed "counts" string of the runs.
 std::string countsToString(const std::vector<std::uint32_t>& counts);
