@@ -8,7 +8,7 @@
 //                   [--split train=0.8,val=0.2] [--seed S] [--stream auto|decimated|full]
 //                   [--image-format png|jpg] [--png-level fast|0..9] [--jpeg-quality 1..100]
 //                   [--jobs N] [--force] [--quiet]
-//   hameritt_export --preview DATASET --image-id ID --out FILE.png
+//   hameritt_export --preview DATASET --image-id ID|most --out FILE.png
 // Exit codes: 0 success, 2 bad flags or output directory, 3 unreadable bag, 4 output write
 // failure, 5 no frames to export, 1 internal error, 130 interrupted.
 
@@ -58,7 +58,7 @@ const char* kUsage =
     "                       [--stream auto|decimated|full] [--image-format png|jpg]\n"
     "                       [--png-level fast|0..9] [--jpeg-quality 1..100] [--jobs N] [--force]\n"
     "                       [--quiet]\n"
-    "       hameritt_export --preview DATASET --image-id ID --out FILE.png\n"
+    "       hameritt_export --preview DATASET --image-id ID|most --out FILE.png\n"
     "  BAG...            mission bags (mission.launch record:=true)\n"
     "  --format          coco (annotations/instances_<split>.json) or yolo (labels/, data.yaml)\n"
     "  --out DIR         dataset directory (must not exist unless --force)\n"
@@ -74,6 +74,7 @@ const char* kUsage =
     "  --jpeg-quality    JPEG quality (default 95)\n"
     "  --jobs N          encoding threads, 1..64 (default 2)\n"
     "  --preview DATASET draw the boxes and masks of image ID of an exported COCO dataset\n"
+    "                    (most: the image with the most annotations, the first of equals)\n"
     "Exit codes: 0 ok, 2 bad flags or output directory, 3 unreadable bag, 4 write failure,\n"
     "5 nothing to export, 130 interrupted.\n";
 
@@ -212,7 +213,8 @@ Options parseArgs(int argc, char** argv) {
     } else if (a == "--preview") {
       o.preview = need(i);
     } else if (a == "--image-id") {
-      o.image_id = integer(a, need(i), 1, std::numeric_limits<long long>::max());
+      const std::string v = need(i);
+      o.image_id = v == "most" ? 0 : integer(a, v, 1, std::numeric_limits<long long>::max());
     } else if (a.size() > 1 && a[0] == '-') {
       throw ExitError(kExitFlags, "unknown flag '" + a + "'");
     } else {
@@ -221,7 +223,7 @@ Options parseArgs(int argc, char** argv) {
   }
   if (o.out.empty()) throw ExitError(kExitFlags, "--out: required");
   if (!o.preview.empty()) {
-    if (o.image_id < 0) throw ExitError(kExitFlags, "--preview: needs --image-id ID");
+    if (o.image_id < 0) throw ExitError(kExitFlags, "--preview: needs --image-id ID|most");
     return o;
   }
   if (o.bags.empty()) throw ExitError(kExitFlags, "expected at least one BAG");
@@ -816,7 +818,7 @@ void Exporter::finish() {
 
 // ------------------------------------------------------------------------- preview
 
-int preview(const Options& o) {
+int preview(Options o) {
   const fs::path root = o.preview;
   const fs::path ann_dir = root / "annotations";
   if (!fs::is_directory(ann_dir)) {
@@ -825,14 +827,28 @@ int preview(const Options& o) {
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(ann_dir)) files.push_back(e.path());
   std::sort(files.begin(), files.end());
-  for (const auto& file : files) {
-    nlohmann::json doc;
+  auto load = [](const fs::path& file) {
     try {
       std::ifstream in(file);
-      doc = nlohmann::json::parse(in);
+      return nlohmann::json::parse(in);
     } catch (const std::exception& e) {
       throw ExitError(kExitFlags, file.string() + ": " + e.what());
     }
+  };
+  if (o.image_id == 0) {
+    std::map<std::int64_t, int> count;
+    for (const auto& file : files) {
+      const nlohmann::json doc = load(file);
+      for (const auto& img : doc.at("images")) count[img.at("id").get<std::int64_t>()] += 0;
+      for (const auto& a : doc.at("annotations")) ++count[a.at("image_id").get<std::int64_t>()];
+    }
+    int best = -1;
+    for (const auto& [id, n] : count) {
+      if (n > best) best = n, o.image_id = id;
+    }
+  }
+  for (const auto& file : files) {
+    const nlohmann::json doc = load(file);
     for (const auto& img : doc.at("images")) {
       if (img.at("id").get<std::int64_t>() != o.image_id) continue;
       const fs::path image_path = root / img.at("file_name").get<std::string>();

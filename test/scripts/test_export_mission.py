@@ -369,11 +369,36 @@ def run_all(tmp):
     a2 = json.load(open(os.path.join(cds, "annotations", "instances_train.json")))["annotations"]
     check(a1 == a2, "compressed input: annotations differ")
 
+    # A record_all-like bag (full-rate topic names only): auto picks it, --stream decimated fails.
+    fbag = os.path.join(tmp, "full.bag")
+    with rosbag.Bag(bag) as src_bag, rosbag.Bag(fbag, "w") as out_bag:
+        for topic, msg, t in src_bag.read_messages():
+            if topic == "/mission" or topic.endswith("/boxes"):
+                out_bag.write(topic, msg, t)
+            elif "/decimated/" in topic:
+                out_bag.write(topic.replace("/decimated/", "/"), msg, t)
+    fds = os.path.join(tmp, "coco_full")
+    export(fbag, fds, "--format", "coco", "--split", "train=0.7,val=0.3", "--seed", "3")
+    check(same_tree(os.path.join(coco, "annotations"), os.path.join(fds, "annotations")) and
+          same_tree(os.path.join(coco, "images"), os.path.join(fds, "images")),
+          "full-rate stream: the export differs from the decimated one")
+    r = run([fbag, "--format", "coco", "--out", os.path.join(tmp, "bad8"), "--stream", "decimated"])
+    check(r.returncode == 5 and "no camera" in r.stderr, "--stream decimated on a full bag: %d %s" %
+          (r.returncode, r.stderr))
+    no_leftovers(tmp, "bad8")
+
     # Preview: the project's own drawing of one image.
     pv = os.path.join(tmp, "preview.png")
     r = run(["--preview", coco, "--image-id", "1", "--out", pv])
     p = cv2.imread(pv)
     check(r.returncode == 0 and p is not None and p.shape[:2] == (480, 640), "preview: %s" % r.stderr)
+    counts = {i: 0 for i in images}
+    for a in anns:
+        counts[a["image_id"]] += 1
+    most = min(i for i in counts if counts[i] == max(counts.values()))
+    r = run(["--preview", coco, "--image-id", "most", "--out", pv])
+    check(r.returncode == 0 and ("image %d (%d annotations)" % (most, counts[most])) in r.stdout,
+          "preview most: expected image %d: %s" % (most, r.stdout))
 
     # Error cases: non-zero exit, a message naming the file, no output left.
     def expect_fail(args, code, pattern, out_name):
