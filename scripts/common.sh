@@ -30,6 +30,8 @@ HAMERITT_PACKAGES=(
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
   # hameritt_campaign: its YAML config, and the single-node Slurm cluster of its test.
   python3-yaml slurm-wlm munge
+  # Dataset export (hameritt_export): the rosbag C++ API; its test reads PNGs with OpenCV.
+  librosbag-storage-dev python3-opencv python3-numpy python3-yaml
 )
 
 install_deps() {

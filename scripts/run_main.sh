@@ -32,6 +32,11 @@ cat "$OUT/mission/metrics.json"
 echo
 echo "== bag ($OUT/mission/mission.bag)"
 rosbag info "$OUT/mission/mission.bag" | head -60
+# Dataset export (issue 11): the mission's bag as a small COCO dataset, and its summary.
+echo "== dataset: hameritt_export $OUT/mission/mission.bag --format coco -> $OUT/dataset"
+rosrun hameritt hameritt_export "$OUT/mission/mission.bag" --format coco --out "$OUT/dataset" \
+  --every 4 --split train=0.8,val=0.2 --seed 1 --force --quiet
+rosrun hameritt hameritt_export --preview "$OUT/dataset" --image-id most --out "$OUT/dataset_preview.png"
 echo "== generating 30 scenarios (all classes, seed 1) -> $OUT/generated"
 rosrun hameritt hameritt_generate --class all --count 30 --seed 1 --out "$OUT/generated" --quiet
 rosrun hameritt hameritt_validate "$OUT"/generated/*/mission.json "$OUT"/generated/*/sim_config.json >/dev/null
