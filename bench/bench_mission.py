@@ -26,6 +26,24 @@ import tempfile
 import time
 
 
+def sample_recorder_cpu(seen, out):
+    """CPU seconds (user + system) so far of the rosbag recorder writing into `out`, by pid."""
+    tick = os.sysconf("SC_CLK_TCK")
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                argv = f.read().split(b"\0")
+            if not argv[0].endswith(b"rosbag/record") or not any(out.encode() in a for a in argv):
+                continue
+            with open("/proc/%s/stat" % pid) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            seen[pid] = (int(fields[11]) + int(fields[12])) / tick
+        except (OSError, IndexError, ValueError):
+            pass
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenario", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenarios", "default"))
@@ -54,9 +72,15 @@ def main():
            "record_compression:=" + args.compression, "output_dir:=" + out]
     log_path = os.path.join(out, "roslaunch.log")
     t0 = time.time()
+    recorder = {}
     with open(log_path, "w") as log:
-        rc = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env,
-                             timeout=max(600.0, 20 * args.sim_seconds))
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+        while proc.poll() is None and time.time() - t0 < max(600.0, 20 * args.sim_seconds):
+            sample_recorder_cpu(recorder, out)
+            time.sleep(0.5)
+        if proc.poll() is None:
+            proc.kill()
+        rc = proc.wait()
     wall_total = time.time() - t0
     log_text = open(log_path).read()
     bag_path = os.path.join(out, "mission.bag")
@@ -109,6 +133,8 @@ def main():
     print("sim time:      %.1f s; simulator clock: %.1f sim s in %.1f wall s -> real-time factor %.2fx (launch total %.1f s wall)" % (sim_seconds, rt_sim, rt_wall, rt_sim / max(rt_wall, 1e-9), wall_total))
     print("bag:           %.1f MB (%.2f MB per sim second), %d topics" % (size_mb, size_mb / max(sim_seconds, 1e-9), len(counts)))
     print("rosbag drops:  %d 'Dropping' warnings" % dropped_log)
+    rec_cpu = sum(recorder.values())
+    print("recorder CPU:  %.1f s (%.0f%% of one core over the simulator's %.1f wall s; last sample)" % (rec_cpu, 100.0 * rec_cpu / max(rt_wall, 1e-9), rt_wall))
     raw_total = sum(group_bytes.values())
     print("uncompressed:  %.1f MB (%.2f MB per sim second); on disk %.0f%% of it" % (raw_total / 1e6, raw_total / 1e6 / max(sim_seconds, 1e-9), 100.0 * size_mb * 1e6 / max(raw_total, 1)))
     for g in sorted(group_bytes, key=lambda g: -group_bytes[g]):
