@@ -28,6 +28,9 @@ HAMERITT_PACKAGES=(
   # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
   # assimp for the meshes.
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
+  # Recording tests: an independent PNG decoder (OpenCV's Python binding, with numpy) and YAML
+  # for `rosbag info --yaml`.
+  python3-opencv python3-numpy python3-yaml
 )
 
 install_deps() {

@@ -7,19 +7,15 @@
 # 65.5345 m or farther); each PNG has the compressed_image_transport format string and decodes to
 # the raw image bit for bit; the noisy image = the noise-free one + zero-mean noise of the
 # scenario's gaussian_std (salt-and-pepper pixels aside).
-set -euo pipefail
-export PATH="/usr/bin:/bin:$PATH"
-src="${HAMERITT_SOURCE_DIR:?}"
-out="$(mktemp -d)"
-trap 'rm -rf "$out"' EXIT
-port=$((14000 + $$ % 2000))
-export ROS_MASTER_URI="http://localhost:$port"
+source "$(dirname "$0")/cli_lib.sh" record_codec
+set -eo pipefail
+export PATH="/usr/bin:/bin:$PATH" ROS_MASTER_URI="http://localhost:$((14000 + $$ % 2000))"
 limit=4
-if ! timeout 300 roslaunch -p "$port" "$src/test/scripts/record_codec.launch" output:="$out/codec.bag" \
-     limit:=$limit >"$out/launch.log" 2>&1; then
-  echo "FAIL: roslaunch exited non-zero or timed out"; tail -40 "$out/launch.log"; exit 1
+if ! timeout 300 roslaunch -p "${ROS_MASTER_URI##*:}" "$SRC/test/scripts/record_codec.launch" output:="$T/codec.bag" \
+     limit:=$limit >"$T/launch.log" 2>&1; then
+  echo "FAIL: roslaunch exited non-zero or timed out"; tail -40 "$T/launch.log"; exit 1
 fi
-/usr/bin/python3 - "$out/codec.bag" "$src" "$limit" <<'PY'
+/usr/bin/python3 - "$T/codec.bag" "$SRC" "$limit" <<'PY'
 import collections, json, os, sys
 import cv2
 import numpy as np
