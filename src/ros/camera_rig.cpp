@@ -35,8 +35,8 @@ struct CameraRig::Camera {
 
   // Every topic of this camera (unadvertised ones are empty publishers with no subscribers).
   std::array<const ros::Publisher*, 14> publishers() const {
-    return {&rgb_pub,   &depth_pub, &seg_pub, &inst_pub, &info_pub, &boxes_pub, &rgb_dec,
-            &depth_dec, &seg_dec,   &inst_dec, &rgb_png, &depth_png, &seg_png,  &inst_png};
+    return {&rgb_pub,   &depth_pub, &seg_pub,  &inst_pub, &info_pub,  &boxes_pub, &rgb_dec,
+            &depth_dec, &seg_dec,   &inst_dec, &rgb_png,  &depth_png, &seg_png,   &inst_png};
   }
   // Whether frame `frame` is one of the compact stream's and someone wants its colour image.
   bool decimatedRgbWanted(std::uint64_t frame) const {
@@ -103,8 +103,10 @@ CameraRig::CameraRig(ros::NodeHandle& nh, const scenario::World& world,
         if (cam->depth && options.decimated_depth_mm) {
           cam->depth_png = nh.advertise<Compressed>(dns + "depth/compressed", 4);
         }
-        if (cam->segmentation) cam->seg_png = nh.advertise<Compressed>(dns + "segmentation/compressed", 4);
-        if (cam->instances) cam->inst_png = nh.advertise<Compressed>(dns + "instances/compressed", 4);
+        if (cam->segmentation)
+          cam->seg_png = nh.advertise<Compressed>(dns + "segmentation/compressed", 4);
+        if (cam->instances)
+          cam->inst_png = nh.advertise<Compressed>(dns + "instances/compressed", 4);
       }
     }
     cam->info_pub = nh.advertise<sensor_msgs::CameraInfo>(ns + "camera_info", 4);
@@ -307,8 +309,8 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
   };
   // One modality: the full-rate message, and the compact stream's (the same message unless the
   // compact stream converts the image) with its PNG.
-  auto send = [&](bool on, const ros::Publisher& full, const ros::Publisher& dec, const ros::Publisher& png,
-                  const Plane& full_plane, const Plane& dec_plane) {
+  auto send = [&](bool on, const ros::Publisher& full, const ros::Publisher& dec,
+                  const ros::Publisher& png, const Plane& full_plane, const Plane& dec_plane) {
     if (!on) return;
     sensor_msgs::ImagePtr full_msg;
     if (wants(full)) {
@@ -316,9 +318,10 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
       full.publish(full_msg);
     }
     if (!decimated || !(wants(dec) || wants(png))) return;
-    const sensor_msgs::ImagePtr m = (full_msg && dec_plane.data == full_plane.data)
-                                        ? full_msg
-                                        : image(dec_plane.encoding, dec_plane.bytes, dec_plane.data);
+    const sensor_msgs::ImagePtr m =
+        (full_msg && dec_plane.data == full_plane.data)
+            ? full_msg
+            : image(dec_plane.encoding, dec_plane.bytes, dec_plane.data);
     if (wants(dec)) dec.publish(m);
     if (wants(png)) png.publish(toPngCompressed(*m, options_.decimated_png_level));
   };
@@ -329,7 +332,8 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
        noise_free ? Plane{enc::RGB8, 3, fs.rgb_noise_free.data()} : rgb);
   const Plane depth{enc::TYPE_32FC1, 4, fs.depth.data()};
   std::vector<std::uint16_t> depth_mm;
-  if (cam.depth && decimated && options_.decimated_depth_mm && (wants(cam.depth_dec) || wants(cam.depth_png))) {
+  if (cam.depth && decimated && options_.decimated_depth_mm &&
+      (wants(cam.depth_dec) || wants(cam.depth_png))) {
     render::depthToMillimetres(fs.depth, &depth_mm);
   }
   send(cam.depth, cam.depth_pub, cam.depth_dec, cam.depth_png, depth,
