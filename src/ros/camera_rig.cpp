@@ -38,12 +38,14 @@ struct CameraRig::Camera {
     return {&rgb_pub,   &depth_pub, &seg_pub,  &inst_pub, &info_pub,  &boxes_pub, &rgb_dec,
             &depth_dec, &seg_dec,   &inst_dec, &rgb_png,  &depth_png, &seg_png,   &inst_png};
   }
+  // Whether frame `frame` is one of the compact stream's.
+  bool decimated(std::uint64_t frame) const {
+    return frames_per_decimated > 0 &&
+           frame % static_cast<std::uint64_t>(frames_per_decimated) == 0;
+  }
   // Whether frame `frame` is one of the compact stream's and someone wants its colour image.
   bool decimatedRgbWanted(std::uint64_t frame) const {
-    if (!rgb || frames_per_decimated <= 0 ||
-        frame % static_cast<std::uint64_t>(frames_per_decimated) != 0) {
-      return false;
-    }
+    if (!rgb || !decimated(frame)) return false;
     return rgb_dec.getNumSubscribers() > 0 || (rgb_png && rgb_png.getNumSubscribers() > 0);
   }
   bool wanted() const {
@@ -299,8 +301,7 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
     m->data.assign(bytes, bytes + static_cast<std::size_t>(w) * h * bytes_per_pixel);
     return m;
   };
-  const bool decimated =
-      cam.frames_per_decimated > 0 && frame % static_cast<std::uint64_t>(cam.frames_per_decimated) == 0;
+  const bool decimated = cam.decimated(frame);
   auto wants = [](const ros::Publisher& p) { return p && p.getNumSubscribers() > 0; };
   struct Plane {
     std::string encoding;
@@ -327,6 +328,8 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
   };
   namespace enc = sensor_msgs::image_encodings;
   const Plane rgb{enc::RGB8, 3, fs.rgb.data()};
+  // The noise-free image was requested when the frame was queued; a subscriber that came later
+  // (never while recording: the clock waits for the recorder) gets the noisy one this once.
   const bool noise_free = fs.rgb_noise_free.size() == fs.rgb.size();
   send(cam.rgb, cam.rgb_pub, cam.rgb_dec, cam.rgb_png, rgb,
        noise_free ? Plane{enc::RGB8, 3, fs.rgb_noise_free.data()} : rgb);
