@@ -8,7 +8,11 @@ every camera topic must hold one message per camera period (no drops) and rosbag
 reported a dropped message. Prints the real-time factor and per-topic counts.
 
   /usr/bin/python3 bench/bench_mission.py [--sim-seconds 60] [--real-time-factor 0]
-      [--record-all] [--mode end_to_end] [--out DIR]
+      [--record-all] [--record-png] [--record-depth 16UC1|32FC1] [--record-rgb-noise]
+      [--compression lz4|bz2] [--mode end_to_end] [--out DIR]
+
+Also prints the bag's MB per sim second and its bytes per topic group (uncompressed), so that
+the recording's size can be traced to its streams.
 """
 import argparse
 import json
@@ -22,12 +26,34 @@ import tempfile
 import time
 
 
+def sample_recorder_cpu(seen, out):
+    """CPU seconds (user + system) so far of the rosbag recorder writing into `out`, by pid."""
+    tick = os.sysconf("SC_CLK_TCK")
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                argv = f.read().split(b"\0")
+            if not argv[0].endswith(b"rosbag/record") or not any(out.encode() in a for a in argv):
+                continue
+            with open("/proc/%s/stat" % pid) as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            seen[pid] = (int(fields[11]) + int(fields[12])) / tick
+        except (OSError, IndexError, ValueError):
+            pass
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenario", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenarios", "default"))
     ap.add_argument("--sim-seconds", type=float, default=60.0)
     ap.add_argument("--real-time-factor", type=float, default=0.0, help="0 = as fast as possible")
     ap.add_argument("--record-all", action="store_true")
+    ap.add_argument("--record-png", action="store_true", help="PNG CompressedImage compact stream")
+    ap.add_argument("--record-depth", default="16UC1", choices=["16UC1", "32FC1"])
+    ap.add_argument("--record-rgb-noise", action="store_true", help="compact colour image with noise")
+    ap.add_argument("--compression", default="lz4", choices=["lz4", "bz2"])
     ap.add_argument("--mode", default="end_to_end")
     ap.add_argument("--out", default="")
     args = ap.parse_args()
@@ -39,13 +65,22 @@ def main():
     cmd = ["roslaunch", "-p", str(port), "hameritt", "mission.launch",
            "scenario:=" + os.path.abspath(args.scenario), "mode:=" + args.mode, "record:=true",
            "record_all:=" + ("true" if args.record_all else "false"),
+           "record_png:=" + ("true" if args.record_png else "false"),
+           "record_depth:=" + args.record_depth,
+           "record_rgb_noise:=" + ("true" if args.record_rgb_noise else "false"),
            "real_time_factor:=%g" % args.real_time_factor, "time_limit:=%g" % args.sim_seconds,
-           "output_dir:=" + out]
+           "record_compression:=" + args.compression, "output_dir:=" + out]
     log_path = os.path.join(out, "roslaunch.log")
     t0 = time.time()
+    recorder = {}
     with open(log_path, "w") as log:
-        rc = subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT, env=env,
-                             timeout=max(600.0, 20 * args.sim_seconds))
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
+        while proc.poll() is None and time.time() - t0 < max(600.0, 20 * args.sim_seconds):
+            sample_recorder_cpu(recorder, out)
+            time.sleep(0.5)
+        if proc.poll() is None:
+            proc.kill()
+        rc = proc.wait()
     wall_total = time.time() - t0
     log_text = open(log_path).read()
     bag_path = os.path.join(out, "mission.bag")
@@ -57,6 +92,12 @@ def main():
     bag = rosbag.Bag(bag_path)
     info = bag.get_type_and_topic_info()
     counts = {t: v.message_count for t, v in info.topics.items()}
+    # Uncompressed bytes per topic group (images per modality, everything else together).
+    group_bytes = {}
+    for topic, raw, _ in bag.read_messages(raw=True):
+        parts = topic.split("/")
+        group = "/".join(parts[4:]) if "/decimated/" in topic else ("full-rate " + parts[4] if len(parts) == 5 and parts[4] in ("image_raw", "depth", "segmentation", "instances") else "other topics")
+        group_bytes[group] = group_bytes.get(group, 0) + len(raw[1])
     # Sim-time span covered by the camera boxes (one per frame).
     bag.close()
     metrics = {}
@@ -79,23 +120,32 @@ def main():
             if args.record_all:
                 expected[base + mods[m]] = n
             else:
-                expected[base + "decimated/" + mods[m]] = int(math.floor(sim_seconds * decim_rate + 1e-9))
+                png = args.record_png and not (m == "depth" and args.record_depth == "32FC1")
+                topic = base + "decimated/" + mods[m] + ("/compressed" if png else "")
+                expected[topic] = int(math.floor(sim_seconds * decim_rate + 1e-9))
     dropped_log = len(re.findall(r"Dropping", log_text))
     missing = {t: (e, counts.get(t, 0)) for t, e in expected.items() if counts.get(t, 0) < e}
     # The simulator logs sim time against wall time since its clock started, every 10 sim s.
     m = re.findall(r"simulator: sim ([0-9.]+) s in wall ([0-9.]+) s", log_text)
     rt_sim, rt_wall = (float(m[-1][0]), float(m[-1][1])) if m else (sim_seconds, wall_total)
     size_mb = os.path.getsize(bag_path) / 1e6
-    print("scenario:      %s (mode %s, %s recording)" % (cfg["scenario_id"], args.mode, "full" if args.record_all else "compact"))
+    print("scenario:      %s (mode %s, %s recording%s)" % (cfg["scenario_id"], args.mode, "full" if args.record_all else "compact", "" if args.record_all else ", depth %s, colour %s%s, %s chunks" % (args.record_depth, "noisy" if args.record_rgb_noise else "noise-free", ", PNG" if args.record_png else "", args.compression)))
     print("sim time:      %.1f s; simulator clock: %.1f sim s in %.1f wall s -> real-time factor %.2fx (launch total %.1f s wall)" % (sim_seconds, rt_sim, rt_wall, rt_sim / max(rt_wall, 1e-9), wall_total))
     print("bag:           %.1f MB (%.2f MB per sim second), %d topics" % (size_mb, size_mb / max(sim_seconds, 1e-9), len(counts)))
     print("rosbag drops:  %d 'Dropping' warnings" % dropped_log)
+    rec_cpu = sum(recorder.values())
+    print("recorder CPU:  %.1f s (%.0f%% of one core over the simulator's %.1f wall s; last sample)" % (rec_cpu, 100.0 * rec_cpu / max(rt_wall, 1e-9), rt_wall))
+    raw_total = sum(group_bytes.values())
+    print("uncompressed:  %.1f MB (%.2f MB per sim second); on disk %.0f%% of it" % (raw_total / 1e6, raw_total / 1e6 / max(sim_seconds, 1e-9), 100.0 * size_mb * 1e6 / max(raw_total, 1)))
+    for g in sorted(group_bytes, key=lambda g: -group_bytes[g]):
+        print("  %-48s %8.2f MB per sim second uncompressed" % (g, group_bytes[g] / 1e6 / max(sim_seconds, 1e-9)))
     for t in sorted(expected):
         print("  %-48s %6d / %6d expected" % (t, counts.get(t, 0), expected[t]))
     for t in sorted(set(counts) - set(expected)):
         print("  %-48s %6d" % (t, counts[t]))
     print("outcome:       %s (roslaunch exit %d)" % (metrics.get("outcome", "?"), rc))
     print("dropped/missing camera messages: %d" % sum(e - c for e, c in missing.values()))
+    print("summary:       %.2f MB per sim second, %.2fx real time, %d camera messages dropped" % (size_mb / max(sim_seconds, 1e-9), rt_sim / max(rt_wall, 1e-9), sum(e - c for e, c in missing.values()) + dropped_log))
     return 0 if not missing and dropped_log == 0 else 3
 
 

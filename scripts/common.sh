@@ -25,6 +25,9 @@ HAMERITT_PACKAGES=(
   python3-geometry-msgs python3-std-msgs python3-actionlib-msgs
   # rostopic and friends on the cameras' messages, and the MarkerArray for RViz users.
   python3-rostopic python3-sensor-msgs python3-visualization-msgs
+  # Recording tests: an independent PNG decoder (OpenCV's Python binding, with numpy); YAML for
+  # `rosbag info --yaml`.
+  python3-opencv python3-numpy python3-yaml
   # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
   # assimp for the meshes.
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev

@@ -91,7 +91,7 @@ __attribute__((target_clones("avx2", "default")))
 #endif
 void applyCameraEffects(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
                         std::uint8_t* out, CameraEffectsScratch* scratch, int row_begin,
-                        int row_end) {
+                        int row_end, std::uint8_t* noise_free) {
   const bool blur = fx.blur.size() > 1;
   const int n = 3 * width;
   scratch->acc.resize(static_cast<std::size_t>(n));
@@ -118,6 +118,10 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
         acc[i] = static_cast<std::uint16_t>(in[row + static_cast<std::size_t>(i)] << 8);
     }
     std::uint8_t* dst = out + row;
+    if (noise_free != nullptr) {
+      std::uint8_t* clean = noise_free + row;
+      for (int i = 0; i < n; ++i) clean[i] = static_cast<std::uint8_t>((acc[i] + 128) >> 8);
+    }
     if (!noisy) {
       for (int i = 0; i < n; ++i) dst[i] = static_cast<std::uint8_t>((acc[i] + 128) >> 8);
       continue;
@@ -180,6 +184,7 @@ struct CameraEffectsWorker::State {
   // The job: rows [0, rows) of the image.
   const std::uint8_t* in = nullptr;
   std::uint8_t* out = nullptr;
+  std::uint8_t* noise_free = nullptr;
   int width = 0, height = 0, rows = 0;
   const CameraEffects* fx = nullptr;
   CameraEffectsScratch scratch;
@@ -194,7 +199,8 @@ CameraEffectsWorker::CameraEffectsWorker() : state_(std::make_unique<State>()) {
       s->cv.wait(lock, [s] { return s->busy || s->stop; });
       if (s->stop) return;
       lock.unlock();
-      applyCameraEffects(s->in, s->width, s->height, *s->fx, s->out, &s->scratch, 0, s->rows);
+      applyCameraEffects(s->in, s->width, s->height, *s->fx, s->out, &s->scratch, 0, s->rows,
+                         s->noise_free);
       lock.lock();
       s->busy = false;
       s->cv.notify_all();
@@ -213,13 +219,14 @@ CameraEffectsWorker::~CameraEffectsWorker() {
 
 void CameraEffectsWorker::apply(const std::uint8_t* in, int width, int height,
                                 const CameraEffects& fx, std::uint8_t* out,
-                                CameraEffectsScratch* scratch) {
+                                CameraEffectsScratch* scratch, std::uint8_t* noise_free) {
   State* s = state_.get();
   const int half = height / 2;
   {
     std::lock_guard<std::mutex> lock(s->mutex);
     s->in = in;
     s->out = out;
+    s->noise_free = noise_free;
     s->width = width;
     s->height = height;
     s->rows = half;
@@ -227,7 +234,7 @@ void CameraEffectsWorker::apply(const std::uint8_t* in, int width, int height,
     s->busy = true;
   }
   s->cv.notify_all();
-  applyCameraEffects(in, width, height, fx, out, scratch, half, height);
+  applyCameraEffects(in, width, height, fx, out, scratch, half, height, noise_free);
   std::unique_lock<std::mutex> lock(s->mutex);
   s->cv.wait(lock, [s] { return !s->busy; });
 }

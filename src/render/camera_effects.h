@@ -42,10 +42,12 @@ struct CameraEffectsScratch {
 
 // Applies `fx` to `in` (RGB8, rows top first) into `out` (same size), rows [row_begin, row_end)
 // only (row_end < 0: to the last row); every output pixel depends on its coordinates alone, so
-// row ranges can run on different threads.
+// row ranges can run on different threads. A non-null `noise_free` (same size) also receives
+// the image with the blur of `fx` but without its noise: byte for byte what `fx` with
+// noise_std = salt = 0 gives (the compact recording's colour image, which compresses).
 void applyCameraEffects(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
                         std::uint8_t* out, CameraEffectsScratch* scratch, int row_begin = 0,
-                        int row_end = -1);
+                        int row_end = -1, std::uint8_t* noise_free = nullptr);
 
 // A thread that applies camera effects to the first half of an image while the caller does
 // the second (two cores are the target machine's). One job at a time.
@@ -57,7 +59,7 @@ class CameraEffectsWorker {
   CameraEffectsWorker& operator=(const CameraEffectsWorker&) = delete;
 
   void apply(const std::uint8_t* in, int width, int height, const CameraEffects& fx,
-             std::uint8_t* out, CameraEffectsScratch* scratch);
+             std::uint8_t* out, CameraEffectsScratch* scratch, std::uint8_t* noise_free = nullptr);
 
  private:
   struct State;

@@ -1197,9 +1197,18 @@ struct Renderer::Impl {
       readBack(f);
       splitLabels(f);
       stage_end(&t0, &f.stats.readback_ms);
+      std::uint8_t* noise_free = nullptr;
+      if (f.request->noise_free_rgb) {
+        f.out->rgb_noise_free.resize(f.out->rgb.size());
+        noise_free = f.out->rgb_noise_free.data();
+      } else {
+        f.out->rgb_noise_free.clear();
+      }
       if (f.effects.any()) {
         effects_worker.apply(f.color.data(), f.targets->width, f.targets->height, f.effects,
-                             f.out->rgb.data(), &effects_scratch);
+                             f.out->rgb.data(), &effects_scratch, noise_free);
+      } else if (noise_free != nullptr) {
+        std::copy(f.out->rgb.begin(), f.out->rgb.end(), noise_free);
       }
       stage_end(&t0, &f.stats.post_ms);
     }

@@ -1,6 +1,7 @@
 #include "hameritt/ros/camera_rig.h"
 
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/image_encodings.h>
 
@@ -8,8 +9,10 @@
 #include <cmath>
 
 #include "hameritt/BoundingBoxArray.h"
+#include "hameritt/render/depth_encoding.h"
 #include "hameritt/render/renderer.h"
 #include "hameritt/ros/conversions.h"
+#include "hameritt/ros/image_compression.h"
 #include "hameritt/scenario/error.h"
 
 namespace hameritt::ros_wrappers {
@@ -28,11 +31,22 @@ struct CameraRig::Camera {
   bool rgb = false, depth = false, segmentation = false, instances = false;
   ros::Publisher rgb_pub, depth_pub, seg_pub, inst_pub, info_pub, boxes_pub;
   ros::Publisher rgb_dec, depth_dec, seg_dec, inst_dec;
+  ros::Publisher rgb_png, depth_png, seg_png, inst_png;  // <decimated topic>/compressed
 
   // Every topic of this camera (unadvertised ones are empty publishers with no subscribers).
-  std::array<const ros::Publisher*, 10> publishers() const {
-    return {&rgb_pub, &depth_pub, &seg_pub, &inst_pub, &info_pub,
-            &boxes_pub, &rgb_dec, &depth_dec, &seg_dec, &inst_dec};
+  std::array<const ros::Publisher*, 14> publishers() const {
+    return {&rgb_pub,   &depth_pub, &seg_pub,  &inst_pub, &info_pub,  &boxes_pub, &rgb_dec,
+            &depth_dec, &seg_dec,   &inst_dec, &rgb_png,  &depth_png, &seg_png,   &inst_png};
+  }
+  // Whether frame `frame` is one of the compact stream's.
+  bool decimated(std::uint64_t frame) const {
+    return frames_per_decimated > 0 &&
+           frame % static_cast<std::uint64_t>(frames_per_decimated) == 0;
+  }
+  // Whether frame `frame` is one of the compact stream's and someone wants its colour image.
+  bool decimatedRgbWanted(std::uint64_t frame) const {
+    if (!rgb || !decimated(frame)) return false;
+    return rgb_dec.getNumSubscribers() > 0 || (rgb_png && rgb_png.getNumSubscribers() > 0);
   }
   bool wanted() const {
     for (const ros::Publisher* p : publishers()) {
@@ -84,6 +98,18 @@ CameraRig::CameraRig(ros::NodeHandle& nh, const scenario::World& world,
       if (cam->depth) cam->depth_dec = nh.advertise<sensor_msgs::Image>(dns + "depth", 4);
       if (cam->segmentation) cam->seg_dec = nh.advertise<sensor_msgs::Image>(dns + "segmentation", 4);
       if (cam->instances) cam->inst_dec = nh.advertise<sensor_msgs::Image>(dns + "instances", 4);
+      if (options.decimated_png_level >= 0) {
+        // The compressed_image_transport topic names; PNG cannot hold 32FC1 depth.
+        using Compressed = sensor_msgs::CompressedImage;
+        if (cam->rgb) cam->rgb_png = nh.advertise<Compressed>(dns + "image_raw/compressed", 4);
+        if (cam->depth && options.decimated_depth_mm) {
+          cam->depth_png = nh.advertise<Compressed>(dns + "depth/compressed", 4);
+        }
+        if (cam->segmentation)
+          cam->seg_png = nh.advertise<Compressed>(dns + "segmentation/compressed", 4);
+        if (cam->instances)
+          cam->inst_png = nh.advertise<Compressed>(dns + "instances/compressed", 4);
+      }
     }
     cam->info_pub = nh.advertise<sensor_msgs::CameraInfo>(ns + "camera_info", 4);
     cam->boxes_pub = nh.advertise<hameritt::BoundingBoxArray>(ns + "boxes", 4);
@@ -219,6 +245,7 @@ void CameraRig::run(int worker) {
       req.frame_index = frame;
       req.weather = options_.weather;
       req.noise = options_.noise;
+      req.noise_free_rgb = options_.decimated_rgb_noise_free && cam.decimatedRgbWanted(frame);
       // Motion blur along the image-plane direction of the camera's own motion.
       const Eigen::Vector3d v_opt = req.world_T_optical.linear().transpose() * job.velocity;
       if (std::hypot(v_opt.x(), v_opt.y()) > 0.2) {
@@ -274,24 +301,50 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
     m->data.assign(bytes, bytes + static_cast<std::size_t>(w) * h * bytes_per_pixel);
     return m;
   };
-  const bool decimated =
-      cam.frames_per_decimated > 0 && frame % static_cast<std::uint64_t>(cam.frames_per_decimated) == 0;
-  // One message per modality, shared by the full-rate and the decimated publisher.
-  auto send = [&](bool on, const ros::Publisher& full, const ros::Publisher& dec, const std::string& encoding,
-                  int bytes, const void* data) {
-    if (!on) return;
-    const bool to_full = full.getNumSubscribers() > 0;
-    const bool to_dec = decimated && dec.getNumSubscribers() > 0;
-    if (!to_full && !to_dec) return;
-    const sensor_msgs::ImagePtr m = image(encoding, bytes, data);
-    if (to_full) full.publish(m);
-    if (to_dec) dec.publish(m);
+  const bool decimated = cam.decimated(frame);
+  auto wants = [](const ros::Publisher& p) { return p && p.getNumSubscribers() > 0; };
+  struct Plane {
+    std::string encoding;
+    int bytes = 0;
+    const void* data = nullptr;
   };
-  send(cam.rgb, cam.rgb_pub, cam.rgb_dec, sensor_msgs::image_encodings::RGB8, 3, fs.rgb.data());
-  send(cam.depth, cam.depth_pub, cam.depth_dec, sensor_msgs::image_encodings::TYPE_32FC1, 4, fs.depth.data());
-  send(cam.segmentation, cam.seg_pub, cam.seg_dec, sensor_msgs::image_encodings::MONO8, 1, fs.semantic.data());
-  send(cam.instances, cam.inst_pub, cam.inst_dec, sensor_msgs::image_encodings::TYPE_16UC1, 2,
-       fs.instance.data());
+  // One modality: the full-rate message, and the compact stream's (the same message unless the
+  // compact stream converts the image) with its PNG.
+  auto send = [&](bool on, const ros::Publisher& full, const ros::Publisher& dec,
+                  const ros::Publisher& png, const Plane& full_plane, const Plane& dec_plane) {
+    if (!on) return;
+    sensor_msgs::ImagePtr full_msg;
+    if (wants(full)) {
+      full_msg = image(full_plane.encoding, full_plane.bytes, full_plane.data);
+      full.publish(full_msg);
+    }
+    if (!decimated || !(wants(dec) || wants(png))) return;
+    const sensor_msgs::ImagePtr m =
+        (full_msg && dec_plane.data == full_plane.data)
+            ? full_msg
+            : image(dec_plane.encoding, dec_plane.bytes, dec_plane.data);
+    if (wants(dec)) dec.publish(m);
+    if (wants(png)) png.publish(toPngCompressed(*m, options_.decimated_png_level));
+  };
+  namespace enc = sensor_msgs::image_encodings;
+  const Plane rgb{enc::RGB8, 3, fs.rgb.data()};
+  // The noise-free image was requested when the frame was queued; a subscriber that came later
+  // (never while recording: the clock waits for the recorder) gets the noisy one this once.
+  const bool noise_free = fs.rgb_noise_free.size() == fs.rgb.size();
+  send(cam.rgb, cam.rgb_pub, cam.rgb_dec, cam.rgb_png, rgb,
+       noise_free ? Plane{enc::RGB8, 3, fs.rgb_noise_free.data()} : rgb);
+  const Plane depth{enc::TYPE_32FC1, 4, fs.depth.data()};
+  std::vector<std::uint16_t> depth_mm;
+  if (cam.depth && decimated && options_.decimated_depth_mm &&
+      (wants(cam.depth_dec) || wants(cam.depth_png))) {
+    render::depthToMillimetres(fs.depth, &depth_mm);
+  }
+  send(cam.depth, cam.depth_pub, cam.depth_dec, cam.depth_png, depth,
+       depth_mm.empty() ? depth : Plane{enc::TYPE_16UC1, 2, depth_mm.data()});
+  const Plane seg{enc::MONO8, 1, fs.semantic.data()};
+  send(cam.segmentation, cam.seg_pub, cam.seg_dec, cam.seg_png, seg, seg);
+  const Plane inst{enc::TYPE_16UC1, 2, fs.instance.data()};
+  send(cam.instances, cam.inst_pub, cam.inst_dec, cam.inst_png, inst, inst);
   cam.info_pub.publish(toCameraInfoMsg(fs.intrinsics, header));
   cam.boxes_pub.publish(toBoxesMsg(fs.boxes, cam.spec.name, header));
 }

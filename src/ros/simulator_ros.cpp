@@ -91,6 +91,22 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                                   std::to_string(co.lod_max_error_px));
     }
     pnh.param("record_image_rate", co.decimated_rate_hz, 0.0);
+    std::string record_depth = "16UC1";
+    pnh.param<std::string>("record_depth", record_depth, record_depth);
+    if (record_depth != "16UC1" && record_depth != "32FC1") {
+      throw scenario::ConfigError(
+          "~record_depth: expected 16UC1 (millimetres) or 32FC1 (metres), got " + record_depth);
+    }
+    co.decimated_depth_mm = record_depth == "16UC1";
+    bool record_rgb_noise = false;
+    pnh.param("record_rgb_noise", record_rgb_noise, record_rgb_noise);
+    co.decimated_rgb_noise_free = !record_rgb_noise;
+    pnh.param("record_png_level", co.decimated_png_level, co.decimated_png_level);
+    if (co.decimated_png_level > 9) {
+      throw scenario::ConfigError(
+          "~record_png_level: expected -1 (off) or a zlib level 0..9, got " +
+          std::to_string(co.decimated_png_level));
+    }
     if (co.queue_depth < 1) {
       throw scenario::ConfigError("~render_queue_depth: expected >= 1, got " + std::to_string(co.queue_depth));
     }

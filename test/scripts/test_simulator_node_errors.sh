@@ -51,6 +51,10 @@ run trajectory "badtraj.json.*entities.*trajectory" __name:=sim_f _sim_config:="
 run bad_rate "~publish_rate_hz" __name:=sim_g _sim_config:="$S" _publish_rate_hz:=300.0
 run bad_physics "physics_rate_hz" __name:=sim_h _sim_config:="$S" _physics_rate_hz:=-5.0
 run bad_urdf "$T/none.urdf" __name:=sim_i _sim_config:="$S" _urdf:="$T/none.urdf"
+run bad_record_depth "~record_depth: expected 16UC1 \\(millimetres\\) or 32FC1 \\(metres\\), got 16UC2" \
+  __name:=sim_j _sim_config:="$S" _record_depth:=16UC2
+run bad_png_level "~record_png_level: expected -1 \\(off\\) or a zlib level 0..9, got 12" \
+  __name:=sim_k _sim_config:="$S" _record_png_level:=12
 
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -68,6 +68,9 @@ struct RenderRequest {
   // Colour effects; false gives the clean image (labels and depth are never affected).
   bool weather = true;  // fog/dust attenuation, rain/snow particles, snow cover (from sim_config)
   bool noise = true;    // sim_config perturbations.camera_noise
+  // Also return FrameSet::rgb_noise_free: the colour image with its blur and weather but
+  // without the sensor noise (Gaussian, salt-and-pepper), from the same pass.
+  bool noise_free_rgb = false;
   // Image-plane direction of the motion blur (perturbations.camera_noise.motion_blur_px long).
   Eigen::Vector2d blur_direction{1.0, 0.0};
   // Draw the UAV model at world_T_uav (for external views; a payload camera leaves it out).
@@ -97,6 +100,7 @@ struct FrameSet {
   Intrinsics intrinsics;
   Eigen::Isometry3d world_T_optical = Eigen::Isometry3d::Identity();
   std::vector<std::uint8_t> rgb;        // width*height*3, row-major, top row first (rgb8)
+  std::vector<std::uint8_t> rgb_noise_free;  // RenderRequest::noise_free_rgb, else empty
   std::vector<float> depth;             // metres along the optical axis; +inf where nothing is hit
   std::vector<std::uint8_t> semantic;   // 0 sky, 1 ground, else scenario::semanticId(class)
   std::vector<std::uint16_t> instance;  // 0 none, else Renderer::instanceEntityId(value)

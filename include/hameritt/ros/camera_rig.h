@@ -45,6 +45,15 @@ struct CameraRigOptions {
   // rate (Hz of sim time; 0 = off; must divide the camera rate): the compact training stream
   // that record.launch records by default.
   double decimated_rate_hz = 0.0;
+  // The compact stream's depth: 16UC1 millimetres (render/depth_encoding.h: 0.5 mm, 0 = no
+  // return, 65535 = 65.5345 m or farther) when true, else the full stream's 32FC1 metres.
+  bool decimated_depth_mm = true;
+  // The compact stream's colour image: without the sensor noise (render::FrameSet::
+  // rgb_noise_free: blur and weather kept) when true, else the noisy full-rate image.
+  bool decimated_rgb_noise_free = true;
+  // Also publish the compact stream as sensor_msgs/CompressedImage PNG on <topic>/compressed
+  // (ros_wrappers::toPngCompressed; depth only as 16UC1), at this zlib level (0-9; < 0: off).
+  int decimated_png_level = -1;
 };
 
 class CameraRig {
