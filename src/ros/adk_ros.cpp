@@ -373,8 +373,12 @@ void AdkRos::finish() {
   finished_at_ = ros::WallTime::now();
   std::string reason = lifecycle_->reason();
   if (watchdog_->lateStart() >= 0) {
-    reason += "; the ADK started at sim time " + scenario::formatNumber(watchdog_->lateStart()) +
-              " s (restarted?): the metrics cover only the mission from then on";
+    char late[160];
+    std::snprintf(late, sizeof(late),
+                  "; the ADK started at sim time %.3f s (restarted?): the metrics cover only the "
+                  "mission from then on",
+                  watchdog_->lateStart());
+    reason += late;
   }
   const adk::MissionMetrics m = metrics_->finish(
       adk::outcomeOf(lifecycle_->state()), reason, lifecycle_->startTime(),
