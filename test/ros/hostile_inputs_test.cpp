@@ -354,7 +354,7 @@ TEST(HostileInputs, AdkAndClients) {
   d.position.y = kInf;
   g->send(g->detections, d);
   cases += 2;
-  // Ground truth with a non-finite time is impossible in a stamp; non-finite poses:
+  // Ground truth (a stamp cannot be non-finite) with a non-finite pose:
   hameritt::EntityStateArray bad_truth;
   bad_truth.header.stamp.fromSec(t);
   bad_truth.entities.resize(1);
@@ -382,6 +382,7 @@ TEST(HostileInputs, AdkAndClients) {
   EXPECT_EQ(g->rosout.errors("/adk", {"/uav/odom", "header.stamp", "older than the last"}), 1);
   EXPECT_EQ(g->rosout.errors("/adk", {"/perception/detections", "hostile", "finite"}), 1);
   EXPECT_EQ(g->rosout.errors("/adk", {"boxes[].entity_id 'no_such_entity'"}), 1);
+  EXPECT_EQ(g->rosout.errors("/adk", {"/ground_truth/entities", "entities[0] 'car_nan'", "finite"}), 1);
   EXPECT_EQ(g->rosout.errors("/planner", {"/uav/odom", "pose.pose.position[0].x"}), 1)
       << g->rosout.dump("/planner");
   for (const char* client : {"/coverage_search_client", "/color_shape_detector"}) {
