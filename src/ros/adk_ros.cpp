@@ -197,9 +197,10 @@ void AdkRos::onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
   const bool was_late = watchdog_->lateStart() >= 0;
   watchdog_->clock(t, ros::WallTime::now().toSec());
   if (!was_late && watchdog_->lateStart() >= 0) {
-    ROS_WARN("adk: started in a mission under way (first sim time %.3f s): the metrics will "
-             "cover only what happens from now on",
-             watchdog_->lateStart());
+    ROS_WARN(
+        "adk: started in a mission under way (first sim time %.3f s): the metrics will "
+        "cover only what happens from now on",
+        watchdog_->lateStart());
   }
   now_ = std::max(now_, t);
   // While odometry flows, it drives the start and the time limit, so that the metrics include
@@ -381,8 +382,8 @@ void AdkRos::finish() {
     reason += late;
   }
   const adk::MissionMetrics m = metrics_->finish(
-      adk::outcomeOf(lifecycle_->state()), reason, lifecycle_->startTime(),
-      lifecycle_->endTime(), lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+      adk::outcomeOf(lifecycle_->state()), reason, lifecycle_->startTime(), lifecycle_->endTime(),
+      lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
   std::string file;
   if (!output_dir_.empty()) {
     try {

@@ -136,8 +136,9 @@ std::optional<scenario::Mission> acceptMission(const hameritt::Mission& msg,
     return std::nullopt;
   }
   if (m.scenario_id != scenario_id) {
-    HAMERITT_ERROR_THROTTLE(5.0, "%s: /mission: scenario_id: expected '%s' (the sim_config's), got '%s'; ignored",
-                            client, scenario_id.c_str(), m.scenario_id.c_str());
+    HAMERITT_ERROR_THROTTLE(
+        5.0, "%s: /mission: scenario_id: expected '%s' (the sim_config's), got '%s'; ignored",
+        client, scenario_id.c_str(), m.scenario_id.c_str());
     return std::nullopt;
   }
   return m;

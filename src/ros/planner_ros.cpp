@@ -90,7 +90,8 @@ bool PlannerRos::onPlan(hameritt::PlanPath::Request& req, hameritt::PlanPath::Re
     std::string error = planning::checkWaypoints({toVec(req.start)}, "start");
     if (error.empty()) error = planning::checkWaypoints(points, "waypoints");
     if (error.empty() && !std::isfinite(req.start_time)) {
-      error = "start_time: expected a finite time (s), got " + scenario::formatNumber(req.start_time);
+      error =
+          "start_time: expected a finite time (s), got " + scenario::formatNumber(req.start_time);
     }
     if (!error.empty()) throw scenario::ConfigError(error);
     points.insert(points.begin(), toVec(req.start));
@@ -117,7 +118,7 @@ void PlannerRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
       planning::checkWaypoints({toVec(msg->pose.pose.position)}, "pose.pose.position");
   if (!error.empty()) {
     HAMERITT_ERROR_THROTTLE(5.0, "planner: %s: %s; ignored", odom_sub_.getTopic().c_str(),
-                       error.c_str());
+                            error.c_str());
     return;
   }
   odom_ = *msg;
@@ -147,7 +148,7 @@ void PlannerRos::onWaypoints(const nav_msgs::Path::ConstPtr& msg) {
   }
   if (!error.empty()) {
     HAMERITT_ERROR_THROTTLE(5.0, "planner: %s: %s; ignored", waypoints_sub_.getTopic().c_str(),
-                       error.c_str());
+                            error.c_str());
     return;
   }
   waypoints_ = std::move(points);

@@ -1,4 +1,3 @@
-#include "hameritt/build_paths.h"
 #include "hameritt/ros/simulator_ros.h"
 
 #include <ros/callback_queue.h>
@@ -10,6 +9,7 @@
 
 #include "hameritt/CrashEvent.h"
 #include "hameritt/EntityStateArray.h"
+#include "hameritt/build_paths.h"
 #include "hameritt/ros/conversions.h"
 #include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
@@ -285,12 +285,12 @@ void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
   const sim::SetpointCheck c = guard_->checkVelocity(&v, &yaw_rate);
   if (!c.error.empty()) {
     HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: %s; setpoint ignored", vel_sub_.getTopic().c_str(),
-                       c.error.c_str());
+                            c.error.c_str());
     return;
   }
   if (!c.clamped.empty()) {
     HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: clamped %s", vel_sub_.getTopic().c_str(),
-                       c.clamped.c_str());
+                            c.clamped.c_str());
   }
   cmd_velocity_ = v;
   cmd_yaw_rate_ = yaw_rate;
@@ -300,8 +300,9 @@ void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
 
 void SimulatorRos::onPose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
   if (!msg->header.frame_id.empty() && msg->header.frame_id != kMapFrame) {
-    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: header.frame_id: expected '%s' (or empty), got '%s'; setpoint ignored",
-                       pose_sub_.getTopic().c_str(), kMapFrame, msg->header.frame_id.c_str());
+    HAMERITT_ERROR_THROTTLE(
+        5.0, "simulator: %s: header.frame_id: expected '%s' (or empty), got '%s'; setpoint ignored",
+        pose_sub_.getTopic().c_str(), kMapFrame, msg->header.frame_id.c_str());
     return;
   }
   const auto& q = msg->pose.orientation;
@@ -310,13 +311,13 @@ void SimulatorRos::onPose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
   sim::Vec3 p(msg->pose.position.x, msg->pose.position.y, msg->pose.position.z);
   const sim::SetpointCheck c = guard_->checkPosition(&p, &yaw);
   if (!c.error.empty()) {
-    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: %s; setpoint ignored", pose_sub_.getTopic().c_str(),
-                       c.error.c_str());
+    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: %s; setpoint ignored",
+                            pose_sub_.getTopic().c_str(), c.error.c_str());
     return;
   }
   if (!c.clamped.empty()) {
     HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: clamped %s", pose_sub_.getTopic().c_str(),
-                       c.clamped.c_str());
+                            c.clamped.c_str());
   }
   velocity_mode_ = false;
   sim_->setPositionSetpoint(p, yaw);

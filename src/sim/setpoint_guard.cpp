@@ -23,7 +23,8 @@ void addField(std::string* list, const std::string& field) {
 SetpointGuard::SetpointGuard(const Geofence& fence, const QuadrotorParams& params)
     : fence_(fence), params_(params) {
   for (int i = 0; i < 3; ++i) {
-    if (!(std::isfinite(fence.min[i]) && std::isfinite(fence.max[i]) && fence.min[i] < fence.max[i])) {
+    if (!(std::isfinite(fence.min[i]) && std::isfinite(fence.max[i]) &&
+          fence.min[i] < fence.max[i])) {
       throw scenario::ConfigError(std::string("geofence: ") + kAxis[i] +
                                   ": expected finite min < max, got [" + fmt(fence.min[i]) + ", " +
                                   fmt(fence.max[i]) + "]");
@@ -57,8 +58,8 @@ SetpointCheck SetpointGuard::checkVelocity(Vec3* velocity, double* yaw_rate) con
   const double z = std::clamp(velocity->z(), -params_.max_descent, params_.max_climb);
   if (z != velocity->z()) {
     velocity->z() = z;
-    addField(&out.clamped, "linear.z to [-" + fmt(params_.max_descent) + ", " +
-                               fmt(params_.max_climb) + "] m/s");
+    addField(&out.clamped,
+             "linear.z to [-" + fmt(params_.max_descent) + ", " + fmt(params_.max_climb) + "] m/s");
   }
   const double w = std::clamp(*yaw_rate, -params_.max_yaw_rate, params_.max_yaw_rate);
   if (w != *yaw_rate) {
@@ -72,8 +73,8 @@ SetpointCheck SetpointGuard::checkPosition(Vec3* position, double* yaw) const {
   SetpointCheck out;
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite((*position)[i])) {
-      out.error = std::string("pose.position.") + kAxis[i] + ": expected a finite coordinate (m), got " +
-                  fmt((*position)[i]);
+      out.error = std::string("pose.position.") + kAxis[i] +
+                  ": expected a finite coordinate (m), got " + fmt((*position)[i]);
       return out;
     }
   }

@@ -134,7 +134,9 @@ struct Graph {
     }
     pub.publish(m);
   }
-  void settle() { spinUntil([] { return false; }, 0.3); }
+  void settle() {
+    spinUntil([] { return false; }, 0.3);
+  }
 
   ros::NodeHandle nh;
   Rosout rosout;
@@ -215,7 +217,8 @@ TEST(HostileInputs, SimulatorSetpoints) {
   EXPECT_NEAR(held.z, start.z, 0.5);
   EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_vel", "expected a finite", "ignored"}), 1)
       << g->rosout.dump("/simulator");
-  EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_pose", "pose.position.", "expected a finite"}), 1);
+  EXPECT_EQ(
+      g->rosout.errors("/simulator", {"/uav/cmd_pose", "pose.position.", "expected a finite"}), 1);
   EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_pose", "header.frame_id", "'map'"}), 1);
 
   // Absurd finite velocity: clamped to the controller's limits; the geofence stops the UAV at
@@ -321,9 +324,14 @@ TEST(HostileInputs, PlannerRequestsAndWaypoints) {
   // An empty list stops the follower (documented), a valid one is flown.
   g->send(g->waypoints, pathOf({}));
   ++cases;
-  EXPECT_TRUE(spinUntil([] { return !g->progress.all.empty() && g->progress.last().message == "empty waypoint list"; }, 10));
+  EXPECT_TRUE(spinUntil(
+      [] {
+        return !g->progress.all.empty() && g->progress.last().message == "empty waypoint list";
+      },
+      10));
   g->send(g->waypoints, pathOf({h + V(40, 0, 0)}));
-  EXPECT_TRUE(spinUntil([] { return !g->progress.all.empty() && g->progress.last().state == "following"; }, 30))
+  EXPECT_TRUE(spinUntil(
+      [] { return !g->progress.all.empty() && g->progress.last().state == "following"; }, 30))
       << (g->progress.all.empty() ? "" : g->progress.last().message);
   EXPECT_TRUE(alive("/planner"));
 }
@@ -378,11 +386,13 @@ TEST(HostileInputs, AdkAndClients) {
   g->send(g->mission, m);
   cases += 4;
   g->settle();
-  EXPECT_EQ(g->rosout.errors("/adk", {"/uav/odom", "expected finite"}), 1) << g->rosout.dump("/adk");
+  EXPECT_EQ(g->rosout.errors("/adk", {"/uav/odom", "expected finite"}), 1)
+      << g->rosout.dump("/adk");
   EXPECT_EQ(g->rosout.errors("/adk", {"/uav/odom", "header.stamp", "older than the last"}), 1);
   EXPECT_EQ(g->rosout.errors("/adk", {"/perception/detections", "hostile", "finite"}), 1);
   EXPECT_EQ(g->rosout.errors("/adk", {"boxes[].entity_id 'no_such_entity'"}), 1);
-  EXPECT_EQ(g->rosout.errors("/adk", {"/ground_truth/entities", "entities[0] 'car_nan'", "finite"}), 1);
+  EXPECT_EQ(g->rosout.errors("/adk", {"/ground_truth/entities", "entities[0] 'car_nan'", "finite"}),
+            1);
   EXPECT_EQ(g->rosout.errors("/planner", {"/uav/odom", "pose.pose.position[0].x"}), 1)
       << g->rosout.dump("/planner");
   for (const char* client : {"/coverage_search_client", "/color_shape_detector"}) {
@@ -406,8 +416,9 @@ TEST(HostileInputs, AdkAndClients) {
     EXPECT_TRUE(alive(node)) << node;
   }
   EXPECT_EQ(g->badSample(), "");
-  std::printf("hostile_inputs: %d hostile messages and requests sent, %zu odometry samples checked\n",
-              cases, g->flight.all.size());
+  std::printf(
+      "hostile_inputs: %d hostile messages and requests sent, %zu odometry samples checked\n",
+      cases, g->flight.all.size());
 }
 
 }  // namespace

@@ -79,11 +79,11 @@ TEST(SetpointGuard, ClampsPositionsIntoTheFenceAndRejectsNonFinite) {
 TEST(SetpointGuard, FenceDropsOutwardVelocityNearAFaceAndReturnsBeyondIt) {
   const SetpointGuard g = guard();
   const Vec3 out(12, -12, 3);
-  EXPECT_EQ(g.fenceVelocity(Vec3(0, 0, 30), out), out);              // far from every face
+  EXPECT_EQ(g.fenceVelocity(Vec3(0, 0, 30), out), out);               // far from every face
   EXPECT_EQ(g.fenceVelocity(Vec3(85, 0, 30), out), Vec3(0, -12, 3));  // near +x
   EXPECT_EQ(g.fenceVelocity(Vec3(0, -45, 70), out), Vec3(12, 0, 0));  // near -y and the ceiling
-  EXPECT_EQ(g.fenceVelocity(Vec3(0, 0, 1), Vec3(0, 0, -2)), Vec3(0, 0, -2));  // landing allowed
-  EXPECT_EQ(g.fenceVelocity(Vec3(101, 0, 30), out), Vec3(-1, -12, 3));        // beyond: return
+  EXPECT_EQ(g.fenceVelocity(Vec3(0, 0, 1), Vec3(0, 0, -2)), Vec3(0, 0, -2));    // landing allowed
+  EXPECT_EQ(g.fenceVelocity(Vec3(101, 0, 30), out), Vec3(-1, -12, 3));          // beyond: return
   EXPECT_EQ(g.fenceVelocity(Vec3(85, 0, 30), Vec3(-5, 0, 0)), Vec3(-5, 0, 0));  // inward kept
 }
 
