@@ -6,6 +6,16 @@
 
 namespace hameritt::planning {
 
+std::string checkPoint(const geometry::Vec3& p, const std::string& field) {
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(p[a])) {
+      return field + "." + std::string(1, "xyz"[a]) + ": expected a finite coordinate (m), got " +
+             scenario::formatNumber(p[a]);
+    }
+  }
+  return "";
+}
+
 std::string checkWaypoints(const std::vector<geometry::Vec3>& points, const std::string& field,
                            std::size_t max_count) {
   if (points.empty()) return field + ": expected at least one waypoint (the goal), got none";
@@ -14,12 +24,8 @@ std::string checkWaypoints(const std::vector<geometry::Vec3>& points, const std:
            std::to_string(points.size());
   }
   for (std::size_t i = 0; i < points.size(); ++i) {
-    for (int a = 0; a < 3; ++a) {
-      if (!std::isfinite(points[i][a])) {
-        return field + "[" + std::to_string(i) + "]." + std::string(1, "xyz"[a]) +
-               ": expected a finite coordinate (m), got " + scenario::formatNumber(points[i][a]);
-      }
-    }
+    std::string error = checkPoint(points[i], field + "[" + std::to_string(i) + "]");
+    if (!error.empty()) return error;
   }
   return "";
 }

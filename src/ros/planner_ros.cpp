@@ -87,7 +87,7 @@ bool PlannerRos::onPlan(hameritt::PlanPath::Request& req, hameritt::PlanPath::Re
     s.algorithm = parseAlgorithm(req.algorithm);
     std::vector<geometry::Vec3> points;
     for (const auto& w : req.waypoints) points.push_back(toVec(w));
-    std::string error = planning::checkWaypoints({toVec(req.start)}, "start");
+    std::string error = planning::checkPoint(toVec(req.start), "start");
     if (error.empty()) error = planning::checkWaypoints(points, "waypoints");
     if (error.empty() && !std::isfinite(req.start_time)) {
       error =
@@ -115,7 +115,7 @@ bool PlannerRos::onPlan(hameritt::PlanPath::Request& req, hameritt::PlanPath::Re
 
 void PlannerRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const std::string error =
-      planning::checkWaypoints({toVec(msg->pose.pose.position)}, "pose.pose.position");
+      planning::checkPoint(toVec(msg->pose.pose.position), "pose.pose.position");
   if (!error.empty()) {
     HAMERITT_ERROR_THROTTLE(5.0, "planner: %s: %s; ignored", odom_sub_.getTopic().c_str(),
                             error.c_str());

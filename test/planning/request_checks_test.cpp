@@ -7,6 +7,12 @@
 namespace hameritt::planning {
 namespace {
 
+TEST(CheckPoint, NamesTheFieldAndAxis) {
+  EXPECT_EQ(checkPoint(geometry::Vec3(1, 2, 3), "start"), "");
+  EXPECT_EQ(checkPoint(geometry::Vec3(1, std::numeric_limits<double>::quiet_NaN(), 3), "start"),
+            "start.y: expected a finite coordinate (m), got nan");
+}
+
 TEST(CheckWaypoints, AcceptsFiniteListsWithinTheLimit) {
   EXPECT_EQ(checkWaypoints({geometry::Vec3(1, 2, 3)}, "waypoints"), "");
   EXPECT_EQ(checkWaypoints(std::vector<geometry::Vec3>(kMaxWaypoints, geometry::Vec3(1e9, -1e9, 0)),

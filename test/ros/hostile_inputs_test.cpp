@@ -283,7 +283,7 @@ TEST(HostileInputs, PlannerRequestsAndWaypoints) {
   nan_start.y = kNan;
   auto r = request(nan_start, {goal}, 0);
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.message.find("start[0].y: expected a finite coordinate"), 0u) << r.message;
+  EXPECT_EQ(r.message.find("start.y: expected a finite coordinate"), 0u) << r.message;
   geometry_msgs::Point inf_goal = goal;
   inf_goal.z = kInf;
   r = request(s, {goal, inf_goal}, 0);
@@ -393,7 +393,7 @@ TEST(HostileInputs, AdkAndClients) {
   EXPECT_EQ(g->rosout.errors("/adk", {"boxes[].entity_id 'no_such_entity'"}), 1);
   EXPECT_EQ(g->rosout.errors("/adk", {"/ground_truth/entities", "entities[0] 'car_nan'", "finite"}),
             1);
-  EXPECT_EQ(g->rosout.errors("/planner", {"/uav/odom", "pose.pose.position[0].x"}), 1)
+  EXPECT_EQ(g->rosout.errors("/planner", {"/uav/odom", "pose.pose.position.x"}), 1)
       << g->rosout.dump("/planner");
   for (const char* client : {"/coverage_search_client", "/color_shape_detector"}) {
     EXPECT_EQ(g->rosout.errors(client, {"/mission: scenario_id: expected", "ffffffffffffffff"}), 1)

@@ -12,6 +12,10 @@ namespace hameritt::planning {
 // each leg is a planning query).
 constexpr std::size_t kMaxWaypoints = 1000;
 
+// Checks one point: "" when every coordinate is finite, else e.g.
+// "start.y: expected a finite coordinate (m), got nan".
+std::string checkPoint(const geometry::Vec3& p, const std::string& field);
+
 // Checks a request's waypoints: between 1 and max_count of them, every coordinate finite.
 // Returns "" when they are acceptable, else an error naming the field, e.g.
 // "waypoints[3].z: expected a finite coordinate (m), got nan".

@@ -14,9 +14,6 @@ struct Geofence {
   // Within this distance of a face, a velocity setpoint's outward component is dropped (the
   // braking distance from full speed at full tilt, with room for the controller's lag).
   double brake_distance = 20.0;
-  bool contains(const Vec3& p) const {
-    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
-  }
 };
 
 // What a setpoint check decided: `error` is empty when the setpoint was accepted as it is or
@@ -43,6 +40,7 @@ class SetpointGuard {
   // 1 m/s is commanded instead).
   Vec3 fenceVelocity(const Vec3& position, const Vec3& velocity) const;
 
+  // The fence this guard keeps.
   const Geofence& fence() const { return fence_; }
 
  private:
