@@ -27,6 +27,14 @@ void GroundTruthHistory::add(double t, std::vector<EntityTruth> entities) {
     throw InputError("ground truth: time: expected a finite number, got " +
                      scenario::formatNumber(t));
   }
+  // A whole snapshot is refused for one bad entity: interpolating across it would be wrong.
+  for (std::size_t i = 0; i < entities.size(); ++i) {
+    const EntityTruth& e = entities[i];
+    if (!e.position.allFinite() || !std::isfinite(e.yaw)) {
+      throw InputError("ground truth: entities[" + std::to_string(i) + "] '" + e.id +
+                       "': expected a finite position and yaw");
+    }
+  }
   if (!snapshots_.empty() && !(t > snapshots_.back().t)) snapshots_.clear();
   snapshots_.push_back(Snapshot{t, std::move(entities)});
   std::size_t drop = 0;

@@ -15,6 +15,7 @@
 #include "hameritt/MissionState.h"
 #include "hameritt/PerceptionReport.h"
 #include "hameritt/ros/adk_conversions.h"
+#include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/sim_config_io.h"
@@ -70,6 +71,13 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     throw ConfigError("~end_linger: expected wall seconds in [0, 60], got " +
                       scenario::formatNumber(end_linger_));
   }
+  double clock_timeout = 10.0;
+  pnh.param("clock_timeout", clock_timeout, clock_timeout);
+  if (!(clock_timeout >= 0.0 && clock_timeout <= 3600.0)) {
+    throw ConfigError("~clock_timeout: expected wall seconds in [0, 3600] (0 = off), got " +
+                      scenario::formatNumber(clock_timeout));
+  }
+  watchdog_ = std::make_unique<adk::ClockWatchdog>(clock_timeout);
   adk::ScoringSettings scoring;
   pnh.param("car_gate", scoring.car_gate, scoring.car_gate);
   pnh.param("pedestrian_gate", scoring.pedestrian_gate, scoring.pedestrian_gate);
@@ -186,6 +194,14 @@ void AdkRos::onStateTimer(const ros::WallTimerEvent&) { publishState(); }
 void AdkRos::onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
   if (finished_) return;
   const double t = msg->clock.toSec();
+  const bool was_late = watchdog_->lateStart() >= 0;
+  watchdog_->clock(t, ros::WallTime::now().toSec());
+  if (!was_late && watchdog_->lateStart() >= 0) {
+    ROS_WARN(
+        "adk: started in a mission under way (first sim time %.3f s): the metrics will "
+        "cover only what happens from now on",
+        watchdog_->lateStart());
+  }
   now_ = std::max(now_, t);
   // While odometry flows, it drives the start and the time limit, so that the metrics include
   // the sample at the limit (the simulator publishes the clock before the odometry of a step);
@@ -204,10 +220,10 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     // The simulator publishes the state twice at a step it was asked for; a time going back is
     // a reset, which a mission run does not do.
     if (t < last_odom_t_) {
-      ROS_WARN_THROTTLE(5.0,
-                        "adk: odometry at t = %.6f s is older than the last (%.6f s); "
-                        "ignored (was the simulator reset?)",
-                        t, last_odom_t_);
+      HAMERITT_ERROR_THROTTLE(5.0,
+                              "adk: %s: header.stamp %.6f s is older than the last (%.6f s); "
+                              "ignored (was the simulator reset?)",
+                              odom_sub_.getTopic().c_str(), t, last_odom_t_);
     }
     return;
   }
@@ -218,7 +234,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     for (const auto& e : monitor_->add(t, p)) events_pub_.publish(toMsg(e));
     metrics_->addState(t, p, v);
   } catch (const adk::InputError& e) {
-    ROS_WARN_THROTTLE(5.0, "adk: odometry ignored: %s", e.what());
+    HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", odom_sub_.getTopic().c_str(), e.what());
     return;
   }
   have_odom_ = true;
@@ -247,7 +263,7 @@ void AdkRos::onTruth(const hameritt::EntityStateArray::ConstPtr& msg) {
   try {
     truth_.add(msg->header.stamp.toSec(), fromMsg(*msg));
   } catch (const adk::InputError& e) {
-    ROS_WARN_THROTTLE(5.0, "adk: ground truth ignored: %s", e.what());
+    HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", truth_sub_.getTopic().c_str(), e.what());
   }
 }
 
@@ -310,10 +326,10 @@ void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::Const
       pe.role = "world";
       pe.attributes = toKeyValues(we.attributes);
     } else {
-      ROS_WARN_THROTTLE(5.0,
-                        "adk: camera %s: box of '%s', which is neither a scenario entity "
-                        "nor a parked world car; ignored",
-                        cam.name.c_str(), box.entity_id.c_str());
+      HAMERITT_ERROR_THROTTLE(5.0,
+                              "adk: camera %s: boxes[].entity_id '%s' is neither a scenario "
+                              "entity nor a parked world car; ignored",
+                              cam.name.c_str(), box.entity_id.c_str());
       continue;
     }
     pe.position.x = where.position.x();
@@ -334,7 +350,8 @@ void AdkRos::onDetection(const hameritt::Detection::ConstPtr& msg) {
   try {
     v = scorer_->score(claim, truthAt(claim.stamp));
   } catch (const adk::InputError& e) {
-    ROS_WARN_THROTTLE(5.0, "adk: detection from '%s' ignored: %s", msg->client.c_str(), e.what());
+    HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: detection from '%s': %s; ignored",
+                            detection_sub_.getTopic().c_str(), msg->client.c_str(), e.what());
     return;
   }
   metrics_->addVerdict(claim.stamp, v);
@@ -355,9 +372,18 @@ void AdkRos::finish() {
   if (finished_) return;
   finished_ = true;
   finished_at_ = ros::WallTime::now();
+  std::string reason = lifecycle_->reason();
+  if (watchdog_->lateStart() >= 0) {
+    char late[160];
+    std::snprintf(late, sizeof(late),
+                  "; the ADK started at sim time %.3f s (restarted?): the metrics cover only the "
+                  "mission from then on",
+                  watchdog_->lateStart());
+    reason += late;
+  }
   const adk::MissionMetrics m = metrics_->finish(
-      adk::outcomeOf(lifecycle_->state()), lifecycle_->reason(), lifecycle_->startTime(),
-      lifecycle_->endTime(), lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+      adk::outcomeOf(lifecycle_->state()), reason, lifecycle_->startTime(), lifecycle_->endTime(),
+      lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
   std::string file;
   if (!output_dir_.empty()) {
     try {
@@ -389,6 +415,14 @@ int AdkRos::spin() {
   ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
   while (true) {
     queue->callAvailable(ros::WallDuration(0.02));
+    if (!finished_) {
+      const std::string stalled = watchdog_->stalled(ros::WallTime::now().toSec());
+      if (!stalled.empty()) {
+        ROS_ERROR("adk: %s: aborting the mission", stalled.c_str());
+        lifecycle_->abort(now_, stalled);
+        finish();
+      }
+    }
     if (g_stop || !ros::ok()) {
       if (!finished_) {
         lifecycle_->abort(now_, g_stop ? "interrupted (SIGINT/SIGTERM) before the end"

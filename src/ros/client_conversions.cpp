@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "hameritt/ros/log_throttle.h"
 #include "hameritt/ros/mission_conversions.h"
 #include "hameritt/scenario/error.h"
 
@@ -131,12 +132,13 @@ std::optional<scenario::Mission> acceptMission(const hameritt::Mission& msg,
   try {
     m = fromMsg(msg);
   } catch (const std::exception& e) {
-    ROS_ERROR("%s: ignoring the mission: %s", client, e.what());
+    HAMERITT_ERROR_THROTTLE(5.0, "%s: /mission: ignored: %s", client, e.what());
     return std::nullopt;
   }
   if (m.scenario_id != scenario_id) {
-    ROS_ERROR("%s: ignoring mission %s: the sim_config is for %s", client, m.scenario_id.c_str(),
-              scenario_id.c_str());
+    HAMERITT_ERROR_THROTTLE(
+        5.0, "%s: /mission: scenario_id: expected '%s' (the sim_config's), got '%s'; ignored",
+        client, scenario_id.c_str(), m.scenario_id.c_str());
     return std::nullopt;
   }
   return m;

@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "hameritt/FollowProgress.h"
+#include "hameritt/planning/request_checks.h"
 #include "hameritt/ros/conversions.h"
+#include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/rng.h"
@@ -81,11 +83,18 @@ PlannerRos::PlannerRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 
 bool PlannerRos::onPlan(hameritt::PlanPath::Request& req, hameritt::PlanPath::Response& res) {
   try {
-    if (req.waypoints.empty()) throw scenario::ConfigError("waypoints: at least one (the goal)");
     planning::UavPlannerSettings s = settings_;
     s.algorithm = parseAlgorithm(req.algorithm);
-    std::vector<geometry::Vec3> points{toVec(req.start)};
+    std::vector<geometry::Vec3> points;
     for (const auto& w : req.waypoints) points.push_back(toVec(w));
+    std::string error = planning::checkPoint(toVec(req.start), "start");
+    if (error.empty()) error = planning::checkWaypoints(points, "waypoints");
+    if (error.empty() && !std::isfinite(req.start_time)) {
+      error =
+          "start_time: expected a finite time (s), got " + scenario::formatNumber(req.start_time);
+    }
+    if (!error.empty()) throw scenario::ConfigError(error);
+    points.insert(points.begin(), toVec(req.start));
     const planning::PlanResult r =
         planning::planUavWaypoints(*full_validity_, points, req.start_time, s, req.seed);
     res.success = r.ok();
@@ -105,6 +114,13 @@ bool PlannerRos::onPlan(hameritt::PlanPath::Request& req, hameritt::PlanPath::Re
 }
 
 void PlannerRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
+  const std::string error =
+      planning::checkPoint(toVec(msg->pose.pose.position), "pose.pose.position");
+  if (!error.empty()) {
+    HAMERITT_ERROR_THROTTLE(5.0, "planner: %s: %s; ignored", odom_sub_.getTopic().c_str(),
+                            error.c_str());
+    return;
+  }
   odom_ = *msg;
   have_odom_ = true;
 }
@@ -120,8 +136,22 @@ std::vector<scenario::KeepOutZone> PlannerRos::committedZones(double t) const {
 }
 
 void PlannerRos::onWaypoints(const nav_msgs::Path::ConstPtr& msg) {
-  waypoints_.clear();
-  for (const auto& p : msg->poses) waypoints_.push_back(toVec(p.pose.position));
+  // Hostile lists are refused whole, the path being flown is kept; an empty list stops.
+  std::vector<geometry::Vec3> points;
+  for (const auto& p : msg->poses) points.push_back(toVec(p.pose.position));
+  std::string error;
+  if (!msg->header.frame_id.empty() && msg->header.frame_id != kMapFrame) {
+    error = "header.frame_id: expected '" + std::string(kMapFrame) + "' (or empty), got '" +
+            msg->header.frame_id + "'";
+  } else if (!points.empty()) {
+    error = planning::checkWaypoints(points, "poses");
+  }
+  if (!error.empty()) {
+    HAMERITT_ERROR_THROTTLE(5.0, "planner: %s: %s; ignored", waypoints_sub_.getTopic().c_str(),
+                            error.c_str());
+    return;
+  }
+  waypoints_ = std::move(points);
   next_waypoint_ = 0;
   replans_ = 0;
   path_.clear();

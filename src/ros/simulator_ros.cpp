@@ -1,4 +1,3 @@
-#include "hameritt/build_paths.h"
 #include "hameritt/ros/simulator_ros.h"
 
 #include <ros/callback_queue.h>
@@ -10,7 +9,9 @@
 
 #include "hameritt/CrashEvent.h"
 #include "hameritt/EntityStateArray.h"
+#include "hameritt/build_paths.h"
 #include "hameritt/ros/conversions.h"
+#include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/generator.h"
 #include "hameritt/scenario/scenario_io.h"
@@ -75,6 +76,19 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (duration_ <= 0) duration_ = config_.duration;
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(config_, sim_config));
   sim_ = std::make_unique<sim::Simulator>(*world_, config_, sim::loadQuadrotorUrdf(urdf), settings);
+  double fence_margin = 50.0;
+  pnh.param("geofence_margin", fence_margin, fence_margin);
+  if (!(fence_margin >= 0 && fence_margin <= 10000)) {
+    throw scenario::ConfigError("~geofence_margin: expected metres in [0, 10000], got " +
+                                std::to_string(fence_margin));
+  }
+  sim::Geofence fence;
+  const geometry::Aabb2 b = world_->bounds();
+  fence.min = sim::Vec3(b.min.x() - fence_margin, b.min.y() - fence_margin, 0.0);
+  fence.max = sim::Vec3(b.max.x() + fence_margin, b.max.y() + fence_margin,
+                        config_.uav.altitude_max + fence_margin);
+  fence.brake_distance = std::min(20.0, fence_margin);
+  guard_ = std::make_unique<sim::SetpointGuard>(fence, sim_->params());
   bool cameras = true;
   pnh.param("cameras", cameras, true);
   if (cameras && !config_.uav.cameras.empty()) {
@@ -115,7 +129,9 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
              cameras_->glRenderer().c_str());
   }
 
-  clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  // A lock-step call publishes a burst of ticks at once: with a queue of 10, a recorder lost
+  // about half of them at 25 ticks per call (test_mission_replay), differently in every run.
+  clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 1000);
   odom_pub_ = nh.advertise<nav_msgs::Odometry>("uav/odom", 50);
   imu_pub_ = nh.advertise<sensor_msgs::Imu>("uav/imu", 50);
   truth_pub_ = nh.advertise<hameritt::EntityStateArray>("ground_truth/entities", 10);
@@ -189,7 +205,10 @@ void SimulatorRos::advance(int steps) {
     sim_->step();
     ++step_count_;
     if (cameras_) cameras_->afterStep(step_count_, sim_->uav());
-    if (step_count_ % steps_per_publish_ == 0) publishState(false);
+    if (step_count_ % steps_per_publish_ == 0) {
+      publishState(false);
+      applyVelocity();
+    }
     // Ground truth on its own schedule (its rate need not be a multiple of the publish rate).
     if (step_count_ % steps_per_ground_truth_ == 0) publishGroundTruth();
   }
@@ -270,21 +289,54 @@ void SimulatorRos::spin() {
   }
 }
 
+void SimulatorRos::applyVelocity() {
+  if (!velocity_mode_) return;
+  sim_->setVelocitySetpoint(guard_->fenceVelocity(sim_->uav().position, cmd_velocity_),
+                            cmd_yaw_rate_);
+}
+
 void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
-  sim_->setVelocitySetpoint(sim::Vec3(msg->linear.x, msg->linear.y, msg->linear.z), msg->angular.z);
+  sim::Vec3 v(msg->linear.x, msg->linear.y, msg->linear.z);
+  double yaw_rate = msg->angular.z;
+  const sim::SetpointCheck c = guard_->checkVelocity(&v, &yaw_rate);
+  if (!c.error.empty()) {
+    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: %s; setpoint ignored", vel_sub_.getTopic().c_str(),
+                            c.error.c_str());
+    return;
+  }
+  if (!c.clamped.empty()) {
+    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: clamped %s", vel_sub_.getTopic().c_str(),
+                            c.clamped.c_str());
+  }
+  cmd_velocity_ = v;
+  cmd_yaw_rate_ = yaw_rate;
+  velocity_mode_ = true;
+  applyVelocity();
 }
 
 void SimulatorRos::onPose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
   if (!msg->header.frame_id.empty() && msg->header.frame_id != kMapFrame) {
-    ROS_WARN_THROTTLE(5.0, "simulator: pose setpoints must be in frame '%s', got '%s'; ignored",
-                      kMapFrame, msg->header.frame_id.c_str());
+    HAMERITT_ERROR_THROTTLE(
+        5.0, "simulator: %s: header.frame_id: expected '%s' (or empty), got '%s'; setpoint ignored",
+        pose_sub_.getTopic().c_str(), kMapFrame, msg->header.frame_id.c_str());
     return;
   }
   const auto& q = msg->pose.orientation;
   double roll, pitch, yaw;
   tf2::Matrix3x3(tf2::Quaternion(q.x, q.y, q.z, q.w)).getRPY(roll, pitch, yaw);
-  if (!std::isfinite(yaw)) yaw = 0.0;
-  sim_->setPositionSetpoint(sim::Vec3(msg->pose.position.x, msg->pose.position.y, msg->pose.position.z), yaw);
+  sim::Vec3 p(msg->pose.position.x, msg->pose.position.y, msg->pose.position.z);
+  const sim::SetpointCheck c = guard_->checkPosition(&p, &yaw);
+  if (!c.error.empty()) {
+    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: %s; setpoint ignored",
+                            pose_sub_.getTopic().c_str(), c.error.c_str());
+    return;
+  }
+  if (!c.clamped.empty()) {
+    HAMERITT_ERROR_THROTTLE(5.0, "simulator: %s: clamped %s", pose_sub_.getTopic().c_str(),
+                            c.clamped.c_str());
+  }
+  velocity_mode_ = false;
+  sim_->setPositionSetpoint(p, yaw);
 }
 
 bool SimulatorRos::onStep(hameritt::StepSimulation::Request& req,
@@ -322,6 +374,7 @@ bool SimulatorRos::onReset(hameritt::ResetSimulation::Request&,
                            hameritt::ResetSimulation::Response& res) {
   if (cameras_) cameras_->flush();
   sim_->reset();
+  velocity_mode_ = false;
   step_count_ = 0;
   crash_reported_ = false;
   publishState(true);

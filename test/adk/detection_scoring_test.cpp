@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "adk_test_util.h"
 #include "hameritt/scenario/error.h"
 
@@ -105,6 +107,26 @@ TEST(DetectionScorer, RejectsAMissionWhoseTargetIsNotInTheSimConfig) {
   bad.car_gate = 0;
   EXPECT_THROW(DetectionScorer(shippedMission(), shippedSimConfig().entities, bad),
                scenario::ConfigError);
+}
+
+TEST(GroundTruthHistory, RefusesASnapshotWithANonFiniteEntity) {
+  GroundTruthHistory h(5.0);
+  EntityTruth ok{"car_1", "car", "target", {1, 2, 0}, 0.5};
+  h.add(1.0, {ok});
+  EntityTruth bad = ok;
+  bad.id = "car_2";
+  bad.position.y() = std::numeric_limits<double>::quiet_NaN();
+  try {
+    h.add(2.0, {ok, bad});
+    FAIL() << "accepted a NaN position";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "ground truth: entities[1] 'car_2': expected a finite position and yaw");
+  }
+  bad.position.y() = 0;
+  bad.yaw = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(h.add(2.0, {bad}), InputError);
+  ASSERT_EQ(h.at(2.0).size(), 1u);  // the good snapshot is kept
+  EXPECT_EQ(h.at(2.0)[0].position, ok.position);
 }
 
 TEST(GroundTruthHistory, InterpolatesBetweenSnapshotsAndHoldsOutside) {

@@ -18,6 +18,7 @@
 #include "hameritt/CrashEvent.h"
 #include "hameritt/Detection.h"
 #include "hameritt/EntityStateArray.h"
+#include "hameritt/adk/clock_watchdog.h"
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/adk/coverage.h"
 #include "hameritt/adk/detection_scoring.h"
@@ -90,6 +91,7 @@ class AdkRos {
   std::unique_ptr<adk::DetectionScorer> scorer_;
   std::unique_ptr<adk::MetricsAccumulator> metrics_;
   std::unique_ptr<adk::MissionLifecycle> lifecycle_;
+  std::unique_ptr<adk::ClockWatchdog> watchdog_;
   adk::GroundTruthHistory truth_{10.0};
 
   // Run state.

@@ -17,6 +17,7 @@
 #include "hameritt/ros/camera_rig.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
+#include "hameritt/sim/setpoint_guard.h"
 #include "hameritt/sim/simulator.h"
 
 namespace hameritt::ros_wrappers {
@@ -33,7 +34,8 @@ namespace hameritt::ros_wrappers {
 //   concurrently, each thread with its own renderer, published in order),
 //   ~record_image_rate (0: also publish camera images decimated to this rate for recording),
 //   ~wait_for (comma-separated topics of this node; the clock starts once each has a
-//   subscriber, or after ~wait_timeout wall seconds, 60).
+//   subscriber, or after ~wait_timeout wall seconds, 60), ~geofence_margin (50 m: the UAV is
+//   kept inside the neighborhood bounds grown by this and below altitude_max + this).
 class SimulatorRos {
  public:
   // Throws scenario::ConfigError (bad parameters or sim_config): the node exits with ROS_FATAL.
@@ -44,6 +46,8 @@ class SimulatorRos {
 
  private:
   void advance(int steps);
+  // Re-applies the last velocity command through the geofence (every publish tick).
+  void applyVelocity();
   void waitForSubscribers();
   int subscribers(const std::string& topic) const;
   void publishState(bool force_ground_truth);
@@ -59,6 +63,11 @@ class SimulatorRos {
   std::unique_ptr<scenario::World> world_;
   std::unique_ptr<sim::Simulator> sim_;
   std::unique_ptr<CameraRig> cameras_;
+  std::unique_ptr<sim::SetpointGuard> guard_;
+  // The last accepted velocity command (valid while velocity_mode_).
+  sim::Vec3 cmd_velocity_{0, 0, 0};
+  double cmd_yaw_rate_ = 0.0;
+  bool velocity_mode_ = false;
   double real_time_factor_ = 0.0;
   double duration_ = 0.0;
   std::vector<std::string> wait_for_;
