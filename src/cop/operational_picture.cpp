@@ -16,6 +16,10 @@ void require(bool ok, const char* field, double value, const char* expected) {
                                 std::to_string(value) + " (expected " + expected + ")");
 }
 
+// Likelihood factors of one described attribute (see OperationalPicture::belief).
+constexpr double kUnknownAttribute = 0.5;
+constexpr double kMismatchedAttribute = 0.02;
+
 bool classesCompatible(const std::string& a, const std::string& b) {
   return a.empty() || b.empty() || a == b;
 }
@@ -183,13 +187,10 @@ double OperationalPicture::belief(const Track& track, const TargetSpec& target) 
   if (!target.entity_class.empty() && track.entity_class != target.entity_class) return 0.0;
   const std::map<std::string, std::string> attrs = track.attributes();
   double agreement = 1.0;
-  if (!target.attributes.empty()) {
-    double sum = 0.0;
-    for (const auto& [key, value] : target.attributes) {
-      const auto it = attrs.find(key);
-      sum += it == attrs.end() ? 0.5 : (it->second == value ? 1.0 : 0.0);
-    }
-    agreement = sum / static_cast<double>(target.attributes.size());
+  for (const auto& [key, value] : target.attributes) {
+    const auto it = attrs.find(key);
+    agreement *= it == attrs.end() ? kUnknownAttribute
+                                   : (it->second == value ? 1.0 : kMismatchedAttribute);
   }
   return agreement * (1.0 - track.miss_probability);
 }

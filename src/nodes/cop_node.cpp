@@ -7,7 +7,8 @@
 #include "hameritt/ros/cop_ros.h"
 
 int main(int argc, char** argv) {
-  ros::init(argc, argv, "cop");
+  // Its own signal handling: the summary is logged before roscpp shuts down.
+  ros::init(argc, argv, "cop", ros::init_options::NoSigintHandler);
   ros::NodeHandle nh, pnh("~");
   std::unique_ptr<hameritt::ros_wrappers::CopRos> node;
   try {
@@ -16,7 +17,8 @@ int main(int argc, char** argv) {
     ROS_FATAL("cop: %s", e.what());
     return 1;
   }
-  ros::spin();
+  hameritt::ros_wrappers::spinUntilSignal();
   node->logSummary();
+  ros::shutdown();
   return 0;
 }

@@ -4,10 +4,12 @@
 
 #include <memory>
 
+#include "hameritt/ros/cop_ros.h"
 #include "hameritt/ros/tak_bridge_ros.h"
 
 int main(int argc, char** argv) {
-  ros::init(argc, argv, "tak_bridge");
+  // Its own signal handling: the summary is logged before roscpp shuts down.
+  ros::init(argc, argv, "tak_bridge", ros::init_options::NoSigintHandler);
   ros::NodeHandle nh, pnh("~");
   std::unique_ptr<hameritt::ros_wrappers::TakBridgeRos> node;
   try {
@@ -16,7 +18,8 @@ int main(int argc, char** argv) {
     ROS_FATAL("tak_bridge: %s", e.what());
     return 1;
   }
-  ros::spin();
+  hameritt::ros_wrappers::spinUntilSignal();
   node->logSummary();
+  ros::shutdown();
   return 0;
 }

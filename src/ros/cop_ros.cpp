@@ -2,7 +2,11 @@
 
 #include <visualization_msgs/MarkerArray.h>
 
+#include <ros/callback_queue.h>
+
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <stdexcept>
 
 #include "hameritt/CopTrackArray.h"
@@ -10,6 +14,8 @@
 
 namespace hameritt::ros_wrappers {
 namespace {
+
+std::atomic<bool> g_stop{false};
 
 cop::CopConfig loadConfig(ros::NodeHandle& pnh) {
   cop::CopConfig c;
@@ -30,6 +36,12 @@ cop::CopConfig loadConfig(ros::NodeHandle& pnh) {
 }
 
 }  // namespace
+
+void spinUntilSignal() {
+  std::signal(SIGINT, [](int) { g_stop = true; });
+  std::signal(SIGTERM, [](int) { g_stop = true; });
+  while (!g_stop && ros::ok()) ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+}
 
 CopRos::CopRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) : picture_(loadConfig(pnh)) {
   double rate = 2.0;

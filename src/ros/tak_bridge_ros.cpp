@@ -169,11 +169,15 @@ void TakBridgeRos::logSummary() const {
   ROS_INFO("tak_bridge: summary: %llu events built", static_cast<unsigned long long>(events_built_));
   for (const auto& s : senders_) {
     const cop::TakSenderStats st = s->stats();
-    ROS_INFO("tak_bridge: summary: %s: %llu sent, %llu dropped, %llu send errors, %llu connects",
+    const bool tcp = s->endpoint().protocol == cop::TakEndpoint::Protocol::kTcp;
+    ROS_INFO("tak_bridge: summary: %s: %llu sent, %llu dropped, %llu send errors%s",
              s->endpoint().url().c_str(), static_cast<unsigned long long>(st.sent),
              static_cast<unsigned long long>(st.dropped),
              static_cast<unsigned long long>(st.send_errors),
-             static_cast<unsigned long long>(st.connects));
+             tcp ? (", " + std::to_string(st.connects) + " connects of " +
+                    std::to_string(st.connect_attempts) + " attempts")
+                       .c_str()
+                 : "");
   }
 }
 

@@ -114,12 +114,18 @@ TEST(OperationalPicture, BeliefFollowsTheTargetDescriptionAndConfidence) {
   // More agreeing claims raise the belief: 1 - 0.4 * 0.4.
   cop.update({obs(0.5, 0.3, 0, "car", kTargetAttrs, 0.6)});
   EXPECT_NEAR(cop.tracks().at("T0001").target_belief, 0.84, 1e-9);
-  // Wrong colour: (0 + 1 + 1/2 + 1/2) / 4 * 0.9.
-  EXPECT_NEAR(cop.tracks().at("T0002").target_belief, 0.45, 1e-9);
+  // A look-alike of another colour: 0.02 * 1 * 1/2 * 1/2 * 0.9.
+  EXPECT_NEAR(cop.tracks().at("T0002").target_belief, 0.0045, 1e-9);
   EXPECT_EQ(cop.tracks().at("T0002").target_id, "");
   EXPECT_EQ(cop.tracks().at("T0003").target_belief, 0.0);  // another class
-  // Colour only: (1 + 3 * 1/2) / 4 * 0.9 = 0.5625.
-  EXPECT_NEAR(cop.tracks().at("T0004").target_belief, 0.5625, 1e-9);
+  // Colour only: 1 * (1/2)^3 * 0.9, not enough to be believed the target.
+  EXPECT_NEAR(cop.tracks().at("T0004").target_belief, 0.1125, 1e-9);
+  EXPECT_EQ(cop.tracks().at("T0004").target_id, "");
+  // The same make, model and class in another colour: a look-alike, not the target.
+  cop.update({obs(1, 300, 0, "car", {{"color", "red"}, {"make", "Toyota"}, {"model", "RAV4"},
+                                     {"vehicle_class", "suv"}}, 1.0)});
+  EXPECT_NEAR(cop.tracks().at("T0005").target_belief, 0.02, 1e-9);
+  EXPECT_EQ(cop.tracks().at("T0005").target_id, "");
 }
 
 TEST(OperationalPicture, AttributesAreMergedByAccumulatedConfidence) {

@@ -98,9 +98,10 @@ class OperationalPicture {
   // Deletes tracks stale at `now`; returns the ids deleted.
   std::vector<std::string> prune(double now);
 
-  // Belief that `track` is `target`, [0, 1]: attribute agreement (class must match; each
-  // described attribute counts 1 if the track's value matches, 0 if it differs, 1/2 if unknown)
-  // times the probability that at least one report was right, 1 - prod(1 - confidence).
+  // Belief that `track` is `target`, [0, 1]: attribute agreement (class must match; the product
+  // over the described attributes of 1 if the track's value matches, 0.02 if it differs, 1/2 if
+  // unknown: look-alikes differ in one attribute) times the probability that at least one report
+  // was right, 1 - prod(1 - confidence).
   static double belief(const Track& track, const TargetSpec& target);
 
   // Tracks ordered by id.

@@ -23,6 +23,10 @@
 
 namespace hameritt::ros_wrappers {
 
+// Serves callbacks until SIGINT or SIGTERM (or ros::shutdown), leaving rosconsole up so that the
+// node can log its summary afterwards; call after ros::init(..., NoSigintHandler).
+void spinUntilSignal();
+
 class CopRos {
  public:
   // Throws std::invalid_argument for bad parameters (the node exits with ROS_FATAL).
