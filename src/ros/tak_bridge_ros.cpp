@@ -141,7 +141,7 @@ void TakBridgeRos::onTimer(const ros::WallTimerEvent&) {
     }
     if (tracks_)
       for (const hameritt::CopTrack& t : tracks_->tracks)
-        if (t.confirmed || send_tentative_)
+        if (t.confirmed || send_tentative_ || !t.target_id.empty())
           broadcast(cop::trackEvent(*frame_, toTrackReport(t), now, events_));
     if (now - last_zones_ >= zone_period_) {
       last_zones_ = now;
