@@ -24,6 +24,19 @@ bool classesCompatible(const std::string& a, const std::string& b) {
   return a.empty() || b.empty() || a == b;
 }
 
+// A track's ground position and its covariance predicted to `stamp` (the CV model's position
+// block, without copying the track).
+void predictPosition(const Track& t, double stamp, double accel_sigma, Eigen::Vector2d* pos,
+                     Eigen::Matrix2d* cov) {
+  const double dt = std::max(0.0, stamp - t.last_seen);
+  const Eigen::Matrix2d pp = t.covariance.topLeftCorner<2, 2>();
+  const Eigen::Matrix2d pv = t.covariance.topRightCorner<2, 2>();
+  const Eigen::Matrix2d vv = t.covariance.bottomRightCorner<2, 2>();
+  *pos = t.state.head<2>() + dt * t.state.tail<2>();
+  const double q = accel_sigma * accel_sigma * dt * dt * dt / 3.0;
+  *cov = pp + dt * (pv + pv.transpose()) + dt * dt * vv + q * Eigen::Matrix2d::Identity();
+}
+
 }  // namespace
 
 void CopConfig::validate() const {
@@ -32,6 +45,7 @@ void CopConfig::validate() const {
   require(std::isfinite(height_walk_sigma) && height_walk_sigma >= 0, "height_walk_sigma",
           height_walk_sigma, ">= 0");
   require(std::isfinite(gate_chi2) && gate_chi2 > 0, "gate_chi2", gate_chi2, "> 0");
+  require(std::isfinite(merge_chi2) && merge_chi2 >= 0, "merge_chi2", merge_chi2, ">= 0");
   require(std::isfinite(initial_speed_sigma) && initial_speed_sigma > 0, "initial_speed_sigma",
           initial_speed_sigma, "> 0 m/s");
   require(confirm_hits >= 1, "confirm_hits", confirm_hits, ">= 1");
@@ -104,6 +118,7 @@ void OperationalPicture::correct(Track& t, const Observation& o) {
   t.z += kz * (o.position.z() - t.z);
   t.z_variance *= 1.0 - kz;
   t.hits++;
+  t.last_report = reports_;
   t.confirmed = t.confirmed || t.hits >= config_.confirm_hits;
   const double c = std::clamp(o.confidence, 0.0, 1.0);
   t.miss_probability *= 1.0 - c;
@@ -131,6 +146,7 @@ Track OperationalPicture::create(const Observation& o) {
 }
 
 void OperationalPicture::update(const std::vector<Observation>& observations) {
+  reports_++;
   // Candidate pairs inside the gate, then global nearest neighbour by greedy assignment in
   // (distance, observation, track id) order: deterministic and one-to-one.
   std::vector<std::tuple<double, size_t, std::string>> pairs;
@@ -138,11 +154,11 @@ void OperationalPicture::update(const std::vector<Observation>& observations) {
     const Observation& o = observations[i];
     for (const auto& [id, track] : tracks_) {
       if (!classesCompatible(track.entity_class, o.entity_class)) continue;
-      Track p = track;
-      predict(p, o.stamp);
-      const Eigen::Matrix2d s =
-          p.covariance.topLeftCorner<2, 2>() + o.sigma * o.sigma * Eigen::Matrix2d::Identity();
-      const Eigen::Vector2d nu = o.position.head<2>() - p.state.head<2>();
+      Eigen::Vector2d pos;
+      Eigen::Matrix2d cov;
+      predictPosition(track, o.stamp, config_.process_accel_sigma, &pos, &cov);
+      const Eigen::Matrix2d s = cov + o.sigma * o.sigma * Eigen::Matrix2d::Identity();
+      const Eigen::Vector2d nu = o.position.head<2>() - pos;
       const double d2 = nu.dot(s.ldlt().solve(nu));
       if (d2 <= config_.gate_chi2) pairs.emplace_back(d2, i, id);
     }
@@ -164,7 +180,57 @@ void OperationalPicture::update(const std::vector<Observation>& observations) {
     Track t = create(observations[i]);
     tracks_.emplace(t.id, std::move(t));
   }
+  mergeDuplicates();
   refreshBeliefs();
+}
+
+void OperationalPicture::mergeDuplicates() {
+  if (config_.merge_chi2 <= 0.0) return;
+  for (auto a = tracks_.begin(); a != tracks_.end(); ++a) {
+    for (auto b = std::next(a); b != tracks_.end();) {
+      Track& older = a->second;
+      const Track& newer = b->second;
+      bool same = classesCompatible(older.entity_class, newer.entity_class) &&
+                  older.last_report != newer.last_report;
+      if (same) {
+        // Both at the later time, then the distance of the positions.
+        const double t = std::max(older.last_seen, newer.last_seen);
+        Eigen::Vector2d pa, pb;
+        Eigen::Matrix2d ca, cb;
+        predictPosition(older, t, config_.process_accel_sigma, &pa, &ca);
+        predictPosition(newer, t, config_.process_accel_sigma, &pb, &cb);
+        const Eigen::Matrix2d s = ca + cb;
+        const Eigen::Vector2d d = pa - pb;
+        same = d.dot(s.ldlt().solve(d)) <= config_.merge_chi2;
+      }
+      if (!same) {
+        ++b;
+        continue;
+      }
+      // The older track keeps its id and state (the newer one holds a report or few); it takes
+      // the newer one's evidence.
+      if (newer.last_seen > older.last_seen) {
+        older.state = newer.state;
+        older.covariance = newer.covariance;
+        older.z = newer.z;
+        older.z_variance = newer.z_variance;
+        older.last_seen = newer.last_seen;
+        older.last_report = newer.last_report;
+        if (!newer.entity_id.empty()) older.entity_id = newer.entity_id;
+      }
+      older.first_seen = std::min(older.first_seen, newer.first_seen);
+      older.hits += newer.hits;
+      older.confirmed = older.confirmed || newer.confirmed || older.hits >= config_.confirm_hits;
+      older.miss_probability *= newer.miss_probability;
+      if (older.entity_class.empty()) older.entity_class = newer.entity_class;
+      if (older.entity_id.empty()) older.entity_id = newer.entity_id;
+      for (const auto& [key, votes] : newer.attribute_votes)
+        for (const auto& [value, w] : votes) older.attribute_votes[key][value] += w;
+      for (const auto& [source, n] : newer.sources) older.sources[source] += n;
+      b = tracks_.erase(b);
+      stats_.merged++;
+    }
+  }
 }
 
 std::vector<std::string> OperationalPicture::prune(double now) {

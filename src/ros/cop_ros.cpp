@@ -4,6 +4,7 @@
 
 #include <ros/callback_queue.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -22,6 +23,7 @@ cop::CopConfig loadConfig(ros::NodeHandle& pnh) {
   pnh.param("process_accel_sigma", c.process_accel_sigma, c.process_accel_sigma);
   pnh.param("height_walk_sigma", c.height_walk_sigma, c.height_walk_sigma);
   pnh.param("gate_chi2", c.gate_chi2, c.gate_chi2);
+  pnh.param("merge_chi2", c.merge_chi2, c.merge_chi2);
   pnh.param("initial_speed_sigma", c.initial_speed_sigma, c.initial_speed_sigma);
   int hits = static_cast<int>(c.confirm_hits);
   pnh.param("confirm_hits", hits, hits);
@@ -152,23 +154,36 @@ void CopRos::logSummary() const {
   size_t confirmed = 0;
   for (const auto& [id, t] : picture_.tracks()) confirmed += t.confirmed ? 1 : 0;
   ROS_INFO("cop: summary: %zu tracks (%zu confirmed), %llu reports, %llu observations, %llu "
-           "associated, %llu tracks created, %llu deleted, %llu publications",
+           "associated, %llu tracks created, %llu merged, %llu deleted, %llu publications",
            picture_.tracks().size(), confirmed, static_cast<unsigned long long>(reports_),
            static_cast<unsigned long long>(s.observations),
            static_cast<unsigned long long>(s.associated),
-           static_cast<unsigned long long>(s.created), static_cast<unsigned long long>(s.deleted),
+           static_cast<unsigned long long>(s.created), static_cast<unsigned long long>(s.merged),
+           static_cast<unsigned long long>(s.deleted),
            static_cast<unsigned long long>(publications_));
   for (const cop::TargetSpec& target : picture_.targets()) {
-    const cop::Track* best = nullptr;
+    // Look-alikes with the same description are equally likely: list every candidate, best
+    // first (belief, then reports), with the ground-truth entity where perfect perception gave it.
+    std::vector<const cop::Track*> candidates;
     for (const auto& [id, t] : picture_.tracks())
-      if (t.target_id == target.id && (!best || t.target_belief > best->target_belief)) best = &t;
-    if (best)
-      ROS_INFO("cop: summary: target %s believed to be track %s (belief %.2f, %u reports, at "
-               "%.1f %.1f, ground-truth entity '%s')",
-               target.id.c_str(), best->id.c_str(), best->target_belief, best->hits,
-               best->state.x(), best->state.y(), best->entity_id.c_str());
-    else
+      if (t.target_id == target.id) candidates.push_back(&t);
+    std::stable_sort(candidates.begin(), candidates.end(), [](const auto* a, const auto* b) {
+      return std::make_pair(a->target_belief, a->hits) > std::make_pair(b->target_belief, b->hits);
+    });
+    if (candidates.empty()) {
       ROS_INFO("cop: summary: target %s not found by any track", target.id.c_str());
+      continue;
+    }
+    std::string list;
+    for (const cop::Track* t : candidates) {
+      char line[256];
+      std::snprintf(line, sizeof line, "%s%s (belief %.2f, %u reports, at %.1f %.1f%s%s)",
+                    list.empty() ? "" : ", ", t->id.c_str(), t->target_belief, t->hits,
+                    t->state.x(), t->state.y(), t->entity_id.empty() ? "" : ", entity ",
+                    t->entity_id.c_str());
+      list += line;
+    }
+    ROS_INFO("cop: summary: target %s believed to be %s", target.id.c_str(), list.c_str());
   }
 }
 

@@ -83,6 +83,26 @@ TEST(OperationalPicture, OneReportsEntitiesAreAssociatedOneToOne) {
   EXPECT_EQ(cop.tracks().at("T0002").hits, 2u);
 }
 
+TEST(OperationalPicture, MergesATrackStartedByAReportOutsideTheGate) {
+  CopConfig c;
+  c.gate_chi2 = 0.5;  // tight: a report 2 m off starts a track of its own
+  OperationalPicture cop(c);
+  for (int i = 0; i < 3; ++i) cop.update({obs(i * 0.1, 0, 0, "car", {{"color", "white"}})});
+  cop.update({obs(0.3, 2, 0, "car", {{"color", "white"}}, 0.8, "car_9")});
+  ASSERT_EQ(cop.tracks().size(), 1u);
+  const Track& t = cop.tracks().at("T0001");
+  EXPECT_EQ(t.hits, 4u);
+  EXPECT_EQ(t.entity_id, "car_9");
+  EXPECT_EQ(t.sources.at("perfect_perception"), 1u);
+  EXPECT_EQ(cop.stats().created, 2u);
+  EXPECT_EQ(cop.stats().merged, 1u);
+  // Two entities in one report stay two tracks however close.
+  OperationalPicture two(c);
+  two.update({obs(0, 0, 0), obs(0, 0.5, 0)});
+  EXPECT_EQ(two.tracks().size(), 2u);
+  EXPECT_EQ(two.stats().merged, 0u);
+}
+
 TEST(OperationalPicture, DeletesTentativeTracksSoonerThanConfirmedOnes) {
   CopConfig c;
   c.tentative_timeout = 2.0;

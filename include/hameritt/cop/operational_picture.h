@@ -5,7 +5,8 @@
 // Applications to Tracking and Navigation", 2001, ch. 6: discretized continuous white-noise
 // acceleration) and a random-walk filter on the height. Reports are associated to tracks by
 // global-nearest-neighbour over the Mahalanobis distance of the innovation, gated by a chi-square
-// threshold and by class compatibility. Tracks are confirmed by hits and deleted when stale.
+// threshold and by class compatibility. Tracks are confirmed by hits and deleted when stale;
+// two tracks that have become statistically the same are merged.
 // Everything is deterministic: the same reports in the same order give the same tracks and ids.
 
 #include <Eigen/Core>
@@ -48,6 +49,7 @@ struct Track {
   double first_seen = 0.0;
   double last_seen = 0.0;
   std::uint32_t hits = 0;
+  std::uint64_t last_report = 0;  // number of the last update() that fed it (1, 2, ...)
   bool confirmed = false;
   double miss_probability = 1.0;  // product of (1 - confidence) over the reports
   std::string entity_id;          // last ground-truth entity id associated ("" if none)
@@ -66,6 +68,10 @@ struct CopConfig {
   double process_accel_sigma = 0.5;  // m/s^2, white acceleration of the CV model
   double height_walk_sigma = 0.1;    // m/sqrt(s), random walk of the height
   double gate_chi2 = 13.82;          // Mahalanobis^2 gate, chi-square 2 dof at 99.9 %
+  // Two tracks whose positions differ by less than this Mahalanobis^2 (summed covariances) are
+  // one entity seen twice (a report that fell outside the gate): the newer merges into the older,
+  // unless one report fed both (two entities side by side). 0 turns merging off.
+  double merge_chi2 = 2.0;
   double initial_speed_sigma = 5.0;  // m/s, velocity prior of a new track
   std::uint32_t confirm_hits = 3;
   double tentative_timeout = 5.0;    // s without reports before a tentative track is deleted
@@ -82,6 +88,7 @@ struct CopStats {
   std::uint64_t associated = 0;
   std::uint64_t created = 0;
   std::uint64_t deleted = 0;
+  std::uint64_t merged = 0;
 };
 
 // The picture: tracks keyed by id, the mission's targets and the association logic.
@@ -115,11 +122,13 @@ class OperationalPicture {
   void correct(Track& t, const Observation& o);
   Track create(const Observation& o);
   void refreshBeliefs();
+  void mergeDuplicates();
 
   CopConfig config_;
   std::map<std::string, Track> tracks_;
   std::vector<TargetSpec> targets_;
   std::uint64_t next_id_ = 1;
+  std::uint64_t reports_ = 0;
   CopStats stats_;
 };
 
