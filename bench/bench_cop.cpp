@@ -111,8 +111,9 @@ int main(int argc, char** argv) {
 
   size_t confirmed = 0;
   for (const auto& [id, t] : picture.tracks()) confirmed += t.confirmed;
-  std::printf("bench_cop: %d entities, %d reports, %zu observations -> %zu tracks (%zu confirmed)\n",
-              entities, reports, observations, picture.tracks().size(), confirmed);
+  std::printf(
+      "bench_cop: %d entities, %d reports, %zu observations -> %zu tracks (%zu confirmed)\n",
+      entities, reports, observations, picture.tracks().size(), confirmed);
   std::printf("  fusion:    %.0f COP updates/s (reports), %.0f observations/s\n", reports / fuse_s,
               observations / fuse_s);
   std::printf("  CoT build: %.0f events/s (%zu events, mean %zu bytes)\n", xml.size() / build_s,

@@ -255,8 +255,8 @@ double OperationalPicture::belief(const Track& track, const TargetSpec& target) 
   double agreement = 1.0;
   for (const auto& [key, value] : target.attributes) {
     const auto it = attrs.find(key);
-    agreement *= it == attrs.end() ? kUnknownAttribute
-                                   : (it->second == value ? 1.0 : kMismatchedAttribute);
+    agreement *=
+        it == attrs.end() ? kUnknownAttribute : (it->second == value ? 1.0 : kMismatchedAttribute);
   }
   return agreement * (1.0 - track.miss_probability);
 }

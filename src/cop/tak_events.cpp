@@ -29,8 +29,8 @@ constexpr int kKozFill = static_cast<int>(0x40FF0000u);
 void TakEventConfig::validate() const {
   const auto positive = [](double v, const char* field) {
     if (!std::isfinite(v) || v <= 0)
-      throw std::invalid_argument(std::string("tak config: ") + field + " = " +
-                                  std::to_string(v) + " (expected > 0)");
+      throw std::invalid_argument(std::string("tak config: ") + field + " = " + std::to_string(v) +
+                                  " (expected > 0)");
   };
   positive(stale_s, "stale_s");
   positive(zone_stale_s, "zone_stale_s");
@@ -74,8 +74,8 @@ CotEvent trackEvent(const EnuFrame& frame, const TrackReport& t, double now,
   std::string attrs;
   for (const auto& [k, v] : t.attributes) attrs += (attrs.empty() ? "" : ", ") + k + "=" + v;
   e.remarks = t.entity_class + (attrs.empty() ? "" : " (" + attrs + ")") + "; " +
-              (t.target_id.empty() ? "no target" : "believed target " + t.target_id) +
-              ", belief " + fixed(t.target_belief, 2) + "; " + std::to_string(t.hits) + " reports";
+              (t.target_id.empty() ? "no target" : "believed target " + t.target_id) + ", belief " +
+              fixed(t.target_belief, 2) + "; " + std::to_string(t.hits) + " reports";
   e.extra = {{"track", t.id},
              {"class", t.entity_class},
              {"target", t.target_id},
@@ -100,8 +100,8 @@ CotEvent zoneEvent(const EnuFrame& frame, const ZoneReport& z, double now,
     shape.vertices.emplace_back(g.latitude, g.longitude);
   }
   if (!z.polygon.empty()) mean /= static_cast<double>(z.polygon.size());
-  e.point = toPoint(frame, Eigen::Vector3d(mean.x(), mean.y(), 0.0), kCotUnknownError,
-                    kCotUnknownError);
+  e.point =
+      toPoint(frame, Eigen::Vector3d(mean.x(), mean.y(), 0.0), kCotUnknownError, kCotUnknownError);
   shape.stroke_argb = z.keep_out ? kKozStroke : kAoiStroke;
   shape.fill_argb = z.keep_out ? kKozFill : kAoiFill;
   e.shape = shape;

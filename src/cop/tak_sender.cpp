@@ -180,8 +180,8 @@ bool TakSender::connectTcp() {
 bool TakSender::transmit(const std::string& xml) {
   if (endpoint_.protocol == TakEndpoint::Protocol::kUdp) {
     const sockaddr_in a = address(endpoint_);
-    if (::sendto(fd_, xml.data(), xml.size(), 0, reinterpret_cast<const sockaddr*>(&a),
-                 sizeof a) == static_cast<ssize_t>(xml.size()))
+    if (::sendto(fd_, xml.data(), xml.size(), 0, reinterpret_cast<const sockaddr*>(&a), sizeof a) ==
+        static_cast<ssize_t>(xml.size()))
       return true;
     setError(errnoText("sendto"));
     return false;
@@ -222,8 +222,8 @@ void TakSender::run() {
       lock.lock();
       if (!ok) {
         stats_.next_backoff_s = backoff;
-        next_attempt = Clock::now() + std::chrono::microseconds(
-                                          static_cast<long long>(backoff * 1e6));
+        next_attempt =
+            Clock::now() + std::chrono::microseconds(static_cast<long long>(backoff * 1e6));
         backoff = std::min(backoff * 2.0, config_.reconnect_max_s);
         continue;
       }

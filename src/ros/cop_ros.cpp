@@ -1,8 +1,7 @@
 #include "hameritt/ros/cop_ros.h"
 
-#include <visualization_msgs/MarkerArray.h>
-
 #include <ros/callback_queue.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
 #include <atomic>
@@ -66,9 +65,10 @@ CopRos::CopRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) : picture_(loadConfig(
   perception_sub_ = nh.subscribe("adk/perfect_perception", 50, &CopRos::onPerception, this);
   mission_sub_ = nh.subscribe("mission", 1, &CopRos::onMission, this);
   timer_ = nh.createTimer(ros::Duration(1.0 / rate), &CopRos::onTimer, this);
-  ROS_INFO("cop: fusing perception/detections and adk/perfect_perception, publishing cop/tracks "
-           "at %.1f Hz (gate chi2 %.2f, confirm after %u reports)",
-           rate, picture_.config().gate_chi2, picture_.config().confirm_hits);
+  ROS_INFO(
+      "cop: fusing perception/detections and adk/perfect_perception, publishing cop/tracks "
+      "at %.1f Hz (gate chi2 %.2f, confirm after %u reports)",
+      rate, picture_.config().gate_chi2, picture_.config().confirm_hits);
 }
 
 void CopRos::onDetection(const hameritt::Detection::ConstPtr& msg) {
@@ -153,14 +153,14 @@ void CopRos::logSummary() const {
   const cop::CopStats& s = picture_.stats();
   size_t confirmed = 0;
   for (const auto& [id, t] : picture_.tracks()) confirmed += t.confirmed ? 1 : 0;
-  ROS_INFO("cop: summary: %zu tracks (%zu confirmed), %llu reports, %llu observations, %llu "
-           "associated, %llu tracks created, %llu merged, %llu deleted, %llu publications",
-           picture_.tracks().size(), confirmed, static_cast<unsigned long long>(reports_),
-           static_cast<unsigned long long>(s.observations),
-           static_cast<unsigned long long>(s.associated),
-           static_cast<unsigned long long>(s.created), static_cast<unsigned long long>(s.merged),
-           static_cast<unsigned long long>(s.deleted),
-           static_cast<unsigned long long>(publications_));
+  ROS_INFO(
+      "cop: summary: %zu tracks (%zu confirmed), %llu reports, %llu observations, %llu "
+      "associated, %llu tracks created, %llu merged, %llu deleted, %llu publications",
+      picture_.tracks().size(), confirmed, static_cast<unsigned long long>(reports_),
+      static_cast<unsigned long long>(s.observations),
+      static_cast<unsigned long long>(s.associated), static_cast<unsigned long long>(s.created),
+      static_cast<unsigned long long>(s.merged), static_cast<unsigned long long>(s.deleted),
+      static_cast<unsigned long long>(publications_));
   for (const cop::TargetSpec& target : picture_.targets()) {
     // Look-alikes with the same description are equally likely: list every candidate, best
     // first (belief, then reports), with the ground-truth entity where perfect perception gave it.

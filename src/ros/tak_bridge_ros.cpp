@@ -35,8 +35,9 @@ TakBridgeRos::TakBridgeRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param<std::string>("endpoints", endpoints, "");
   const std::vector<std::string> urls = splitList(endpoints);
   if (urls.empty())
-    throw std::invalid_argument("~endpoints is empty (expected udp://A.B.C.D:PORT, "
-                                "tcp://A.B.C.D:PORT or udp:// for multicast, comma-separated)");
+    throw std::invalid_argument(
+        "~endpoints is empty (expected udp://A.B.C.D:PORT, "
+        "tcp://A.B.C.D:PORT or udp:// for multicast, comma-separated)");
   double rate = 1.0;
   pnh.param("rate_hz", rate, rate);
   requirePositive(rate, "rate_hz");
@@ -54,8 +55,9 @@ TakBridgeRos::TakBridgeRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const int origin_keys = pnh.hasParam("origin_latitude") + pnh.hasParam("origin_longitude") +
                           pnh.hasParam("origin_altitude");
   if (origin_keys != 0 && origin_keys != 3)
-    throw std::invalid_argument("~origin_latitude, ~origin_longitude, ~origin_altitude: set all "
-                                "three (an override of the mission's origin) or none");
+    throw std::invalid_argument(
+        "~origin_latitude, ~origin_longitude, ~origin_altitude: set all "
+        "three (an override of the mission's origin) or none");
   if (origin_keys == 3) {
     cop::Geodetic g;
     pnh.getParam("origin_latitude", g.latitude);
@@ -103,13 +105,13 @@ void TakBridgeRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) { odom_ =
 void TakBridgeRos::onMission(const hameritt::Mission::ConstPtr& msg) {
   try {
     if (!origin_override_)
-      frame_.emplace(cop::Geodetic{msg->origin_latitude, msg->origin_longitude,
-                                   msg->origin_altitude});
+      frame_.emplace(
+          cop::Geodetic{msg->origin_latitude, msg->origin_longitude, msg->origin_altitude});
     zones_ = zonesOf(*msg);
     last_zones_ = -1e18;  // send them at the next tick
-    ROS_INFO("tak_bridge: mission %s: origin %.7f %.7f %.2f m, %zu zones",
-             msg->scenario_id.c_str(), frame_->origin().latitude, frame_->origin().longitude,
-             frame_->origin().altitude, zones_.size());
+    ROS_INFO("tak_bridge: mission %s: origin %.7f %.7f %.2f m, %zu zones", msg->scenario_id.c_str(),
+             frame_->origin().latitude, frame_->origin().longitude, frame_->origin().altitude,
+             zones_.size());
   } catch (const std::exception& e) {
     ROS_ERROR("tak_bridge: mission %s ignored: %s", msg->scenario_id.c_str(), e.what());
   }
@@ -166,7 +168,8 @@ void TakBridgeRos::warnUnreachable() {
 }
 
 void TakBridgeRos::logSummary() const {
-  ROS_INFO("tak_bridge: summary: %llu events built", static_cast<unsigned long long>(events_built_));
+  ROS_INFO("tak_bridge: summary: %llu events built",
+           static_cast<unsigned long long>(events_built_));
   for (const auto& s : senders_) {
     const cop::TakSenderStats st = s->stats();
     const bool tcp = s->endpoint().protocol == cop::TakEndpoint::Protocol::kTcp;

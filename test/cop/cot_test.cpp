@@ -56,8 +56,7 @@ TEST(Cot, EventParsesWithTheRequiredSchemaFields) {
   EXPECT_NEAR(pt->DoubleAttribute("le"), 1.0, 1e-9);
   const tinyxml2::XMLElement* d = ev->FirstChildElement("detail");
   ASSERT_NE(d, nullptr);
-  EXPECT_STREQ(d->FirstChildElement("contact")->Attribute("callsign"),
-               "T0001 <car> & \"friends\"");
+  EXPECT_STREQ(d->FirstChildElement("contact")->Attribute("callsign"), "T0001 <car> & \"friends\"");
   EXPECT_NEAR(d->FirstChildElement("track")->DoubleAttribute("course"), 90.0, 1e-9);
   EXPECT_NEAR(d->FirstChildElement("track")->DoubleAttribute("speed"), 3.5, 1e-9);
   EXPECT_STREQ(d->FirstChildElement("remarks")->GetText(),

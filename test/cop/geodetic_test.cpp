@@ -64,12 +64,14 @@ TEST(Geodetic, EnuAxesAtTheMissionOrigin) {
   EXPECT_LT((up - Eigen::Vector3d(0, 0, 100)).norm(), 1e-6);
   // North along the meridian: +y, the meridian arc of 0.001 deg at 42.4851 N is 111.083 m
   // (M = a(1-e2)/(1-e2 sin^2)^1.5), and a slight drop below the tangent plane.
-  const Eigen::Vector3d north = f.toEnu({origin.latitude + 0.001, origin.longitude, origin.altitude});
+  const Eigen::Vector3d north =
+      f.toEnu({origin.latitude + 0.001, origin.longitude, origin.altitude});
   EXPECT_NEAR(north.x(), 0.0, 1e-6);
   EXPECT_NEAR(north.y(), 111.083, 0.01);
   EXPECT_LT(north.z(), 0.0);
   // East along the parallel: +x, N cos(lat) * 0.001 deg = 82.219 m.
-  const Eigen::Vector3d east = f.toEnu({origin.latitude, origin.longitude + 0.001, origin.altitude});
+  const Eigen::Vector3d east =
+      f.toEnu({origin.latitude, origin.longitude + 0.001, origin.altitude});
   EXPECT_NEAR(east.x(), 82.219, 0.01);
   EXPECT_NEAR(east.y(), 0.0, 0.01);
 }
@@ -77,7 +79,7 @@ TEST(Geodetic, EnuAxesAtTheMissionOrigin) {
 TEST(Geodetic, EnuRoundTripsKnownMapPoints) {
   const EnuFrame f({42.4851, -71.1873, 40.0});
   const Eigen::Vector3d points[] = {{0, 0, 0},          {-388.287, 108.702, 0}, {5.184, 1.75, 0},
-                                    {500, -500, 120.5}, {-10000, 10000, 3000}, {1e5, 2e5, -50}};
+                                    {500, -500, 120.5}, {-10000, 10000, 3000},  {1e5, 2e5, -50}};
   for (const Eigen::Vector3d& p : points) {
     const Geodetic g = f.toGeodetic(p);
     EXPECT_LT((f.toEnu(g) - p).norm(), 1e-6) << p.transpose();

@@ -24,9 +24,10 @@ Observation obs(double t, double x, double y, const std::string& cls = "car",
   return o;
 }
 
-const TargetSpec kTarget{"car_706", "car",
-                         {{"color", "white"}, {"make", "Toyota"}, {"model", "RAV4"},
-                          {"vehicle_class", "suv"}}};
+const TargetSpec kTarget{
+    "car_706",
+    "car",
+    {{"color", "white"}, {"make", "Toyota"}, {"model", "RAV4"}, {"vehicle_class", "suv"}}};
 const std::map<std::string, std::string> kTargetAttrs = kTarget.attributes;
 
 TEST(OperationalPicture, AssociatesNearbyReportsAndConfirms) {
@@ -38,7 +39,7 @@ TEST(OperationalPicture, AssociatesNearbyReportsAndConfirms) {
   EXPECT_EQ(t.hits, 3u);
   EXPECT_TRUE(t.confirmed);
   EXPECT_NEAR(t.state.x(), 11.0, 1.0);
-  EXPECT_GT(t.state(2), 0.0);  // moving east
+  EXPECT_GT(t.state(2), 0.0);                    // moving east
   EXPECT_LT(t.positionCovariance()(0, 0), 9.0);  // tighter than one report
 }
 
@@ -60,8 +61,8 @@ TEST(OperationalPicture, FollowsAMovingTargetWithTheConstantVelocityModel) {
 TEST(OperationalPicture, GatesByMahalanobisDistanceAndClass) {
   OperationalPicture cop;
   cop.update({obs(0, 0, 0, "car")});
-  cop.update({obs(0.1, 2, 0, "car")});        // inside the gate: same track
-  cop.update({obs(0.2, 40, 0, "car")});       // far: a new track
+  cop.update({obs(0.1, 2, 0, "car")});           // inside the gate: same track
+  cop.update({obs(0.2, 40, 0, "car")});          // far: a new track
   cop.update({obs(0.3, 0.5, 0, "pedestrian")});  // near, but another class: a new track
   cop.update({obs(0.4, 1.5, 0.1, "")});  // unknown class: compatible, the nearest track (T0001)
   ASSERT_EQ(cop.tracks().size(), 3u);
@@ -109,7 +110,7 @@ TEST(OperationalPicture, DeletesTentativeTracksSoonerThanConfirmedOnes) {
   c.confirmed_timeout = 10.0;
   OperationalPicture cop(c);
   for (int i = 0; i < 3; ++i) cop.update({obs(i * 0.1, 0, 0)});  // confirmed
-  cop.update({obs(0.3, 100, 100)});                               // tentative
+  cop.update({obs(0.3, 100, 100)});                              // tentative
   EXPECT_TRUE(cop.prune(2.0).empty());
   EXPECT_EQ(cop.prune(2.5), std::vector<std::string>{"T0002"});
   EXPECT_TRUE(cop.prune(10.0).empty());
@@ -142,8 +143,9 @@ TEST(OperationalPicture, BeliefFollowsTheTargetDescriptionAndConfidence) {
   EXPECT_NEAR(cop.tracks().at("T0004").target_belief, 0.1125, 1e-9);
   EXPECT_EQ(cop.tracks().at("T0004").target_id, "");
   // The same make, model and class in another colour: a look-alike, not the target.
-  cop.update({obs(1, 300, 0, "car", {{"color", "red"}, {"make", "Toyota"}, {"model", "RAV4"},
-                                     {"vehicle_class", "suv"}}, 1.0)});
+  cop.update({obs(
+      1, 300, 0, "car",
+      {{"color", "red"}, {"make", "Toyota"}, {"model", "RAV4"}, {"vehicle_class", "suv"}}, 1.0)});
   EXPECT_NEAR(cop.tracks().at("T0005").target_belief, 0.02, 1e-9);
   EXPECT_EQ(cop.tracks().at("T0005").target_id, "");
 }
@@ -162,8 +164,7 @@ TEST(OperationalPicture, AttributesAreMergedByAccumulatedConfidence) {
 TEST(OperationalPicture, PerfectPerceptionKeepsTheEntityIdAsGroundTruth) {
   OperationalPicture cop;
   cop.setTargets({kTarget});
-  for (int i = 0; i < 3; ++i)
-    cop.update({obs(i, 0.1 * i, 0, "car", kTargetAttrs, 1.0, "car_706")});
+  for (int i = 0; i < 3; ++i) cop.update({obs(i, 0.1 * i, 0, "car", kTargetAttrs, 1.0, "car_706")});
   const Track& t = cop.tracks().at("T0001");
   EXPECT_EQ(t.entity_id, "car_706");
   EXPECT_EQ(t.target_id, "car_706");
@@ -183,7 +184,8 @@ TEST(OperationalPicture, SameReportsGiveTheSameTracks) {
     for (int k = 0; k < 30; ++k) {
       std::vector<Observation> batch;
       for (size_t i = 0; i < truth.size(); ++i)
-        if (rng() % 2) batch.push_back(obs(k * 0.5, truth[i].x() + noise(rng), truth[i].y() + noise(rng)));
+        if (rng() % 2)
+          batch.push_back(obs(k * 0.5, truth[i].x() + noise(rng), truth[i].y() + noise(rng)));
       cop.update(batch);
       cop.prune(k * 0.5);
     }

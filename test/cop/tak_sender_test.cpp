@@ -138,13 +138,16 @@ TEST(TakSender, UnreachableTcpServerBacksOffWithoutBlockingThenConnects) {
   const int conn = ::accept(server.fd, nullptr, nullptr);
   ASSERT_GE(conn, 0);
   std::string stream;
-  waitFor([&] {
-    stream += server.receive(conn, 50);
-    return stream.find("e19") != std::string::npos;
-  }, 5.0);
+  waitFor(
+      [&] {
+        stream += server.receive(conn, 50);
+        return stream.find("e19") != std::string::npos;
+      },
+      5.0);
   ::close(conn);
-  EXPECT_EQ(stream, "<event uid=\"e15\"/><event uid=\"e16\"/><event uid=\"e17\"/>"
-                    "<event uid=\"e18\"/><event uid=\"e19\"/>");
+  EXPECT_EQ(stream,
+            "<event uid=\"e15\"/><event uid=\"e16\"/><event uid=\"e17\"/>"
+            "<event uid=\"e18\"/><event uid=\"e19\"/>");
   EXPECT_TRUE(waitFor([&] { return sender.stats().connects == 1; }, 2.0));
 }
 

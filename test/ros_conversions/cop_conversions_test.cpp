@@ -1,8 +1,8 @@
 // COP message conversions: claims and perfect-perception reports in, tracks out, a track as the
 // TAK bridge sees it, the mission's targets and zones.
-#include <gtest/gtest.h>
-
 #include "hameritt/ros/cop_conversions.h"
+
+#include <gtest/gtest.h>
 
 namespace hameritt::ros_wrappers {
 namespace {

@@ -19,7 +19,7 @@ namespace hameritt::cop {
 
 // A report of one entity at one time.
 struct Observation {
-  double stamp = 0.0;  // seconds (sim time)
+  double stamp = 0.0;                                  // seconds (sim time)
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // map (ENU) frame, bottom-face centre
   std::string entity_class;  // car, pedestrian, ... ("" = unknown: compatible with any)
   std::map<std::string, std::string> attributes;
@@ -54,8 +54,8 @@ struct Track {
   double miss_probability = 1.0;  // product of (1 - confidence) over the reports
   std::string entity_id;          // last ground-truth entity id associated ("" if none)
   std::map<std::string, std::uint32_t> sources;  // reports per source
-  std::string target_id;        // mission target this track is believed to be ("" = none)
-  double target_belief = 0.0;   // belief in that target (or the best one), [0, 1]
+  std::string target_id;       // mission target this track is believed to be ("" = none)
+  double target_belief = 0.0;  // belief in that target (or the best one), [0, 1]
 
   // The attribute value with the most accumulated confidence per key (ties: smallest value).
   std::map<std::string, std::string> attributes() const;

@@ -18,7 +18,7 @@ namespace hameritt::cop {
 struct TakEventConfig {
   std::string uid_prefix = "hameritt";
   std::string uav_callsign = "HAMERITT-UAV";
-  double stale_s = 30.0;       // UAV and tracks: stale = time + stale_s
+  double stale_s = 30.0;        // UAV and tracks: stale = time + stale_s
   double zone_stale_s = 600.0;  // zones
   double uav_ce = 1.0;          // the UAV's own position error (m, 1-sigma)
   double uav_le = 1.0;
@@ -34,8 +34,8 @@ struct TrackReport {
   std::map<std::string, std::string> attributes;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  // map frame
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // east, north m/s
-  double ce = kCotUnknownError;  // horizontal 1-sigma (m)
-  double le = kCotUnknownError;  // vertical 1-sigma (m)
+  double ce = kCotUnknownError;                        // horizontal 1-sigma (m)
+  double le = kCotUnknownError;                        // vertical 1-sigma (m)
   std::string target_id;
   double target_belief = 0.0;
   std::string entity_id;
@@ -46,7 +46,7 @@ struct TrackReport {
 struct ZoneReport {
   std::string id;
   bool keep_out = false;
-  std::string purpose;                  // keep-out zones: vantage_denial, ...
+  std::string purpose;                   // keep-out zones: vantage_denial, ...
   std::vector<Eigen::Vector2d> polygon;  // map frame, counter-clockwise
   std::optional<double> alt_min, alt_max;
 };

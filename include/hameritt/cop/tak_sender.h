@@ -49,12 +49,12 @@ struct TakSenderConfig {
 struct TakSenderStats {
   std::uint64_t queued = 0;
   std::uint64_t sent = 0;
-  std::uint64_t dropped = 0;          // oldest events dropped from a full queue
-  std::uint64_t send_errors = 0;      // datagrams or streams that failed
+  std::uint64_t dropped = 0;      // oldest events dropped from a full queue
+  std::uint64_t send_errors = 0;  // datagrams or streams that failed
   std::uint64_t connect_attempts = 0;
   std::uint64_t connects = 0;
-  bool connected = false;             // TCP: a live connection; UDP: the socket is open
-  double next_backoff_s = 0.0;        // TCP: delay before the next attempt after a failure
+  bool connected = false;       // TCP: a live connection; UDP: the socket is open
+  double next_backoff_s = 0.0;  // TCP: delay before the next attempt after a failure
   std::string last_error;
 };
 

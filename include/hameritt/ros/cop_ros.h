@@ -9,8 +9,8 @@
 //
 // Parameters (private): ~publish_rate_hz (2), ~frame_id ("map"), ~claim_sigma (3 m),
 // ~perfect_sigma (0.5 m), and cop::CopConfig's fields: ~process_accel_sigma, ~height_walk_sigma,
-// ~gate_chi2, ~merge_chi2, ~initial_speed_sigma, ~confirm_hits, ~tentative_timeout, ~confirmed_timeout,
-// ~belief_threshold.
+// ~gate_chi2, ~merge_chi2, ~initial_speed_sigma, ~confirm_hits, ~tentative_timeout,
+// ~confirmed_timeout, ~belief_threshold.
 
 #include <ros/ros.h>
 
