@@ -32,7 +32,7 @@ void requirePositive(double v, const char* name) {
 
 TakBridgeRos::TakBridgeRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   std::string endpoints;
-  pnh.param<std::string>("endpoints", endpoints, "");
+  pnh.param<std::string>("endpoints", endpoints, "udp://");  // unset: TAK multicast
   const std::vector<std::string> urls = splitList(endpoints);
   if (urls.empty())
     throw std::invalid_argument(

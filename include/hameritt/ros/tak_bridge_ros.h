@@ -8,13 +8,13 @@
 // map frame), mission (hameritt/Mission, latched).
 //
 // Parameters (private): ~endpoints (comma-separated URLs, e.g. "udp://127.0.0.1:6969,
-// tcp://10.0.0.5:8087"; "udp://" = multicast 239.2.3.1:6969), ~rate_hz (1: UAV and tracks, wall
-// time), ~zone_period_s (10), ~send_tentative (false: tentative tracks stay off TAK unless
-// believed to be a target), ~origin_latitude, ~origin_longitude,
-// ~origin_altitude (all three or none: overrides the mission's frame origin), ~uid_prefix,
-// ~uav_callsign, ~stale_s, ~zone_stale_s, ~uav_ce, ~uav_le (cop::TakEventConfig),
-// ~queue_capacity, ~multicast_ttl, ~reconnect_initial_s, ~reconnect_max_s, ~connect_timeout_s
-// (cop::TakSenderConfig). config/tak.yaml holds the defaults (launch/cop.launch loads it).
+// tcp://10.0.0.5:8087"; "udp://" = multicast 239.2.3.1:6969, the default when unset), ~rate_hz (1:
+// UAV and tracks, wall time), ~zone_period_s (10), ~send_tentative (false: tentative tracks stay
+// off TAK unless believed to be a target), ~origin_latitude, ~origin_longitude, ~origin_altitude
+// (all three or none: overrides the mission's frame origin), ~uid_prefix, ~uav_callsign, ~stale_s,
+// ~zone_stale_s, ~uav_ce, ~uav_le (cop::TakEventConfig), ~queue_capacity, ~multicast_ttl,
+// ~reconnect_initial_s, ~reconnect_max_s, ~connect_timeout_s (cop::TakSenderConfig).
+// config/tak.yaml holds the defaults (launch/cop.launch loads it).
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
