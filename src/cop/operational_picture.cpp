@@ -207,8 +207,8 @@ void OperationalPicture::mergeDuplicates() {
         ++b;
         continue;
       }
-      // The older track keeps its id and state (the newer one holds a report or few); it takes
-      // the newer one's evidence.
+      // The older track keeps its id and takes the newer one's evidence, and its state when that
+      // is more recent.
       if (newer.last_seen > older.last_seen) {
         older.state = newer.state;
         older.covariance = newer.covariance;
