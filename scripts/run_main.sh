@@ -36,8 +36,8 @@ ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" hameritt mission.la
 grep -E "simulator: sim .* wall" "$OUT/mission/launch.log" | tail -1 || true
 echo "== COP and TAK bridge ($OUT/mission/cot.log)"
 kill -INT "$cot_pid" && wait "$cot_pid" || true
-grep -hE "(cop|tak_bridge): summary" "$OUT/mission/launch.log" | sed 's/^.*\]: //' || true
-head -8 "$OUT/mission/cot.log"
+grep -hE "(cop|tak_bridge): summary" "$OUT/mission/launch.log" | sed 's/^.*\]: //; s/\x1b\[[0-9;]*m//g' || true
+grep -E "^cot_listen|^  [a-z]-|believed target" "$OUT/mission/cot.log" | head -12 || true
 echo "== metrics ($OUT/mission/metrics.json)"
 cat "$OUT/mission/metrics.json"
 echo
