@@ -22,11 +22,22 @@ rm -rf "$OUT/mission"
 mkdir -p "$OUT/mission"
 # A private ROS master port, so that a running roscore is left alone.
 port=$((11400 + $$ % 500))
+# The COP and the TAK bridge ride along (README "Common Operational Picture and TAK bridge"):
+# CoT events go to a local listener on 127.0.0.1 only.
+tak_port=$((16000 + $$ % 2000))
+/usr/bin/python3 "$HAMERITT_ROOT/scripts/cot_listen.py" --port "$tak_port" >"$OUT/mission/cot.log" 2>&1 &
+cot_pid=$!
+trap 'kill -INT $cot_pid 2>/dev/null || true' EXIT
 ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" hameritt mission.launch \
   scenario:="$SCENARIO" mode:="${HAMERITT_MODE:-end_to_end}" record:=true output_dir:="$OUT/mission" \
-  real_time_factor:="${HAMERITT_REAL_TIME_FACTOR:-0}" >"$OUT/mission/launch.log" 2>&1 ||
+  real_time_factor:="${HAMERITT_REAL_TIME_FACTOR:-0}" cop:=true tak:="udp://127.0.0.1:$tak_port" \
+  >"$OUT/mission/launch.log" 2>&1 ||
   { tail -40 "$OUT/mission/launch.log"; echo "hameritt: the mission launch failed (log: $OUT/mission/launch.log)"; exit 1; }
 grep -E "simulator: sim .* wall" "$OUT/mission/launch.log" | tail -1 || true
+echo "== COP and TAK bridge ($OUT/mission/cot.log)"
+kill -INT "$cot_pid" && wait "$cot_pid" || true
+grep -hE "(cop|tak_bridge): summary" "$OUT/mission/launch.log" | sed 's/^.*\]: //; s/\x1b\[[0-9;]*m//g' || true
+grep -E "^cot_listen|^  [a-z]-|believed target" "$OUT/mission/cot.log" | head -12 || true
 echo "== metrics ($OUT/mission/metrics.json)"
 cat "$OUT/mission/metrics.json"
 echo
