@@ -262,8 +262,16 @@ std::shared_ptr<const StreetIndex> streetIndex(const World& w) {
 // The car's footprint at a pose is on the street and clear of parked cars. `nearby`, when
 // given, holds every occluder that can touch the footprint (see validPoses).
 // `fwd` is the unit heading (cos yaw, sin yaw).
+// An occluder near a route piece: its footprint centre and the squared sum of its
+// circumradius and the car's reach.
+struct NearbyBox {
+  int index;
+  Vec2 center;
+  double r2;
+};
+
 bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const Vec2& fwd,
-              const RouteSettings& s, const std::vector<int>* nearby = nullptr) {
+              const RouteSettings& s, const std::vector<NearbyBox>* nearby = nullptr) {
   const Vec2 left(-fwd.y(), fwd.x());
   for (double a : {-0.5, 0.5}) {
     for (double b : {-0.5, 0.5}) {
@@ -277,19 +285,17 @@ bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const V
   car.size = geometry::Vec3(s.vehicle_length, s.vehicle_width, 1.6);
   car.yaw = q.yaw;
   const auto& occ = w.occluders();
-  const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
   if (!nearby) {
+    const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
     for (int i : occ.near(q.p, reach)) {
       if (geometry::footprintsOverlap(car, occ.box(i))) return false;
     }
     return true;
   }
-  for (int i : *nearby) {
-    const auto& o = occ.box(i);
+  for (const NearbyBox& nb : *nearby) {
     // Footprints that overlap have centres within the sum of their circumradii.
-    const double r = reach + 0.5 * std::hypot(o.size.x(), o.size.y());
-    if ((o.center2() - q.p).squaredNorm() > r * r) continue;
-    if (geometry::footprintsOverlap(car, o)) return false;
+    if ((nb.center - q.p).squaredNorm() > nb.r2) continue;
+    if (geometry::footprintsOverlap(car, occ.box(nb.index))) return false;
   }
   return true;
 }
@@ -311,7 +317,12 @@ std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::ve
   const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
   box.min -= Vec2(reach, reach);
   box.max += Vec2(reach, reach);
-  const std::vector<int> nearby = w.occluders().candidates(box);
+  std::vector<NearbyBox> nearby;
+  for (int i : w.occluders().candidates(box)) {
+    const auto& o = w.occluders().box(i);
+    const double r = reach + 0.5 * std::hypot(o.size.x(), o.size.y());
+    nearby.push_back({i, o.center2(), r * r});
+  }
   // Consecutive poses mostly share their heading: its sine and cosine are computed once.
   double yaw = std::numeric_limits<double>::quiet_NaN();
   Vec2 fwd(1, 0);
@@ -338,11 +349,12 @@ std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose&
   if (straight > 1e-6 && std::abs(geometry::wrapPi(heading - a.yaw)) < 2e-3 &&
       std::abs(geometry::wrapPi(b.yaw - a.yaw)) < 2e-3) {
     const int n = std::max(1, static_cast<int>(std::ceil(straight / 0.25)));
+    const double turn = geometry::wrapPi(b.yaw - a.yaw);
     std::vector<Pose> out;
     out.reserve(static_cast<std::size_t>(n) + 1);
     for (int k = 0; k <= n; ++k) {
       const double u = static_cast<double>(k) / n;
-      out.push_back({a.p + ab * u, a.yaw + geometry::wrapPi(b.yaw - a.yaw) * u});
+      out.push_back({a.p + ab * u, a.yaw + turn * u});
     }
     return validPoses(w, streets, std::move(out), s);
   }
