@@ -306,8 +306,11 @@ bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const R
 
 // The poses, or empty when one of them is invalid. The occluders near the whole piece are
 // fetched once instead of once per pose.
+// `straight`: the poses lie on the segment from the first to the last (up to rounding), so
+// occluders farther from it than their circumradius plus the car's reach (and 1e-6 m) are
+// dropped up front: no pose's centre test could pass for them.
 std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::vector<Pose> poses,
-                             const RouteSettings& s) {
+                             const RouteSettings& s, bool straight) {
   if (poses.empty()) return poses;
   geometry::Aabb2 box{poses.front().p, poses.front().p};
   for (const auto& q : poses) {
@@ -321,6 +324,10 @@ std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::ve
   for (int i : w.occluders().candidates(box)) {
     const auto& o = w.occluders().box(i);
     const double r = reach + 0.5 * std::hypot(o.size.x(), o.size.y());
+    if (straight &&
+        geometry::pointSegmentDistance(o.center2(), poses.front().p, poses.back().p) > r + 1e-6) {
+      continue;
+    }
     nearby.push_back({i, o.center2(), r * r});
   }
   // Consecutive poses mostly share their heading: its sine and cosine are computed once.
@@ -356,7 +363,7 @@ std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose&
       const double u = static_cast<double>(k) / n;
       out.push_back({a.p + ab * u, a.yaw + turn * u});
     }
-    return validPoses(w, streets, std::move(out), s);
+    return validPoses(w, streets, std::move(out), s, true);
   }
   auto space = std::make_shared<ob::DubinsStateSpace>(radius);
   ob::ScopedState<ob::DubinsStateSpace> sa(space), sb(space), x(space);
@@ -378,7 +385,7 @@ std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose&
     out.push_back({Vec2(x->getX(), x->getY()), x->getYaw()});
   }
   out.push_back({Vec2(sb->getX(), sb->getY()), sb->getYaw()});
-  return validPoses(w, streets, std::move(out), s);
+  return validPoses(w, streets, std::move(out), s, false);
 }
 
 }  // namespace
