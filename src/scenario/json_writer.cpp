@@ -1,5 +1,6 @@
 #include "hameritt/scenario/json_writer.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -67,6 +68,15 @@ JsonWriter& JsonWriter::key(std::string_view k) {
 
 void JsonWriter::escape(std::string_view s) {
   out_ += '"';
+  // Plain text (the usual case: ids, keys, names) is copied at once.
+  const bool plain = std::all_of(s.begin(), s.end(), [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && c != '"' && c != '\\';
+  });
+  if (plain) {
+    out_.append(s);
+    out_ += '"';
+    return;
+  }
   for (char c : s) {
     switch (c) {
       case '"':
