@@ -416,10 +416,19 @@ class ScenarioBuilder {
       const double t = k * dt;
       Subject s = subjectOf(target);
       s.box = poseBox(target.box, sampleTrajectory(traj, t));
+      constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf};
       auto consider = [&](const Subject& rel) {
-        const RelationFacts f = eval_.measure(s, rel);
-        for (RelationOp op : {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf}) {
-          const std::string key = rel.id + toString(op);
+        std::string keys[3];
+        bool open = false;  // some operator not yet seen with this entity
+        for (int j = 0; j < 3; ++j) {
+          keys[j] = rel.id + toString(kOps[j]);
+          open = open || !seen.count(keys[j]);
+        }
+        if (!open) return;
+        const RelationFacts f = eval_.measureSideways(s, rel);
+        for (int j = 0; j < 3; ++j) {
+          const RelationOp op = kOps[j];
+          const std::string& key = keys[j];
           if (seen.count(key) || !eval_.holds(op, f, rel.cls)) continue;
           seen.insert(key);
           if (rel.cls == EntityClass::kStreet || rel.cls == EntityClass::kFence) continue;

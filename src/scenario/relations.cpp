@@ -113,6 +113,25 @@ RelationFacts RelationEvaluator::measure(const Subject& target, const Subject& r
   return f;
 }
 
+RelationFacts RelationEvaluator::measureSideways(const Subject& target,
+                                                 const Subject& related) const {
+  RelationFacts f;
+  f.distance = geometry::footprintDistance(target.box, related.box);
+  const Vec2 d = related.box.center2() - target.box.center2();
+  f.bearing_deg = geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
+  f.dz = target.box.minZ() - related.box.maxZ();
+  if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
+    f.line_of_sight = true;
+  } else if (f.distance <= config_.radius) {
+    const double tol = config_.bearing_tolerance_deg;
+    const bool could = f.distance < config_.next_to_distance ||
+                       geometry::angleDiffDeg(f.bearing_deg, 90.0) <= tol ||
+                       geometry::angleDiffDeg(f.bearing_deg, 270.0) <= tol;
+    if (could) f.line_of_sight = lineOfSight(target, related);
+  }
+  return f;
+}
+
 bool RelationEvaluator::holds(RelationOp op, const RelationFacts& f, EntityClass cls) const {
   if (!operatorApplies(op, cls)) return false;
   const double tol = config_.bearing_tolerance_deg;

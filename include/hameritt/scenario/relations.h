@@ -57,6 +57,10 @@ class RelationEvaluator {
   void removeOccluder(const std::string& id);
 
   RelationFacts measure(const Subject& target, const Subject& related) const;
+  // measure() for NEXT_TO, LEFT_OF and RIGHT_OF only: `over` is left false, and line of sight
+  // is only computed where one of them could hold (else false), so holds() gives the same
+  // answer for those three operators.
+  RelationFacts measureSideways(const Subject& target, const Subject& related) const;
   // True when `op` (not PART_OF) holds for these facts and the related class.
   bool holds(RelationOp op, const RelationFacts& f, EntityClass related_cls) const;
   // Line of sight between two box centres, ignoring the two subjects themselves.
