@@ -4,8 +4,10 @@
 #include <ompl/base/spaces/DubinsStateSpace.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <memory>
@@ -143,6 +145,43 @@ int edgeBetween(const World& w, int u, int v) {
   return -1;
 }
 
+// Validated route pieces of one world, shared between the routes of a batch: the lane and
+// corner pieces between street nodes recur in many routes. A piece is a pure function of its
+// end poses, the turning radius and the car's size (the world being fixed), so a cached piece
+// is the one that would be computed; keys compare the numbers' bits. Thread-safe; stops
+// storing at kMaxPoses poses in all.
+class PieceCache {
+ public:
+  using Key = std::array<std::uint64_t, 9>;
+  static Key key(const Pose& a, const Pose& b, double radius, const RouteSettings& s) {
+    const double v[9] = {a.p.x(), a.p.y(), a.yaw, b.p.x(), b.p.y(), b.yaw,
+                         radius,  s.vehicle_length, s.vehicle_width};
+    Key k;
+    static_assert(sizeof(v) == sizeof(k));
+    std::memcpy(k.data(), v, sizeof(v));
+    return k;
+  }
+  // The cached piece for `k`, or nullptr.
+  std::shared_ptr<const std::vector<Pose>> find(const Key& k) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = pieces_.find(k);
+    return it == pieces_.end() ? nullptr : it->second;
+  }
+  void insert(const Key& k, const std::vector<Pose>& piece) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (poses_ + piece.size() + 1 > kMaxPoses) return;
+    if (pieces_.emplace(k, std::make_shared<const std::vector<Pose>>(piece)).second) {
+      poses_ += piece.size() + 1;
+    }
+  }
+
+ private:
+  static constexpr std::size_t kMaxPoses = 2'000'000;  // about 50 MB
+  mutable std::mutex mutex_;
+  std::map<Key, std::shared_ptr<const std::vector<Pose>>> pieces_;
+  std::size_t poses_ = 0;
+};
+
 // Street edges bucketed on a square grid: a point within half a street width of an edge lies
 // in a cell that the edge's widened bounding box touches, so one cell's edges answer
 // onStreet() exactly as the scan over every edge does. A finer grid over the same area marks
@@ -244,6 +283,10 @@ class StreetIndex {
   int nx_ = 0, ny_ = 0, fnx_ = 0, fny_ = 0;
   std::vector<std::vector<int>> cells_;
   std::vector<char> fine_state_;  // kOff, kOn or kKerb per fine cell, row-major
+
+ public:
+  // Route pieces validated on this world.
+  mutable PieceCache pieces;
 };
 
 // One street index per world (by fingerprint), built once and shared read-only between calls
@@ -388,6 +431,16 @@ std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose&
   return validPoses(w, streets, std::move(out), s, false);
 }
 
+// dubins() through the world's piece cache.
+std::vector<Pose> cachedDubins(const World& w, const StreetIndex& streets, const Pose& a,
+                               const Pose& b, double radius, const RouteSettings& s) {
+  const PieceCache::Key k = PieceCache::key(a, b, radius, s);
+  if (const auto hit = streets.pieces.find(k)) return *hit;
+  std::vector<Pose> piece = dubins(w, streets, a, b, radius, s);
+  streets.pieces.insert(k, piece);
+  return piece;
+}
+
 }  // namespace
 
 void SpeedProfile::validate() const {
@@ -526,7 +579,7 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   for (std::size_t i = 1; i < wps.size(); ++i) {
     std::vector<Pose> piece;
     for (double radius : {s.turn_radius, 0.7 * s.turn_radius, 0.5 * s.turn_radius}) {
-      piece = dubins(w, streets, wps[i - 1], wps[i], radius, s);
+      piece = cachedDubins(w, streets, wps[i - 1], wps[i], radius, s);
       if (!piece.empty()) break;
     }
     if (piece.empty()) {
