@@ -417,7 +417,7 @@ class ScenarioBuilder {
       Subject s = subjectOf(target);
       s.box = poseBox(target.box, sampleTrajectory(traj, t));
       constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf};
-      auto consider = [&](const Subject& rel) {
+      auto consider = [&](const Subject& rel, double distance) {
         std::string keys[3];
         bool open = false;  // some operator not yet seen with this entity
         for (int j = 0; j < 3; ++j) {
@@ -425,7 +425,7 @@ class ScenarioBuilder {
           open = open || !seen.count(keys[j]);
         }
         if (!open) return;
-        const RelationFacts f = eval_.measureSideways(s, rel);
+        const RelationFacts f = eval_.measureSideways(s, rel, distance);
         for (int j = 0; j < 3; ++j) {
           const RelationOp op = kOps[j];
           const std::string& key = keys[j];
@@ -438,9 +438,10 @@ class ScenarioBuilder {
           out.push_back(r);
         }
       };
-      for (int i : eval_.nearbyWorld(s.box)) consider(worldSubject(world_, i));
+      for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box)) consider(worldSubject(world_, i), d);
       for (const auto& p : parked) {
-        if (geometry::footprintDistance(s.box, p.box) <= cfg_.relations.radius) consider(p);
+        const double d = geometry::footprintDistance(s.box, p.box);
+        if (d <= cfg_.relations.radius) consider(p, d);
       }
     }
     if (static_cast<int>(out.size()) > want) out.resize(static_cast<std::size_t>(want));

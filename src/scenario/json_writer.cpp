@@ -123,7 +123,12 @@ char* writeNumber(double d, char* p) {
   // moved, which is the shortest form that reads back to the same double and much faster
   // than the general algorithm. Anything else takes std::to_chars' shortest round-trip form.
   if (std::abs(d) < 1e12) {
-    const long long k = std::llround(d * 1000.0);
+    // std::llround(x) inline: |x| < 2^52, so x - trunc(x) is exact.
+    const double x = d * 1000.0;
+    long long k = static_cast<long long>(x);
+    const double rest = x - static_cast<double>(k);
+    if (rest >= 0.5) ++k;
+    if (rest <= -0.5) --k;
     if (static_cast<double>(k) / 1000.0 == d) {
       unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
       if (k < 0) *p++ = '-';

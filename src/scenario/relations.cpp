@@ -117,10 +117,10 @@ RelationFacts RelationEvaluator::measure(const Subject& target, const Subject& r
   return f;
 }
 
-RelationFacts RelationEvaluator::measureSideways(const Subject& target,
-                                                 const Subject& related) const {
+RelationFacts RelationEvaluator::measureSideways(const Subject& target, const Subject& related,
+                                                 std::optional<double> distance) const {
   RelationFacts f;
-  f.distance = geometry::footprintDistance(target.box, related.box);
+  f.distance = distance ? *distance : geometry::footprintDistance(target.box, related.box);
   const Vec2 d = related.box.center2() - target.box.center2();
   f.bearing_deg = geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
   f.dz = target.box.minZ() - related.box.maxZ();
@@ -169,15 +169,21 @@ bool RelationEvaluator::holds(RelationOp op, const RelationFacts& f, EntityClass
 }
 
 std::vector<int> RelationEvaluator::nearbyWorld(const OrientedBox& target) const {
+  std::vector<int> out;
+  for (const auto& [i, d] : nearbyWorldDistances(target)) out.push_back(i);
+  return out;
+}
+
+std::vector<std::pair<int, double>> RelationEvaluator::nearbyWorldDistances(
+    const OrientedBox& target) const {
   // Footprint index query around the centre, widened by the target's half diagonal, then the
   // exact footprint-to-footprint distance.
   const double reach = config_.radius + 0.5 * target.size.head<2>().norm();
-  std::vector<int> out;
+  std::vector<std::pair<int, double>> out;
   for (int i : world_.footprints().near(target.center2(), reach)) {
-    if (geometry::footprintDistance(target, world_.entities()[static_cast<std::size_t>(i)].box) <=
-        config_.radius) {
-      out.push_back(i);
-    }
+    const double d =
+        geometry::footprintDistance(target, world_.entities()[static_cast<std::size_t>(i)].box);
+    if (d <= config_.radius) out.emplace_back(i, d);
   }
   return out;
 }
