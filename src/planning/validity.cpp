@@ -108,7 +108,8 @@ class SegmentBoxes {
       ++last;
     }
     boxes_.clear();
-    for (int i : o.index.candidates(geometry::Aabb2{lo - Vec2(kPad, kPad), hi + Vec2(kPad, kPad)})) {
+    for (int i :
+         o.index.candidates(geometry::Aabb2{lo - Vec2(kPad, kPad), hi + Vec2(kPad, kPad)})) {
       const geometry::OrientedBox& b = o.index.box(i);
       boxes_.push_back({b, b.bounds2()});
     }
@@ -343,8 +344,8 @@ std::string WorldValidity::checkTrajectory(const scenario::Trajectory& traj, dou
     if (!(tb > ta)) return "sample " + std::to_string(i) + ": time not increasing";
     if (i > run_end) run_end = run.collect(*obstacles_, traj, i - 1);
     const bool b_valid = staticValid(b, slack);
-    const bool static_ok = a_valid && b_valid &&
-                           (slack <= 0 ? obstacles_->index.clear(a, b) : run.clear(a, b, slack));
+    const bool static_ok =
+        a_valid && b_valid && (slack <= 0 ? obstacles_->index.clear(a, b) : run.clear(a, b, slack));
     a_valid = b_valid;
     // Both checks are exact over a whole segment, so a valid segment needs no pieces; the
     // pieces only locate a failure for the message.

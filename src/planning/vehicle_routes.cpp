@@ -154,7 +154,7 @@ class PieceCache {
  public:
   using Key = std::array<std::uint64_t, 9>;
   static Key key(const Pose& a, const Pose& b, double radius, const RouteSettings& s) {
-    const double v[9] = {a.p.x(), a.p.y(), a.yaw, b.p.x(), b.p.y(), b.yaw,
+    const double v[9] = {a.p.x(), a.p.y(),          a.yaw,          b.p.x(), b.p.y(), b.yaw,
                          radius,  s.vehicle_length, s.vehicle_width};
     Key k;
     static_assert(sizeof(v) == sizeof(k));

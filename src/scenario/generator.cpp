@@ -416,7 +416,8 @@ class ScenarioBuilder {
       const double t = k * dt;
       Subject s = subjectOf(target);
       s.box = poseBox(target.box, sampleTrajectory(traj, t));
-      constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf};
+      constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf,
+                                     RelationOp::kRightOf};
       auto consider = [&](const Subject& rel, double distance) {
         std::string keys[3];
         bool open = false;  // some operator not yet seen with this entity
@@ -438,7 +439,8 @@ class ScenarioBuilder {
           out.push_back(r);
         }
       };
-      for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box)) consider(worldSubject(world_, i), d);
+      for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box))
+        consider(worldSubject(world_, i), d);
       for (const auto& p : parked) {
         const double d = geometry::footprintDistance(s.box, p.box);
         if (d <= cfg_.relations.radius) consider(p, d);

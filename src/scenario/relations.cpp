@@ -106,8 +106,8 @@ RelationFacts RelationEvaluator::measure(const Subject& target, const Subject& r
   // A point farther from the box centre than its corners (plus 1 mm, far above the polygon's
   // touching tolerance) is outside the footprint: no polygon needed.
   const double corner = 0.5 * related.box.size.head<2>().norm() + 1e-3;
-  f.over = d.squaredNorm() <= corner * corner &&
-           related.box.footprint().contains(target.box.center2());
+  f.over =
+      d.squaredNorm() <= corner * corner && related.box.footprint().contains(target.box.center2());
   // Sight only matters for the operators that need it; surfaces are never occluded.
   if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
     f.line_of_sight = true;
@@ -122,7 +122,8 @@ RelationFacts RelationEvaluator::measureSideways(const Subject& target, const Su
   RelationFacts f;
   f.distance = distance ? *distance : geometry::footprintDistance(target.box, related.box);
   const Vec2 d = related.box.center2() - target.box.center2();
-  f.bearing_deg = geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
+  f.bearing_deg =
+      geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
   f.dz = target.box.minZ() - related.box.maxZ();
   if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
     f.line_of_sight = true;

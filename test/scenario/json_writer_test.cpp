@@ -81,9 +81,9 @@ TEST(JsonWriterTest, NumberArraysMatchValueByValue) {
   JsonWriter p;
   p.beginObject();
   p.key("p").numbers({1.5, -2.0, 0.25});
-  p.key("long").numbers({0.1 + 0.2, 1e-7 / 3, 2.0 / 3, -1.0 / 7, 0.1 + 0.2, 1e-7 / 3, 2.0 / 3,
-                         -1.0 / 7, 0.1 + 0.2, 1e-7 / 3, 2.0 / 3, -1.0 / 7, 0.1 + 0.2, 1e-7 / 3,
-                         2.0 / 3, -1.0 / 7, 0.1 + 0.2, 1e-7 / 3, 2.0 / 3, -1.0 / 7, 12.345});
+  p.key("long").numbers({0.1 + 0.2, 1e-7 / 3,  2.0 / 3,   -1.0 / 7, 0.1 + 0.2, 1e-7 / 3,  2.0 / 3,
+                         -1.0 / 7,  0.1 + 0.2, 1e-7 / 3,  2.0 / 3,  -1.0 / 7,  0.1 + 0.2, 1e-7 / 3,
+                         2.0 / 3,   -1.0 / 7,  0.1 + 0.2, 1e-7 / 3, 2.0 / 3,   -1.0 / 7,  12.345});
   p.key("none").numbers({});
   p.endObject();
   EXPECT_NE(p.str().find("\"p\": [1.5, -2, 0.25]"), std::string::npos) << p.str();

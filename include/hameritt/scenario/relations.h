@@ -72,7 +72,8 @@ class RelationEvaluator {
   // World entities whose footprint lies within the relation radius of the target's footprint.
   std::vector<int> nearbyWorld(const geometry::OrientedBox& target) const;
   // nearbyWorld() with each entity's footprint distance to the target alongside.
-  std::vector<std::pair<int, double>> nearbyWorldDistances(const geometry::OrientedBox& target) const;
+  std::vector<std::pair<int, double>> nearbyWorldDistances(
+      const geometry::OrientedBox& target) const;
 
   // Every true relation of the target at this instant against nearby world entities and the
   // given extra subjects (pedestrians, other scenario cars), and PART_OF its groups.
