@@ -290,11 +290,13 @@ class StreetIndex {
 };
 
 // One street index per world (by fingerprint), built once and shared read-only between calls
-// and threads; the last few are kept.
+// and threads; the last few are kept (clearRouteCaches() drops them).
+std::mutex street_index_mutex;
+std::map<std::uint64_t, std::shared_ptr<const StreetIndex>> street_indexes;
+
 std::shared_ptr<const StreetIndex> streetIndex(const World& w) {
-  static std::mutex mutex;
-  static std::map<std::uint64_t, std::shared_ptr<const StreetIndex>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<std::mutex> lock(street_index_mutex);
+  auto& cache = street_indexes;
   if (auto it = cache.find(w.fingerprint()); it != cache.end()) return it->second;
   auto index = std::make_shared<const StreetIndex>(w);
   if (cache.size() >= 8) cache.clear();
@@ -478,6 +480,11 @@ void RouteSettings::validate() const {
   need(vehicle_width > 0 && vehicle_width < 5, "vehicle_width", "metres in (0, 5)", vehicle_width);
   need(sample_spacing >= 0.25 && sample_spacing <= 50, "sample_spacing", "metres in [0.25, 50]",
        sample_spacing);
+}
+
+void clearRouteCaches() {
+  std::lock_guard<std::mutex> lock(street_index_mutex);
+  street_indexes.clear();
 }
 
 bool onStreet(const World& w, const Vec2& p, double shrink) {
