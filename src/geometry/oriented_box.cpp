@@ -56,8 +56,15 @@ bool OrientedBox::contains(const Vec3& p) const {
 // its body frame; all intervals closed, so grazing an edge or a corner counts as touching.
 bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b) const {
   if (!a.allFinite() || !b.allFinite()) return false;
-  const Vec3 p = toBody(a);
-  const Vec3 d = toBody(b) - p;
+  // toBody() for both ends, with one sine and cosine.
+  const double cy = std::cos(yaw);
+  const double sy = std::sin(yaw);
+  auto body = [&](const Vec3& w) {
+    const Vec3 q = w - center;
+    return Vec3(cy * q.x() + sy * q.y(), -sy * q.x() + cy * q.y(), q.z());
+  };
+  const Vec3 p = body(a);
+  const Vec3 d = body(b) - p;
   const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(boxTolerance(*this));
   double t0 = 0.0;
   double t1 = 1.0;

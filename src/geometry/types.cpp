@@ -10,6 +10,8 @@ constexpr double kTwoPi = 2.0 * kPi;
 
 // std::remainder is exact and lands in [-pi, pi]; only -pi needs moving to +pi.
 double wrapPi(double a) {
+  // Inside (-pi, pi] the remainder is `a` itself (it is exact): skip the library call.
+  if (a > -kPi && a <= kPi) return a;
   double r = std::remainder(a, kTwoPi);
   if (r <= -kPi) r += kTwoPi;
   return r;

@@ -88,6 +88,56 @@ struct WorldValidity::Obstacles {
 
 namespace {
 
+// The inflated boxes near a run of trajectory samples, for checkTrajectory().
+class SegmentBoxes {
+ public:
+  // Collects the boxes whose bounds meet those of samples `first`.. (at most kSamples of them
+  // within kSpan metres in x and y), padded by kPad; returns the last sample of the run.
+  std::size_t collect(const WorldValidity::Obstacles& o, const scenario::Trajectory& traj,
+                      std::size_t first) {
+    constexpr std::size_t kSamples = 64;
+    constexpr double kSpan = 24.0;
+    Vec2 lo(traj[first].x, traj[first].y), hi = lo;
+    std::size_t last = first;
+    while (last + 1 < traj.size() && last + 1 - first < kSamples) {
+      const Vec2 q(traj[last + 1].x, traj[last + 1].y);
+      const Vec2 nlo = lo.cwiseMin(q), nhi = hi.cwiseMax(q);
+      if (last > first && (nhi - nlo).maxCoeff() > kSpan) break;
+      lo = nlo;
+      hi = nhi;
+      ++last;
+    }
+    boxes_.clear();
+    for (int i :
+         o.index.candidates(geometry::Aabb2{lo - Vec2(kPad, kPad), hi + Vec2(kPad, kPad)})) {
+      const geometry::OrientedBox& b = o.index.box(i);
+      boxes_.push_back({b, b.bounds2()});
+    }
+    return last;
+  }
+  // staticSegmentValid's obstacle test with slack > 0 for a segment of the run: the same boxes
+  // (bounds overlapping the segment's), the same test.
+  bool clear(const Vec3& a, const Vec3& b, double slack) const {
+    const geometry::Aabb2 box{a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())};
+    for (const Near& n : boxes_) {
+      if (!n.bounds.overlaps(box)) continue;
+      geometry::OrientedBox o = n.box;
+      o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
+      if (o.intersectsSegment(a, b)) return false;
+    }
+    return true;
+  }
+
+ private:
+  // Rounding margin of the run's bounds (each segment then filters exactly).
+  static constexpr double kPad = 1e-3;
+  struct Near {
+    geometry::OrientedBox box;
+    geometry::Aabb2 bounds;
+  };
+  std::vector<Near> boxes_;
+};
+
 // The world's obstacles inflated by `margin`, built once per world fingerprint and margin and
 // shared (immutable) between checkers and threads; the last few are kept.
 std::shared_ptr<const WorldValidity::Obstacles> inflatedObstacles(const scenario::World& world,
@@ -282,13 +332,24 @@ std::string WorldValidity::checkTrajectory(const scenario::Trajectory& traj, dou
   if (!staticValid(pos(traj[0]), slack) || !kozClear(pos(traj[0]), traj[0].t, traj[0].t, slack)) {
     return "sample 0: " + explain(pos(traj[0]), traj[0].t);
   }
+  // staticSegmentValid() over runs of consecutive samples: the boxes near a run are looked up
+  // once and each segment tests those whose bounds meet its own, as staticSegmentValid does;
+  // an end point's check is reused by the next segment.
+  SegmentBoxes run;
+  std::size_t run_end = 0;  // last sample of the current run
+  bool a_valid = true;      // staticValid of sample i - 1 (sample 0 checked above)
   for (std::size_t i = 1; i < traj.size(); ++i) {
     const Vec3 a = pos(traj[i - 1]), b = pos(traj[i]);
     const double ta = traj[i - 1].t, tb = traj[i].t;
     if (!(tb > ta)) return "sample " + std::to_string(i) + ": time not increasing";
+    if (i > run_end) run_end = run.collect(*obstacles_, traj, i - 1);
+    const bool b_valid = staticValid(b, slack);
+    const bool static_ok =
+        a_valid && b_valid && (slack <= 0 ? obstacles_->index.clear(a, b) : run.clear(a, b, slack));
+    a_valid = b_valid;
     // Both checks are exact over a whole segment, so a valid segment needs no pieces; the
     // pieces only locate a failure for the message.
-    if (staticSegmentValid(a, b, slack) && kozSegmentClear(a, b, ta, tb, slack)) continue;
+    if (static_ok && kozSegmentClear(a, b, ta, tb, slack)) continue;
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / max_step)));
     for (int k = 0; k < n; ++k) {
       const double u0 = static_cast<double>(k) / n, u1 = static_cast<double>(k + 1) / n;

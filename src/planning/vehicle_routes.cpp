@@ -4,8 +4,10 @@
 #include <ompl/base/spaces/DubinsStateSpace.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <memory>
@@ -87,12 +89,15 @@ std::vector<int> search(const World& w, int from, int in_edge, int to, std::uint
     cost[e] =
         (w.nodes()[ed.b].position - w.nodes()[ed.a].position).norm() * (1 + noise * rng.unit());
   }
-  // State: (node, edge it was entered by) so that U-turns can be excluded.
+  // State: (node, edge it was entered by) so that U-turns can be excluded. The node is an end
+  // of the edge, so a state is a directed edge (2 per edge) or a node entered by no edge.
   const std::size_t ne = w.edges().size();
   auto key = [&](int node, int edge) {
-    return static_cast<std::size_t>(node) * (ne + 1) + static_cast<std::size_t>(edge + 1);
+    if (edge < 0) return 2 * ne + static_cast<std::size_t>(node);
+    return 2 * static_cast<std::size_t>(edge) +
+           (w.edges()[static_cast<std::size_t>(edge)].b == node ? 1 : 0);
   };
-  std::vector<double> dist(w.nodes().size() * (ne + 1), std::numeric_limits<double>::infinity());
+  std::vector<double> dist(2 * ne + w.nodes().size(), std::numeric_limits<double>::infinity());
   std::vector<std::pair<int, int>> prev(dist.size(), {-1, -1});
   using Item = std::tuple<double, int, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
@@ -140,12 +145,52 @@ int edgeBetween(const World& w, int u, int v) {
   return -1;
 }
 
+// Validated route pieces of one world, shared between the routes of a batch: the lane and
+// corner pieces between street nodes recur in many routes. A piece is a pure function of its
+// end poses, the turning radius and the car's size (the world being fixed), so a cached piece
+// is the one that would be computed; keys compare the numbers' bits. Thread-safe; stops
+// storing at kMaxPoses poses in all.
+class PieceCache {
+ public:
+  using Key = std::array<std::uint64_t, 9>;
+  static Key key(const Pose& a, const Pose& b, double radius, const RouteSettings& s) {
+    const double v[9] = {a.p.x(), a.p.y(),          a.yaw,          b.p.x(), b.p.y(), b.yaw,
+                         radius,  s.vehicle_length, s.vehicle_width};
+    Key k;
+    static_assert(sizeof(v) == sizeof(k));
+    std::memcpy(k.data(), v, sizeof(v));
+    return k;
+  }
+  // The cached piece for `k`, or nullptr.
+  std::shared_ptr<const std::vector<Pose>> find(const Key& k) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = pieces_.find(k);
+    return it == pieces_.end() ? nullptr : it->second;
+  }
+  void insert(const Key& k, const std::vector<Pose>& piece) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (poses_ + piece.size() + 1 > kMaxPoses) return;
+    if (pieces_.emplace(k, std::make_shared<const std::vector<Pose>>(piece)).second) {
+      poses_ += piece.size() + 1;
+    }
+  }
+
+ private:
+  static constexpr std::size_t kMaxPoses = 2'000'000;  // about 50 MB
+  mutable std::mutex mutex_;
+  std::map<Key, std::shared_ptr<const std::vector<Pose>>> pieces_;
+  std::size_t poses_ = 0;
+};
+
 // Street edges bucketed on a square grid: a point within half a street width of an edge lies
 // in a cell that the edge's widened bounding box touches, so one cell's edges answer
-// onStreet() exactly as the scan over every edge does.
+// onStreet() exactly as the scan over every edge does. A finer grid over the same area marks
+// the cells that lie wholly on one street or wholly off every street (with a 1e-6 m margin, far
+// above rounding), which answer without a distance; only cells along a kerb scan their edges.
 class StreetIndex {
  public:
-  explicit StreetIndex(const World& w, double cell_size = 8.0) : cell_(cell_size) {
+  explicit StreetIndex(const World& w, double cell_size = 8.0, int fine_per_cell = 8)
+      : cell_(cell_size), fine_(cell_size / fine_per_cell) {
     const auto b = w.bounds();
     x0_ = b.min.x() - cell_;
     y0_ = b.min.y() - cell_;
@@ -163,12 +208,19 @@ class StreetIndex {
         for (int i = i0; i <= i1; ++i) cell(i, j).push_back(static_cast<int>(e));
       }
     }
+    classifyFineCells(fine_per_cell);
   }
   // Same answer as planning::onStreet(w, p) (shrink 0) for the world the index was built
   // from; points off the grid fall back to that scan.
   bool onStreet(const World& w, const Vec2& p) const {
     const double fx = (p.x() - x0_) / cell_, fy = (p.y() - y0_) / cell_;
     if (!(fx >= 0 && fy >= 0 && fx < nx_ && fy < ny_)) return planning::onStreet(w, p);
+    const double gx = (p.x() - x0_) / fine_, gy = (p.y() - y0_) / fine_;
+    if (gx < fnx_ && gy < fny_) {
+      const char state =
+          fine_state_[static_cast<std::size_t>(static_cast<int>(gy) * fnx_ + static_cast<int>(gx))];
+      if (state != kKerb) return state == kOn;
+    }
     const std::size_t c =
         static_cast<std::size_t>(static_cast<int>(fy) * nx_ + static_cast<int>(fx));
     for (int e : cells_[c]) {
@@ -187,22 +239,64 @@ class StreetIndex {
   }
   std::vector<int>& cell(int i, int j) { return cells_[static_cast<std::size_t>(j * nx_ + i)]; }
 
+  // Fine cell states: every point of a kOn cell is within half a street width of one edge, no
+  // point of a kOff cell is near any edge (decided from the cell centre's distance and the
+  // cell's half diagonal, a margin of 1e-6 m either way); kKerb cells need the scan.
+  static constexpr char kOff = 0, kOn = 1, kKerb = 2;
+  void classifyFineCells(int fine_per_cell) {
+    fnx_ = nx_ * fine_per_cell;
+    fny_ = ny_ * fine_per_cell;
+    fine_state_.assign(static_cast<std::size_t>(fnx_) * static_cast<std::size_t>(fny_), kOff);
+    constexpr double kMargin = 1e-6;
+    const double half_diag = fine_ * std::sqrt(0.5);
+    auto index = [&](double v, double v0, int n) {
+      return std::clamp(static_cast<int>(std::floor((v - v0) / fine_)), 0, n - 1);
+    };
+    for (const Seg& sg : segs_) {
+      const double reach = sg.half_width + fine_;
+      const int i0 = index(std::min(sg.a.x(), sg.b.x()) - reach, x0_, fnx_);
+      const int i1 = index(std::max(sg.a.x(), sg.b.x()) + reach, x0_, fnx_);
+      const int j0 = index(std::min(sg.a.y(), sg.b.y()) - reach, y0_, fny_);
+      const int j1 = index(std::max(sg.a.y(), sg.b.y()) + reach, y0_, fny_);
+      for (int j = j0; j <= j1; ++j) {
+        for (int i = i0; i <= i1; ++i) {
+          char& st = fine_state_[static_cast<std::size_t>(j * fnx_ + i)];
+          if (st == kOn) continue;
+          const Vec2 c(x0_ + (i + 0.5) * fine_, y0_ + (j + 0.5) * fine_);
+          const double d = geometry::pointSegmentDistance(c, sg.a, sg.b);
+          if (d + half_diag <= sg.half_width - kMargin) {
+            st = kOn;
+          } else if (d - half_diag <= sg.half_width + kMargin) {
+            st = kKerb;
+          }
+        }
+      }
+    }
+  }
+
   struct Seg {
     Vec2 a, b;
     double half_width;
   };
   std::vector<Seg> segs_;  // street edges: centreline and half width
-  double cell_, x0_ = 0, y0_ = 0;
-  int nx_ = 0, ny_ = 0;
+  double cell_, fine_, x0_ = 0, y0_ = 0;
+  int nx_ = 0, ny_ = 0, fnx_ = 0, fny_ = 0;
   std::vector<std::vector<int>> cells_;
+  std::vector<char> fine_state_;  // kOff, kOn or kKerb per fine cell, row-major
+
+ public:
+  // Route pieces validated on this world.
+  mutable PieceCache pieces;
 };
 
 // One street index per world (by fingerprint), built once and shared read-only between calls
-// and threads; the last few are kept.
+// and threads; the last few are kept (clearRouteCaches() drops them).
+std::mutex street_index_mutex;
+std::map<std::uint64_t, std::shared_ptr<const StreetIndex>> street_indexes;
+
 std::shared_ptr<const StreetIndex> streetIndex(const World& w) {
-  static std::mutex mutex;
-  static std::map<std::uint64_t, std::shared_ptr<const StreetIndex>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<std::mutex> lock(street_index_mutex);
+  auto& cache = street_indexes;
   if (auto it = cache.find(w.fingerprint()); it != cache.end()) return it->second;
   auto index = std::make_shared<const StreetIndex>(w);
   if (cache.size() >= 8) cache.clear();
@@ -212,9 +306,18 @@ std::shared_ptr<const StreetIndex> streetIndex(const World& w) {
 
 // The car's footprint at a pose is on the street and clear of parked cars. `nearby`, when
 // given, holds every occluder that can touch the footprint (see validPoses).
-bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const RouteSettings& s,
-              const std::vector<int>* nearby = nullptr) {
-  const Vec2 fwd(std::cos(q.yaw), std::sin(q.yaw)), left(-fwd.y(), fwd.x());
+// `fwd` is the unit heading (cos yaw, sin yaw).
+// An occluder near a route piece: its footprint centre and the squared sum of its
+// circumradius and the car's reach.
+struct NearbyBox {
+  int index;
+  Vec2 center;
+  double r2;
+};
+
+bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const Vec2& fwd,
+              const RouteSettings& s, const std::vector<NearbyBox>* nearby = nullptr) {
+  const Vec2 left(-fwd.y(), fwd.x());
   for (double a : {-0.5, 0.5}) {
     for (double b : {-0.5, 0.5}) {
       const Vec2 c = q.p + fwd * (a * s.vehicle_length) + left * (b * s.vehicle_width);
@@ -227,27 +330,32 @@ bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const R
   car.size = geometry::Vec3(s.vehicle_length, s.vehicle_width, 1.6);
   car.yaw = q.yaw;
   const auto& occ = w.occluders();
-  const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
   if (!nearby) {
+    const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
     for (int i : occ.near(q.p, reach)) {
       if (geometry::footprintsOverlap(car, occ.box(i))) return false;
     }
     return true;
   }
-  for (int i : *nearby) {
-    const auto& o = occ.box(i);
+  for (const NearbyBox& nb : *nearby) {
     // Footprints that overlap have centres within the sum of their circumradii.
-    const double r = reach + 0.5 * std::hypot(o.size.x(), o.size.y());
-    if ((o.center2() - q.p).squaredNorm() > r * r) continue;
-    if (geometry::footprintsOverlap(car, o)) return false;
+    if ((nb.center - q.p).squaredNorm() > nb.r2) continue;
+    if (geometry::footprintsOverlap(car, occ.box(nb.index))) return false;
   }
   return true;
 }
 
+bool carValid(const World& w, const StreetIndex& streets, const Pose& q, const RouteSettings& s) {
+  return carValid(w, streets, q, Vec2(std::cos(q.yaw), std::sin(q.yaw)), s);
+}
+
 // The poses, or empty when one of them is invalid. The occluders near the whole piece are
 // fetched once instead of once per pose.
+// `straight`: the poses lie on the segment from the first to the last (up to rounding), so
+// occluders farther from it than their circumradius plus the car's reach (and 1e-6 m) are
+// dropped up front: no pose's centre test could pass for them.
 std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::vector<Pose> poses,
-                             const RouteSettings& s) {
+                             const RouteSettings& s, bool straight) {
   if (poses.empty()) return poses;
   geometry::Aabb2 box{poses.front().p, poses.front().p};
   for (const auto& q : poses) {
@@ -257,9 +365,25 @@ std::vector<Pose> validPoses(const World& w, const StreetIndex& streets, std::ve
   const double reach = 0.5 * std::hypot(s.vehicle_length, s.vehicle_width) + 0.1;
   box.min -= Vec2(reach, reach);
   box.max += Vec2(reach, reach);
-  const std::vector<int> nearby = w.occluders().candidates(box);
+  std::vector<NearbyBox> nearby;
+  for (int i : w.occluders().candidates(box)) {
+    const auto& o = w.occluders().box(i);
+    const double r = reach + 0.5 * std::hypot(o.size.x(), o.size.y());
+    if (straight &&
+        geometry::pointSegmentDistance(o.center2(), poses.front().p, poses.back().p) > r + 1e-6) {
+      continue;
+    }
+    nearby.push_back({i, o.center2(), r * r});
+  }
+  // Consecutive poses mostly share their heading: its sine and cosine are computed once.
+  double yaw = std::numeric_limits<double>::quiet_NaN();
+  Vec2 fwd(1, 0);
   for (const auto& q : poses) {
-    if (!carValid(w, streets, q, s, &nearby)) return {};
+    if (!(q.yaw == yaw)) {
+      yaw = q.yaw;
+      fwd = Vec2(std::cos(yaw), std::sin(yaw));
+    }
+    if (!carValid(w, streets, q, fwd, s, &nearby)) return {};
   }
   return poses;
 }
@@ -277,13 +401,14 @@ std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose&
   if (straight > 1e-6 && std::abs(geometry::wrapPi(heading - a.yaw)) < 2e-3 &&
       std::abs(geometry::wrapPi(b.yaw - a.yaw)) < 2e-3) {
     const int n = std::max(1, static_cast<int>(std::ceil(straight / 0.25)));
+    const double turn = geometry::wrapPi(b.yaw - a.yaw);
     std::vector<Pose> out;
     out.reserve(static_cast<std::size_t>(n) + 1);
     for (int k = 0; k <= n; ++k) {
       const double u = static_cast<double>(k) / n;
-      out.push_back({a.p + ab * u, a.yaw + geometry::wrapPi(b.yaw - a.yaw) * u});
+      out.push_back({a.p + ab * u, a.yaw + turn * u});
     }
-    return validPoses(w, streets, std::move(out), s);
+    return validPoses(w, streets, std::move(out), s, true);
   }
   auto space = std::make_shared<ob::DubinsStateSpace>(radius);
   ob::ScopedState<ob::DubinsStateSpace> sa(space), sb(space), x(space);
@@ -295,11 +420,27 @@ std::vector<Pose> dubins(const World& w, const StreetIndex& streets, const Pose&
   const int n = std::max(1, static_cast<int>(std::ceil(len / 0.25)));
   std::vector<Pose> out;
   out.reserve(static_cast<std::size_t>(n) + 1);
-  for (int k = 0; k <= n; ++k) {
-    space->interpolate(sa.get(), sb.get(), static_cast<double>(k) / n, x.get());
+  // The curve is computed on the first inner sample and reused (OMPL's four-argument
+  // interpolate recomputes it per call; at t = 0 and t = 1 it copies the end states, as here).
+  bool first_time = true;
+  ob::DubinsStateSpace::DubinsPath path;
+  out.push_back(a);
+  for (int k = 1; k < n; ++k) {
+    space->interpolate(sa.get(), sb.get(), static_cast<double>(k) / n, first_time, path, x.get());
     out.push_back({Vec2(x->getX(), x->getY()), x->getYaw()});
   }
-  return validPoses(w, streets, std::move(out), s);
+  out.push_back({Vec2(sb->getX(), sb->getY()), sb->getYaw()});
+  return validPoses(w, streets, std::move(out), s, false);
+}
+
+// dubins() through the world's piece cache.
+std::vector<Pose> cachedDubins(const World& w, const StreetIndex& streets, const Pose& a,
+                               const Pose& b, double radius, const RouteSettings& s) {
+  const PieceCache::Key k = PieceCache::key(a, b, radius, s);
+  if (const auto hit = streets.pieces.find(k)) return *hit;
+  std::vector<Pose> piece = dubins(w, streets, a, b, radius, s);
+  streets.pieces.insert(k, piece);
+  return piece;
 }
 
 }  // namespace
@@ -339,6 +480,11 @@ void RouteSettings::validate() const {
   need(vehicle_width > 0 && vehicle_width < 5, "vehicle_width", "metres in (0, 5)", vehicle_width);
   need(sample_spacing >= 0.25 && sample_spacing <= 50, "sample_spacing", "metres in [0.25, 50]",
        sample_spacing);
+}
+
+void clearRouteCaches() {
+  std::lock_guard<std::mutex> lock(street_index_mutex);
+  street_indexes.clear();
 }
 
 bool onStreet(const World& w, const Vec2& p, double shrink) {
@@ -440,7 +586,7 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   for (std::size_t i = 1; i < wps.size(); ++i) {
     std::vector<Pose> piece;
     for (double radius : {s.turn_radius, 0.7 * s.turn_radius, 0.5 * s.turn_radius}) {
-      piece = dubins(w, streets, wps[i - 1], wps[i], radius, s);
+      piece = cachedDubins(w, streets, wps[i - 1], wps[i], radius, s);
       if (!piece.empty()) break;
     }
     if (piece.empty()) {

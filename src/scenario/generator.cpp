@@ -416,10 +416,20 @@ class ScenarioBuilder {
       const double t = k * dt;
       Subject s = subjectOf(target);
       s.box = poseBox(target.box, sampleTrajectory(traj, t));
-      auto consider = [&](const Subject& rel) {
-        const RelationFacts f = eval_.measure(s, rel);
-        for (RelationOp op : {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf}) {
-          const std::string key = rel.id + toString(op);
+      constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf,
+                                     RelationOp::kRightOf};
+      auto consider = [&](const Subject& rel, double distance) {
+        std::string keys[3];
+        bool open = false;  // some operator not yet seen with this entity
+        for (int j = 0; j < 3; ++j) {
+          keys[j] = rel.id + toString(kOps[j]);
+          open = open || !seen.count(keys[j]);
+        }
+        if (!open) return;
+        const RelationFacts f = eval_.measureSideways(s, rel, distance);
+        for (int j = 0; j < 3; ++j) {
+          const RelationOp op = kOps[j];
+          const std::string& key = keys[j];
           if (seen.count(key) || !eval_.holds(op, f, rel.cls)) continue;
           seen.insert(key);
           if (rel.cls == EntityClass::kStreet || rel.cls == EntityClass::kFence) continue;
@@ -429,9 +439,11 @@ class ScenarioBuilder {
           out.push_back(r);
         }
       };
-      for (int i : eval_.nearbyWorld(s.box)) consider(worldSubject(world_, i));
+      for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box))
+        consider(worldSubject(world_, i), d);
       for (const auto& p : parked) {
-        if (geometry::footprintDistance(s.box, p.box) <= cfg_.relations.radius) consider(p);
+        const double d = geometry::footprintDistance(s.box, p.box);
+        if (d <= cfg_.relations.radius) consider(p, d);
       }
     }
     if (static_cast<int>(out.size()) > want) out.resize(static_cast<std::size_t>(want));

@@ -1,5 +1,6 @@
 #include "hameritt/scenario/json_writer.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -67,6 +68,15 @@ JsonWriter& JsonWriter::key(std::string_view k) {
 
 void JsonWriter::escape(std::string_view s) {
   out_ += '"';
+  // Plain text (the usual case: ids, keys, names) is copied at once.
+  const bool plain = std::all_of(s.begin(), s.end(), [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && c != '"' && c != '\\';
+  });
+  if (plain) {
+    out_.append(s);
+    out_ += '"';
+    return;
+  }
   for (char c : s) {
     switch (c) {
       case '"':
@@ -103,22 +113,27 @@ JsonWriter& JsonWriter::value(std::string_view s) {
   return *this;
 }
 
-JsonWriter& JsonWriter::value(double d) {
-  if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
-  separate();
+namespace {
+
+// Writes a finite number at p (room for 40 characters); returns the end.
+char* writeNumber(double d, char* p) {
   if (d == 0.0) d = 0.0;  // no "-0"
-  char buf[40];
+  char* const end = p + 40;
   // Most values are millimetre-rounded (k / 1000): print k's digits with the decimal point
   // moved, which is the shortest form that reads back to the same double and much faster
   // than the general algorithm. Anything else takes std::to_chars' shortest round-trip form.
   if (std::abs(d) < 1e12) {
-    const long long k = std::llround(d * 1000.0);
+    // std::llround(x) inline: |x| < 2^52, so x - trunc(x) is exact.
+    const double x = d * 1000.0;
+    long long k = static_cast<long long>(x);
+    const double rest = x - static_cast<double>(k);
+    if (rest >= 0.5) ++k;
+    if (rest <= -0.5) --k;
     if (static_cast<double>(k) / 1000.0 == d) {
-      char* p = buf;
       unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
       if (k < 0) *p++ = '-';
       const unsigned long long whole = a / 1000, frac = a % 1000;
-      p = std::to_chars(p, buf + sizeof(buf), whole).ptr;
+      p = std::to_chars(p, end, whole).ptr;
       if (frac != 0) {
         *p++ = '.';
         char digits[3] = {static_cast<char>('0' + frac / 100), static_cast<char>('0' + frac / 10 % 10),
@@ -127,12 +142,19 @@ JsonWriter& JsonWriter::value(double d) {
         while (digits[n - 1] == '0') --n;
         for (int i = 0; i < n; ++i) *p++ = digits[i];
       }
-      out_.append(buf, p);
-      return *this;
+      return p;
     }
   }
-  const auto res = std::to_chars(buf, buf + sizeof(buf), d);
-  out_.append(buf, res.ptr);
+  return std::to_chars(p, end, d).ptr;
+}
+
+}  // namespace
+
+JsonWriter& JsonWriter::value(double d) {
+  if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
+  separate();
+  char buf[40];
+  out_.append(buf, writeNumber(d, buf));
   return *this;
 }
 
@@ -160,13 +182,29 @@ JsonWriter& JsonWriter::null() {
   return *this;
 }
 
+// The same characters as beginArray(), value() per number and the closing bracket, formatted
+// into one buffer and appended at once.
 JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
-  beginArray();
-  ++inline_depth_;
-  for (double d : v) value(d);
-  --inline_depth_;
-  has_items_.pop_back();
-  out_ += ']';
+  for (double d : v) {
+    if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
+  }
+  separate();
+  const std::string_view sep = pretty_ ? ", " : ",";
+  char buf[512];
+  std::size_t k = 0;
+  buf[k++] = '[';
+  for (const double* d = v.begin(); d != v.end(); ++d) {
+    if (k + 48 > sizeof(buf)) {  // long lists go out in pieces
+      out_.append(buf, k);
+      k = 0;
+    }
+    if (d != v.begin()) {
+      for (char c : sep) buf[k++] = c;
+    }
+    k = static_cast<std::size_t>(writeNumber(*d, buf + k) - buf);
+  }
+  buf[k++] = ']';
+  out_.append(buf, k);
   return *this;
 }
 

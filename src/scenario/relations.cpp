@@ -103,12 +103,36 @@ RelationFacts RelationEvaluator::measure(const Subject& target, const Subject& r
   const Vec2 d = related.box.center2() - target.box.center2();
   f.bearing_deg = geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
   f.dz = target.box.minZ() - related.box.maxZ();
-  f.over = related.box.footprint().contains(target.box.center2());
+  // A point farther from the box centre than its corners (plus 1 mm, far above the polygon's
+  // touching tolerance) is outside the footprint: no polygon needed.
+  const double corner = 0.5 * related.box.size.head<2>().norm() + 1e-3;
+  f.over =
+      d.squaredNorm() <= corner * corner && related.box.footprint().contains(target.box.center2());
   // Sight only matters for the operators that need it; surfaces are never occluded.
   if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
     f.line_of_sight = true;
   } else if (f.distance <= config_.radius) {
     f.line_of_sight = lineOfSight(target, related);
+  }
+  return f;
+}
+
+RelationFacts RelationEvaluator::measureSideways(const Subject& target, const Subject& related,
+                                                 std::optional<double> distance) const {
+  RelationFacts f;
+  f.distance = distance ? *distance : geometry::footprintDistance(target.box, related.box);
+  const Vec2 d = related.box.center2() - target.box.center2();
+  f.bearing_deg =
+      geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
+  f.dz = target.box.minZ() - related.box.maxZ();
+  if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
+    f.line_of_sight = true;
+  } else if (f.distance <= config_.radius) {
+    const double tol = config_.bearing_tolerance_deg;
+    const bool could = f.distance < config_.next_to_distance ||
+                       geometry::angleDiffDeg(f.bearing_deg, 90.0) <= tol ||
+                       geometry::angleDiffDeg(f.bearing_deg, 270.0) <= tol;
+    if (could) f.line_of_sight = lineOfSight(target, related);
   }
   return f;
 }
@@ -146,15 +170,21 @@ bool RelationEvaluator::holds(RelationOp op, const RelationFacts& f, EntityClass
 }
 
 std::vector<int> RelationEvaluator::nearbyWorld(const OrientedBox& target) const {
+  std::vector<int> out;
+  for (const auto& [i, d] : nearbyWorldDistances(target)) out.push_back(i);
+  return out;
+}
+
+std::vector<std::pair<int, double>> RelationEvaluator::nearbyWorldDistances(
+    const OrientedBox& target) const {
   // Footprint index query around the centre, widened by the target's half diagonal, then the
   // exact footprint-to-footprint distance.
   const double reach = config_.radius + 0.5 * target.size.head<2>().norm();
-  std::vector<int> out;
+  std::vector<std::pair<int, double>> out;
   for (int i : world_.footprints().near(target.center2(), reach)) {
-    if (geometry::footprintDistance(target, world_.entities()[static_cast<std::size_t>(i)].box) <=
-        config_.radius) {
-      out.push_back(i);
-    }
+    const double d =
+        geometry::footprintDistance(target, world_.entities()[static_cast<std::size_t>(i)].box);
+    if (d <= config_.radius) out.emplace_back(i, d);
   }
   return out;
 }

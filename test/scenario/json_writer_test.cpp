@@ -57,3 +57,48 @@ TEST(JsonWriterTest, StructureAndEscaping) {
   EXPECT_TRUE(j["none"].is_null());
   EXPECT_THROW(JsonWriter().value(std::nan("")), std::invalid_argument);
 }
+
+// numbers() formats a whole array at once: the same characters as value() per element.
+TEST(JsonWriterTest, NumberArraysMatchValueByValue) {
+  std::mt19937_64 gen(14);
+  int checked = 0;
+  for (int i = 0; i < 5000; ++i) {
+    const double raw = std::ldexp(static_cast<double>(gen() >> 11) * 0x1.0p-53 - 0.5,
+                                  static_cast<int>(gen() % 50) - 10);
+    const double milli = roundMilli(raw);
+    JsonWriter a(false);
+    a.numbers({raw, milli, -milli, 0.0, -0.0, 0.0005, 1e12 + 0.5});
+    JsonWriter b(false);
+    b.beginArray();
+    for (double v : {raw, milli, -milli, 0.0, -0.0, 0.0005, 1e12 + 0.5}) b.value(v);
+    b.endArray();
+    ASSERT_EQ(a.str(), b.str()) << raw;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 5000);
+  // Pretty output keeps the array on one line with ", " between numbers; a long list that
+  // overflows the formatting buffer comes out whole.
+  JsonWriter p;
+  p.beginObject();
+  p.key("p").numbers({1.5, -2.0, 0.25});
+  p.key("long").numbers({0.1 + 0.2, 1e-7 / 3,  2.0 / 3,   -1.0 / 7, 0.1 + 0.2, 1e-7 / 3,  2.0 / 3,
+                         -1.0 / 7,  0.1 + 0.2, 1e-7 / 3,  2.0 / 3,  -1.0 / 7,  0.1 + 0.2, 1e-7 / 3,
+                         2.0 / 3,   -1.0 / 7,  0.1 + 0.2, 1e-7 / 3, 2.0 / 3,   -1.0 / 7,  12.345});
+  p.key("none").numbers({});
+  p.endObject();
+  EXPECT_NE(p.str().find("\"p\": [1.5, -2, 0.25]"), std::string::npos) << p.str();
+  EXPECT_NE(p.str().find("\"none\": []"), std::string::npos) << p.str();
+  const auto j = nlohmann::json::parse(p.str());
+  ASSERT_EQ(j["long"].size(), 21u);
+  EXPECT_EQ(j["long"][0].get<double>(), 0.1 + 0.2);
+  EXPECT_EQ(j["long"][19].get<double>(), -1.0 / 7);
+  EXPECT_EQ(j["long"][20].get<double>(), 12.345);
+  EXPECT_THROW(JsonWriter().numbers({1.0, std::nan("")}), std::invalid_argument);
+}
+
+// Strings without a character to escape are copied as they are, UTF-8 included.
+TEST(JsonWriterTest, PlainStringsCopiedAsTheyAre) {
+  JsonWriter w(false);
+  w.beginObject().key("name").value("caf\xc3\xa9 street_12").key("q").value("a\"b").endObject();
+  EXPECT_EQ(w.str(), "{\"name\":\"caf\xc3\xa9 street_12\",\"q\":\"a\\\"b\"}\n");
+}

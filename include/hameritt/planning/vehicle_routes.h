@@ -63,6 +63,10 @@ RouteResult planVehicleRoute(const scenario::World& world, const scenario::Traje
                              const RouteGoal& goal, std::uint64_t seed,
                              const SpeedProfile& speed = {}, const RouteSettings& settings = {});
 
+// Drops the structures kept per world for vehicle routes (street index, validated route
+// pieces); the next route on a world builds them again. Routes do not depend on them.
+void clearRouteCaches();
+
 // True when the point is within `half_width` of some street centreline (the street surface
 // shrunk by the rest of the street half-width).
 bool onStreet(const scenario::World& world, const geometry::Vec2& p, double shrink = 0.0);

@@ -6,6 +6,7 @@
 // ORTHOGONAL_TO ~ 90 or 270. Line of sight runs between the two box centres and is blocked by
 // any other occluder (see occluderBoxes()).
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,12 @@ class RelationEvaluator {
   void removeOccluder(const std::string& id);
 
   RelationFacts measure(const Subject& target, const Subject& related) const;
+  // measure() for NEXT_TO, LEFT_OF and RIGHT_OF only: `over` is left false, and line of sight
+  // is only computed where one of them could hold (else false), so holds() gives the same
+  // answer for those three operators.
+  // `distance`: footprintDistance(target.box, related.box), when the caller has it.
+  RelationFacts measureSideways(const Subject& target, const Subject& related,
+                                std::optional<double> distance = std::nullopt) const;
   // True when `op` (not PART_OF) holds for these facts and the related class.
   bool holds(RelationOp op, const RelationFacts& f, EntityClass related_cls) const;
   // Line of sight between two box centres, ignoring the two subjects themselves.
@@ -64,6 +71,9 @@ class RelationEvaluator {
 
   // World entities whose footprint lies within the relation radius of the target's footprint.
   std::vector<int> nearbyWorld(const geometry::OrientedBox& target) const;
+  // nearbyWorld() with each entity's footprint distance to the target alongside.
+  std::vector<std::pair<int, double>> nearbyWorldDistances(
+      const geometry::OrientedBox& target) const;
 
   // Every true relation of the target at this instant against nearby world entities and the
   // given extra subjects (pedestrians, other scenario cars), and PART_OF its groups.
