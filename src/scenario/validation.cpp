@@ -564,7 +564,7 @@ class Semantics {
     if (!id || !cls || !seed || !isNonNegativeInteger(*seed)) return;
     const auto seed_value = integerAs<std::uint64_t>(*seed);
     if (!seed_value) {
-      add(jsonPointerAppend(path, "seed"), "scenario_id", "expected a seed below 2^64, got " + seed->dump());
+      add(path, "scenario_id", "expected a seed below 2^64, got " + seed->dump());
       return;
     }
     const std::string want = *cls + "-" + hex64(*seed_value);

@@ -13,20 +13,25 @@
 
 namespace {
 
-// A private directory for this process's files (removed at exit).
-const std::string& workDir() {
-  static const std::string dir = [] {
-    char tmpl[] = "/tmp/hameritt_mesh_fuzz_XXXXXX";
-    const char* d = mkdtemp(tmpl);
-    if (d == nullptr) std::abort();
+// A private directory for this process's files, removed at exit (a plain char array, so that
+// it outlives the static objects destroyed before the atexit handler runs).
+char g_dir[] = "/tmp/hameritt_mesh_fuzz_XXXXXX";
+
+std::string workDir() {
+  static const bool made = [] {
+    if (mkdtemp(g_dir) == nullptr) std::abort();
     std::atexit([] {
-      std::remove((workDir() + "/fuzz.obj").c_str());
-      std::remove((workDir() + "/fuzz.mtl").c_str());
-      rmdir(workDir().c_str());
+      for (const char* f : {"/fuzz.obj", "/fuzz.mtl"}) {
+        char path[sizeof(g_dir) + 16];
+        std::snprintf(path, sizeof(path), "%s%s", g_dir, f);
+        std::remove(path);
+      }
+      rmdir(g_dir);
     });
-    return std::string(d);
+    return true;
   }();
-  return dir;
+  (void)made;
+  return g_dir;
 }
 
 void writeFile(const std::string& path, const std::string& content) {

@@ -75,7 +75,7 @@ TEST(ReaderLimitsTest, StringOverloadsNameTheFile) {
 
 TEST(ReaderLimitsTest, ManifestSeedBeyond64BitsIsAnIssue) {
   const auto issues = validateText(regression("manifest", "seed_3.8735e83.json"));
-  EXPECT_TRUE(hasIssue(issues, "/scenarios/0/seed", "scenario_id")) << issues.size();
+  EXPECT_TRUE(hasIssue(issues, "/scenarios/0/id", "scenario_id")) << issues.size();
 }
 
 TEST(ReaderLimitsTest, PriorCellRow1e300IsOutsideTheGrid) {
