@@ -26,6 +26,16 @@ set +u
 source "$ASAN_BUILD_DIR/devel/setup.bash"
 set -u
 cd "$HAMERITT_ROOT"
+# True when the only report in the log is LeakSanitizer's and every leaked block was allocated
+# directly from an unloaded module: Mesa's driver is dlclosed when the EGL display is
+# terminated, so its leaks have no symbols and cannot be named in a suppression. Any test
+# failure, any other sanitizer report, or any leak with a named frame still fails.
+third_party_leaks_only() {
+  grep -q 'ERROR: LeakSanitizer' "$1" || return 1
+  grep -qE 'runtime error|ERROR: AddressSanitizer|\[  FAILED  \]' "$1" && return 1
+  # Frame #1 (the allocation's caller) of every leak.
+  ! grep -A2 -E '^(Direct|Indirect) leak of' "$1" | grep -E '^    #1 ' | grep -qv '(<unknown module>)'
+}
 passed=0
 failed=0
 for p in "${programs[@]}"; do
@@ -33,6 +43,10 @@ for p in "${programs[@]}"; do
   if "$ASAN_BUILD_DIR/devel/lib/hameritt/$p" >"$log" 2>&1; then
     passed=$((passed + 1))
     echo "ok   $p: $(grep -E '^\[  PASSED  \]' "$log" | tail -1)"
+  elif third_party_leaks_only "$log"; then
+    passed=$((passed + 1))
+    echo "ok   $p: $(grep -E '^\[  PASSED  \]' "$log" | tail -1); LeakSanitizer: only leaks" \
+      "allocated from an unloaded module (Mesa's EGL/DRI driver, dlclosed at eglTerminate)"
   else
     failed=$((failed + 1))
     echo "FAIL $p (log: $log)"
