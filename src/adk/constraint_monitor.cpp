@@ -5,6 +5,7 @@
 #include <limits>
 #include <tuple>
 
+#include "hameritt/geometry/segment.h"
 #include "hameritt/scenario/error.h"
 
 namespace hameritt::adk {
@@ -130,6 +131,15 @@ std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon, con
     const double flen = f.norm();
     if (flen == 0.0) continue;
     const Vec2 w = c - a;
+    // A vertex on the segment is a breakpoint whatever the angle of its edges: for an edge
+    // almost parallel to the segment the line intersection below is ill-conditioned and may
+    // miss it, and the walk would then carry "inside" past the vertex (a sliver zone crossed
+    // along an edge; found by test_geometry_oracle.py against Shapely).
+    const double vertex_scale =
+        std::max({1.0, std::fabs(a.x()), std::fabs(a.y()), std::fabs(c.x()), std::fabs(c.y())});
+    if (geometry::pointSegmentDistance(c, a, b) <= geometry::kEpsilon * vertex_scale) {
+      breaks.push_back({clamp01(w.dot(d) / dd), true});
+    }
     const double denom = cross2(d, f);
     if (std::fabs(denom) > 1e-12 * len * flen) {
       const double u = cross2(w, f) / denom;  // along the segment

@@ -4,7 +4,8 @@
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 #include <unordered_map>
 
 #include "hameritt/scenario/trajectory.h"
@@ -204,73 +205,24 @@ void Scene::loadLods(const std::string& dir,
   const std::string path = dir + "lod.json";
   std::ifstream in(path);
   if (!in) return;  // no coarse meshes: every instance is drawn in full
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    throw RenderError(path + ": not valid JSON: " + e.what());
+  std::stringstream text;
+  text << in.rdbuf();
+  std::set<std::string> class_meshes;
+  for (const auto& [file, m] : file_model) {
+    const std::string name = file.substr(0, file.size() - 4);  // without ".obj"
+    if (name != "sentinel") class_meshes.insert(name);
   }
-  auto fail = [&path](const std::string& field, const std::string& expected) {
-    throw RenderError(path + ": " + field + ": expected " + expected);
-  };
-  if (!doc.is_object() || doc.value("schema", "") != "hameritt_mesh_lod") {
-    fail("schema", "\"hameritt_mesh_lod\"");
-  }
-  if (!doc.contains("schema_version") || doc["schema_version"] != 2) fail("schema_version", "2");
-  if (!doc.contains("meshes") || !doc["meshes"].is_array()) fail("meshes", "an array");
-  const auto& meshes = doc["meshes"];
-  for (std::size_t i = 0; i < meshes.size(); ++i) {
-    const auto& e = meshes[i];
-    const std::string at = "meshes[" + std::to_string(i) + "]";
-    if (!e.is_object()) fail(at, "an object");
-    if (!e.contains("mesh") || !e["mesh"].is_string()) fail(at + ".mesh", "a class mesh name");
-    const std::string name = e["mesh"].get<std::string>();
-    const auto it = file_model.find(name + ".obj");
-    if (it == file_model.end() || name == "sentinel") {
-      fail(at + ".mesh", "a class mesh name (house_1, car_sedan, ...), got '" + name + "'");
-    }
-    const int fine = it->second;
-    if (!lods_[static_cast<std::size_t>(fine)].empty()) fail(at + ".mesh", "each mesh once");
-    const auto& size = e.contains("design_size_m") ? e["design_size_m"] : nlohmann::json();
-    bool size_ok = size.is_array() && size.size() == 3;
-    for (std::size_t a = 0; size_ok && a < 3; ++a) {
-      size_ok = size[a].is_number() && std::isfinite(size[a].get<double>()) &&
-                size[a].get<double>() > 0;
-    }
-    if (!size_ok) fail(at + ".design_size_m", "three numbers > 0 (metres)");
-    if (!e.contains("levels") || !e["levels"].is_array() || e["levels"].empty() ||
-        e["levels"].size() > static_cast<std::size_t>(kMaxLodLevels)) {
-      fail(at + ".levels", "an array of 1 to " + std::to_string(kMaxLodLevels) + " levels");
-    }
-    double previous = -1.0;
+  for (const LodManifestEntry& e : parseLodManifest(text.str(), path, dir, class_meshes)) {
+    const int fine = file_model.at(e.mesh + ".obj");
     std::vector<LodLevel> levels;
-    for (std::size_t l = 0; l < e["levels"].size(); ++l) {
-      const auto& level = e["levels"][l];
-      const std::string lat = at + ".levels[" + std::to_string(l) + "]";
-      if (!level.is_object()) fail(lat, "an object");
-      if (!level.contains("file") || !level["file"].is_string() ||
-          level["file"].get<std::string>().empty() ||
-          level["file"].get<std::string>().find('/') != std::string::npos) {
-        fail(lat + ".file", "an OBJ file name in " + dir);
-      }
-      if (!level.contains("max_deviation_m") || !level["max_deviation_m"].is_number() ||
-          !std::isfinite(level["max_deviation_m"].get<double>()) ||
-          level["max_deviation_m"].get<double>() < 0) {
-        fail(lat + ".max_deviation_m", "a finite number >= 0 (metres)");
-      }
-      const double dev = level["max_deviation_m"].get<double>();
-      if (dev <= previous) {
-        fail(lat + ".max_deviation_m", "more than the previous level's (levels go from fine to coarse)");
-      }
-      previous = dev;
-      Mesh coarse = loadObjMesh(dir + level["file"].get<std::string>(), true);
+    for (const LodFileLevel& lf : e.levels) {
+      Mesh coarse = loadObjMesh(dir + lf.file, true);
       // The canopy of every level is scaled about the same point.
       coarse.canopy_center = models_[static_cast<std::size_t>(fine)].canopy_center;
       LodLevel level_of;
       level_of.model = addModel(std::move(coarse));
       for (int a = 0; a < 3; ++a) {
-        level_of.axis_error[a] =
-            static_cast<float>(dev / size[static_cast<std::size_t>(a)].get<double>());
+        level_of.axis_error[a] = static_cast<float>(lf.max_deviation_m / e.design_size_m[a]);
       }
       levels.push_back(level_of);
     }

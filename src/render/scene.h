@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "hameritt/render/renderer.h"
+#include "lod_manifest.h"
 #include "mesh.h"
 
 namespace hameritt::render {
@@ -23,8 +24,6 @@ struct InstanceRecord {
   float canopy = 1.0f;      // canopy scale about the mesh's canopy centre
 };
 
-// Coarser versions of a class mesh (models/meshes/lod.json) the renderer may draw instead.
-constexpr int kMaxLodLevels = 4;
 
 // One drawn object.
 struct SceneInstance {

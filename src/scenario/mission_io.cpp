@@ -74,10 +74,11 @@ Attributes attributes(Obj& o, const std::string& key) {
   for (auto it = a.begin(); it != a.end(); ++it) {
     if (it->is_string()) {
       out.set(it.key(), it->get<std::string>());
-    } else if (it->is_number_integer()) {
+    } else if (strict_json::isInt64(*it)) {
       out.set(it.key(), it->get<std::int64_t>());
     } else {
-      o.fail(o.at(key + "." + it.key()), "expected a string or an integer", *it);
+      o.fail(o.at(key + "." + it.key()),
+             "expected a string or an integer within [-2^63, 2^63)", *it);
     }
   }
   return out;
@@ -288,6 +289,10 @@ Mission missionFromJson(const json& j, const std::string& file) {
   }
   root.finish();
   return m;
+}
+
+Mission parseMission(const std::string& text, const std::string& file) {
+  return missionFromJson(strict_json::parseText(text, file), file);
 }
 
 Mission loadMission(const std::string& path) {

@@ -313,14 +313,20 @@ void GeneratorConfig::validate() const {
   }
 }
 
+json parseJsonString(const std::string& text, const std::string& file) {
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw ConfigError(file + ": malformed JSON: " + e.what());
+  }
+}
+
 json readJsonFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open file");
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw ConfigError(path + ": malformed JSON: " + e.what());
-  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseJsonString(text.str(), path);
 }
 
 WorldParams loadWorldParams(const std::string& path) {

@@ -101,10 +101,11 @@ ScenarioEntity readEntity(const json& j, const std::string& path, const std::str
     for (auto it = a.begin(); it != a.end(); ++it) {
       if (it->is_string()) {
         e.attributes.set(it.key(), it->get<std::string>());
-      } else if (it->is_number_integer()) {
+      } else if (strict_json::isInt64(*it)) {
         e.attributes.set(it.key(), it->get<std::int64_t>());
       } else {
-        o.fail(o.at("attributes." + it.key()), "expected a string or an integer", *it);
+        o.fail(o.at("attributes." + it.key()),
+               "expected a string or an integer within [-2^63, 2^63)", *it);
       }
     }
   }
@@ -280,6 +281,10 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
   }
   root.finish();
   return s;
+}
+
+SimConfig parseSimConfig(const std::string& text, const std::string& file) {
+  return simConfigFromJson(strict_json::parseText(text, file), file);
 }
 
 SimConfig loadSimConfig(const std::string& path) {

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -24,20 +25,35 @@ using json = nlohmann::ordered_json;
 // A double with all its digits, for messages.
 inline std::string fmt(double v) { return formatNumber(v); }
 
+// An integer that std::int64_t holds (JSON integers above 2^63 - 1 would wrap around).
+inline bool isInt64(const json& v) {
+  return v.is_number_integer() &&
+         !(v.is_number_unsigned() &&
+           v.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX));
+}
+
 // "path[i]".
 inline std::string idx(const std::string& path, std::size_t i) {
   return path + "[" + std::to_string(i) + "]";
+}
+
+// Parses a whole document text, keeping key order (ConfigError on syntax errors, with `file`).
+inline json parseText(const std::string& text, const std::string& file) {
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw ConfigError(file + ": malformed JSON: " + e.what());
+  }
 }
 
 // Parses a whole file, keeping key order (ConfigError on I/O or syntax errors, with the file).
 inline json parseFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ConfigError(path + ": cannot open file");
-  try {
-    return json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw ConfigError(path + ": malformed JSON: " + e.what());
-  }
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(path + ": cannot read file");
+  return parseText(text.str(), path);
 }
 
 // A JSON object being read strictly.
@@ -81,7 +97,7 @@ class Object {
   }
   std::int64_t integer(const std::string& key) {
     const json& v = get(key);
-    if (!v.is_number_integer()) fail(at(key), "expected an integer", v);
+    if (!isInt64(v)) fail(at(key), "expected an integer within [-2^63, 2^63)", v);
     return v.get<std::int64_t>();
   }
   std::uint64_t unsignedInteger(const std::string& key) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -98,6 +99,33 @@ std::size_t codePoints(const std::string& s) {
 
 bool isNonNegativeInteger(const json& v) { return isInteger(v) && v.get<double>() >= 0; }
 
+// v as a T when it is an integer (integer-valued floats included) that T holds exactly;
+// nullopt otherwise (a fraction, 1e300, 2^64, or a negative for an unsigned T). Converting an
+// out-of-range double is undefined behaviour, so every integer read goes through here.
+template <typename T>
+std::optional<T> integerAs(const json& v) {
+  using Limits = std::numeric_limits<T>;
+  if (v.is_number_unsigned()) {
+    const auto u = v.get<std::uint64_t>();
+    if (u > static_cast<std::uint64_t>(Limits::max())) return std::nullopt;
+    return static_cast<T>(u);
+  }
+  if (v.is_number_integer()) {
+    const auto i = v.get<std::int64_t>();
+    if (i < 0 && !Limits::is_signed) return std::nullopt;
+    if (Limits::is_signed && (i < static_cast<std::int64_t>(Limits::min()) ||
+                              i > static_cast<std::int64_t>(Limits::max()))) {
+      return std::nullopt;
+    }
+    return static_cast<T>(i);
+  }
+  if (!isInteger(v)) return std::nullopt;
+  const double d = v.get<double>();
+  const double limit = std::ldexp(1.0, Limits::digits);  // 2^bits: the first value T lacks
+  if (d >= limit || d < (Limits::is_signed ? -limit : 0.0)) return std::nullopt;
+  return static_cast<T>(d);
+}
+
 }  // namespace
 
 std::string jsonPointerAppend(const std::string& pointer, const std::string& token) {
@@ -178,7 +206,7 @@ void JsonSchema::compile(const json& s, const std::string& spath) {
       if (v.is_array()) fail(at, "an array of schemas (tuple validation) is not supported");
       compile(v, at);
     } else if (k == "minItems" || k == "maxItems" || k == "minLength" || k == "maxLength") {
-      if (!isNonNegativeInteger(v)) fail(at, "expected a non-negative integer");
+      if (!integerAs<std::size_t>(v)) fail(at, "expected a non-negative integer below 2^64");
     } else if (k == "uniqueItems") {
       if (!v.is_boolean()) fail(at, "expected a boolean");
     } else if (k == "minimum" || k == "maximum" || k == "exclusiveMinimum" ||
@@ -284,10 +312,10 @@ void JsonSchema::check(const json& doc, const json& s, const std::string& path, 
   if (doc.is_string()) {
     const std::string& str = doc.get_ref<const std::string&>();
     const std::size_t n = codePoints(str);
-    if (auto m = s.find("minLength"); m != s.end() && n < m->get<std::size_t>()) {
+    if (auto m = s.find("minLength"); m != s.end() && n < *integerAs<std::size_t>(*m)) {
       issue(path, "minLength", "expected at least " + m->dump() + " characters, got " + brief(doc));
     }
-    if (auto m = s.find("maxLength"); m != s.end() && n > m->get<std::size_t>()) {
+    if (auto m = s.find("maxLength"); m != s.end() && n > *integerAs<std::size_t>(*m)) {
       issue(path, "maxLength", "expected at most " + m->dump() + " characters, got " + brief(doc));
     }
     if (auto p = s.find("pattern"); p != s.end()) {
@@ -298,11 +326,11 @@ void JsonSchema::check(const json& doc, const json& s, const std::string& path, 
     }
   }
   if (doc.is_array()) {
-    if (auto m = s.find("minItems"); m != s.end() && doc.size() < m->get<std::size_t>()) {
+    if (auto m = s.find("minItems"); m != s.end() && doc.size() < *integerAs<std::size_t>(*m)) {
       issue(path, "minItems",
             "expected at least " + m->dump() + " items, got " + std::to_string(doc.size()));
     }
-    if (auto m = s.find("maxItems"); m != s.end() && doc.size() > m->get<std::size_t>()) {
+    if (auto m = s.find("maxItems"); m != s.end() && doc.size() > *integerAs<std::size_t>(*m)) {
       issue(path, "maxItems",
             "expected at most " + m->dump() + " items, got " + std::to_string(doc.size()));
     }
@@ -534,7 +562,12 @@ class Semantics {
     const auto cls = stringAt(entry, "class");
     const json* seed = member(entry, "seed");
     if (!id || !cls || !seed || !isNonNegativeInteger(*seed)) return;
-    const std::string want = *cls + "-" + hex64(seed->get<std::uint64_t>());
+    const auto seed_value = integerAs<std::uint64_t>(*seed);
+    if (!seed_value) {
+      add(path, "scenario_id", "expected a seed below 2^64, got " + seed->dump());
+      return;
+    }
+    const std::string want = *cls + "-" + hex64(*seed_value);
     if (*id != want) {
       add(path, "scenario_id",
           "expected '" + want + "' for class " + *cls + " and seed " + seed->dump() + ", got '" +
@@ -657,8 +690,13 @@ class Semantics {
         cell_ids.note(cell, cp);
         const json* row = member(cell, "row");
         const json* col = member(cell, "col");
-        if (row && col && isInteger(*row) && isInteger(*col)) {
-          const long r = row->get<long>(), k = col->get<long>();
+        const auto row_value = row ? integerAs<long>(*row) : std::nullopt;
+        const auto col_value = col ? integerAs<long>(*col) : std::nullopt;
+        if (row && col && isInteger(*row) && isInteger(*col) && !(row_value && col_value)) {
+          add(cp, "prior_cells", "row " + row->dump() + ", col " + col->dump() +
+                                     " lies outside the grid");
+        } else if (row_value && col_value) {
+          const long r = *row_value, k = *col_value;
           if (n > 0 && (r < 0 || r >= n || k < 0 || k >= n)) {
             add(cp, "prior_cells",
                 "row " + std::to_string(r) + ", col " + std::to_string(k) + " lies outside the " +

@@ -20,4 +20,7 @@ Mission missionFromJson(const nlohmann::ordered_json& j, const std::string& file
 // Reads and parses a mission.json file (ConfigError on I/O or syntax errors, with the file).
 Mission loadMission(const std::string& path);
 
+// The same from the document's text; `file` names it in messages.
+Mission parseMission(const std::string& text, const std::string& file);
+
 }  // namespace hameritt::scenario

@@ -21,5 +21,7 @@ GeneratorConfig generatorConfigFromJson(const nlohmann::json& j, const std::stri
 void writeGeneratorConfig(JsonWriter& w, const GeneratorConfig& c);
 // Parses a JSON file; a syntax error is a ConfigError with the file, line and column.
 nlohmann::json readJsonFile(const std::string& path);
+// Parses a JSON text; a syntax error is a ConfigError naming `file`, the line and column.
+nlohmann::json parseJsonString(const std::string& text, const std::string& file);
 
 }  // namespace hameritt::scenario

@@ -23,6 +23,9 @@ SimConfig simConfigFromJson(const nlohmann::json& j, const std::string& file);
 // keeping key order.
 SimConfig loadSimConfig(const std::string& path);
 
+// The same from the document's text; `file` names it in messages.
+SimConfig parseSimConfig(const std::string& text, const std::string& file);
+
 // Regenerates the neighborhood from the sim_config's world parameters and checks it against the
 // recorded fingerprint (ConfigError naming `file` and world.fingerprint on a mismatch).
 World generateCheckedWorld(const SimConfig& config, const std::string& file);
