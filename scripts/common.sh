@@ -31,10 +31,13 @@ HAMERITT_PACKAGES=(
   # Renderer: GL and EGL through glvnd, Mesa's EGL and llvmpipe for machines without a GPU,
   # assimp for the meshes.
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev
-  # hameritt_campaign: its YAML config, and the single-node Slurm cluster of its test.
-  python3-yaml slurm-wlm munge
-  # Dataset export (hameritt_export): the rosbag C++ API; its test reads PNGs with OpenCV.
-  librosbag-storage-dev python3-opencv python3-numpy python3-yaml
+  # hameritt_campaign: its YAML config (python3-yaml, above), and the single-node Slurm cluster
+  # of its test.
+  slurm-wlm munge
+  # Dataset export (hameritt_export): the rosbag C++ API (its test reads PNGs with OpenCV, above).
+  librosbag-storage-dev
+  # Reliability: libFuzzer targets with clang (ASan/UBSan), the Shapely geometry oracle.
+  clang-14 libfuzzer-14-dev python3-shapely
 )
 
 install_deps() {
