@@ -37,7 +37,7 @@ HAMERITT_PACKAGES=(
   # Dataset export (hameritt_export): the rosbag C++ API (its test reads PNGs with OpenCV, above).
   librosbag-storage-dev
   # Reliability: libFuzzer targets with clang (ASan/UBSan), the Shapely geometry oracle.
-  clang-14 libfuzzer-14-dev python3-shapely
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-shapely
 )
 
 install_deps() {
