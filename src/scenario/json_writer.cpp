@@ -3,14 +3,23 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace hameritt::scenario {
 
 void JsonWriter::newline() {
   if (!pretty_ || inline_depth_ > 0) return;
-  out_ += '\n';
-  out_.append(2 * has_items_.size(), ' ');
+  // A newline and the indent copied from one constant (cheaper than filling with spaces).
+  static constexpr std::string_view kIndent =
+      "\n                                                                ";
+  const std::size_t n = 1 + 2 * has_items_.size();
+  if (n <= kIndent.size()) {
+    out_.append(kIndent.data(), n);
+  } else {
+    out_ += '\n';
+    out_.append(n - 1, ' ');
+  }
 }
 
 void JsonWriter::separate() {
@@ -115,6 +124,12 @@ JsonWriter& JsonWriter::value(std::string_view s) {
 
 namespace {
 
+// "00" "01" ... "99".
+constexpr char kDigitPairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
 // Writes a finite number at p (room for 40 characters); returns the end.
 char* writeNumber(double d, char* p) {
   if (d == 0.0) d = 0.0;  // no "-0"
@@ -132,15 +147,33 @@ char* writeNumber(double d, char* p) {
     if (static_cast<double>(k) / 1000.0 == d) {
       unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
       if (k < 0) *p++ = '-';
-      const unsigned long long whole = a / 1000, frac = a % 1000;
-      p = std::to_chars(p, end, whole).ptr;
+      // All digits of a (at least four), two at a time from a table, then the whole part,
+      // the point and the fraction without its trailing zeros. Copies have fixed sizes
+      // (inlined); bytes past the number are overwritten later or lie past the returned end.
+      const unsigned frac = static_cast<unsigned>(a % 1000);
+      char tmp[64];
+      char* const tend = tmp + 40;
+      char* q = tend;
+      while (a >= 100) {
+        const unsigned r = static_cast<unsigned>(a % 100);
+        a /= 100;
+        q -= 2;
+        std::memcpy(q, kDigitPairs + 2 * r, 2);
+      }
+      if (a >= 10) {
+        q -= 2;
+        std::memcpy(q, kDigitPairs + 2 * a, 2);
+      } else {
+        *--q = static_cast<char>('0' + a);
+      }
+      while (tend - q < 4) *--q = '0';
+      const std::size_t whole_len = static_cast<std::size_t>(tend - q) - 3;  // at most 12
+      std::memcpy(p, q, 16);
+      p += whole_len;
       if (frac != 0) {
-        *p++ = '.';
-        char digits[3] = {static_cast<char>('0' + frac / 100), static_cast<char>('0' + frac / 10 % 10),
-                          static_cast<char>('0' + frac % 10)};
-        int n = 3;
-        while (digits[n - 1] == '0') --n;
-        for (int i = 0; i < n; ++i) *p++ = digits[i];
+        *p = '.';
+        std::memcpy(p + 1, tend - 3, 4);
+        p += frac % 100 == 0 ? 2 : frac % 10 == 0 ? 3 : 4;
       }
       return p;
     }
