@@ -130,6 +130,26 @@ constexpr char kDigitPairs[] =
     "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
     "8081828384858687888990919293949596979899";
 
+// Writes a's decimal digits just before end, two at a time; returns where they start. (Called
+// with 32-bit values where they fit: their division by 100 is cheaper.)
+template <typename U>
+char* digitsBefore(U a, char* end) {
+  char* q = end;
+  while (a >= 100) {
+    const unsigned r = static_cast<unsigned>(a % 100);
+    a /= 100;
+    q -= 2;
+    std::memcpy(q, kDigitPairs + 2 * r, 2);
+  }
+  if (a >= 10) {
+    q -= 2;
+    std::memcpy(q, kDigitPairs + 2 * a, 2);
+  } else {
+    *--q = static_cast<char>('0' + a);
+  }
+  return q;
+}
+
 // Writes a finite number at p (room for 40 characters); returns the end.
 char* writeNumber(double d, char* p) {
   if (d == 0.0) d = 0.0;  // no "-0"
@@ -153,19 +173,8 @@ char* writeNumber(double d, char* p) {
       const unsigned frac = static_cast<unsigned>(a % 1000);
       char tmp[64];
       char* const tend = tmp + 40;
-      char* q = tend;
-      while (a >= 100) {
-        const unsigned r = static_cast<unsigned>(a % 100);
-        a /= 100;
-        q -= 2;
-        std::memcpy(q, kDigitPairs + 2 * r, 2);
-      }
-      if (a >= 10) {
-        q -= 2;
-        std::memcpy(q, kDigitPairs + 2 * a, 2);
-      } else {
-        *--q = static_cast<char>('0' + a);
-      }
+      char* q = a <= 0xffffffffULL ? digitsBefore(static_cast<std::uint32_t>(a), tend)
+                                   : digitsBefore(a, tend);
       while (tend - q < 4) *--q = '0';
       const std::size_t whole_len = static_cast<std::size_t>(tend - q) - 3;  // at most 12
       std::memcpy(p, q, 16);
