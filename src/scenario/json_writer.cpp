@@ -8,14 +8,26 @@
 
 namespace hameritt::scenario {
 
+namespace {
+
+// A comma, a newline and an indent of up to 64 spaces: separators are appended from it at once.
+constexpr std::string_view kCommaIndent =
+    ",\n                                                                ";
+
+// True when s needs no escaping.
+bool plainText(std::string_view s) {
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && c != '"' && c != '\\';
+  });
+}
+
+}  // namespace
+
 void JsonWriter::newline() {
   if (!pretty_ || inline_depth_ > 0) return;
-  // A newline and the indent copied from one constant (cheaper than filling with spaces).
-  static constexpr std::string_view kIndent =
-      "\n                                                                ";
   const std::size_t n = 1 + 2 * has_items_.size();
-  if (n <= kIndent.size()) {
-    out_.append(kIndent.data(), n);
+  if (n + 1 <= kCommaIndent.size()) {
+    out_.append(kCommaIndent.data() + 1, n);
   } else {
     out_ += '\n';
     out_.append(n - 1, ' ');
@@ -28,11 +40,18 @@ void JsonWriter::separate() {
     return;
   }
   if (!has_items_.empty()) {
-    if (has_items_.back()) {
+    const bool had = has_items_.back();
+    has_items_.back() = true;
+    const std::size_t n = 2 + 2 * has_items_.size();  // comma, newline, indent
+    if (pretty_ && inline_depth_ == 0 && n <= kCommaIndent.size()) {
+      // The comma (if any), the newline and the indent in one append.
+      out_.append(kCommaIndent.data() + (had ? 0 : 1), had ? n : n - 1);
+      return;
+    }
+    if (had) {
       out_ += ',';
       if (inline_depth_ > 0 && pretty_) out_ += ' ';
     }
-    has_items_.back() = true;
     newline();
   }
 }
@@ -69,19 +88,29 @@ JsonWriter& JsonWriter::endArray() {
 
 JsonWriter& JsonWriter::key(std::string_view k) {
   separate();
+  after_key_ = true;
+  char buf[96];
+  if (k.size() + 4 <= sizeof(buf) && plainText(k)) {
+    // The quoted key and the colon in one append.
+    std::size_t n = 0;
+    buf[n++] = '"';
+    std::memcpy(buf + n, k.data(), k.size());
+    n += k.size();
+    buf[n++] = '"';
+    buf[n++] = ':';
+    if (pretty_) buf[n++] = ' ';
+    out_.append(buf, n);
+    return *this;
+  }
   escape(k);
   out_ += pretty_ ? ": " : ":";
-  after_key_ = true;
   return *this;
 }
 
 void JsonWriter::escape(std::string_view s) {
   out_ += '"';
   // Plain text (the usual case: ids, keys, names) is copied at once.
-  const bool plain = std::all_of(s.begin(), s.end(), [](char c) {
-    return static_cast<unsigned char>(c) >= 0x20 && c != '"' && c != '\\';
-  });
-  if (plain) {
+  if (plainText(s)) {
     out_.append(s);
     out_ += '"';
     return;
