@@ -147,6 +147,15 @@ void JsonWriter::escape(std::string_view s) {
 
 JsonWriter& JsonWriter::value(std::string_view s) {
   separate();
+  char buf[96];
+  if (s.size() + 2 <= sizeof(buf) && plainText(s)) {
+    // A short plain string with its quotes in one append.
+    buf[0] = '"';
+    std::memcpy(buf + 1, s.data(), s.size());
+    buf[s.size() + 1] = '"';
+    out_.append(buf, s.size() + 2);
+    return *this;
+  }
   escape(s);
   return *this;
 }
@@ -260,7 +269,6 @@ JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
     if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   }
   separate();
-  const std::string_view sep = pretty_ ? ", " : ",";
   char buf[512];
   std::size_t k = 0;
   buf[k++] = '[';
@@ -270,7 +278,8 @@ JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
       k = 0;
     }
     if (d != v.begin()) {
-      for (char c : sep) buf[k++] = c;
+      buf[k++] = ',';
+      if (pretty_) buf[k++] = ' ';
     }
     k = static_cast<std::size_t>(writeNumber(*d, buf + k) - buf);
   }
