@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 
 namespace hameritt::geometry {
 
@@ -16,29 +15,37 @@ double boxTolerance(const OrientedBox& b) {
   return kEpsilon * std::max({1.0, b.center.cwiseAbs().maxCoeff(), b.size.cwiseAbs().maxCoeff()});
 }
 
-// Cosine and sine of a yaw, remembered for the last yaw seen on this thread: the same box is
-// often asked many times in a row (its corners, then points and segments against it). The
-// values are those std::cos and std::sin return; the yaw is compared by its bits, so -0 and
-// +0 are kept apart.
+// Cosine and sine of a yaw, remembered for the last two yaws seen on this thread: the same
+// boxes are often asked many times in a row (a box's corners, then points and segments
+// against it; pairs of boxes in footprintDistance). The values are those std::cos and
+// std::sin return; yaws are compared by their bits, so -0 and +0 are kept apart.
 struct YawTrig {
-  std::uint64_t bits;
-  double c, s;
+  std::uint64_t bits[2];
+  double c[2], s[2];
+  int next;  // the entry to replace on a miss
 };
+// Starts with yaw +0 in both entries: cos(+0) = 1 and sin(+0) = +0 exactly.
 __attribute__((tls_model("initial-exec"))) thread_local YawTrig t_last_yaw = {
-    0x7ff8dead00000000ULL, std::numeric_limits<double>::quiet_NaN(),
-    std::numeric_limits<double>::quiet_NaN()};
+    {0, 0}, {1.0, 1.0}, {0.0, 0.0}, 0};
 
 inline void cosSin(double yaw, double* c, double* s) {
   std::uint64_t bits;
   std::memcpy(&bits, &yaw, sizeof(bits));
   YawTrig& last = t_last_yaw;
-  if (bits != last.bits) {
-    last.c = std::cos(yaw);
-    last.s = std::sin(yaw);
-    last.bits = bits;
+  int i;
+  if (bits == last.bits[0]) {
+    i = 0;
+  } else if (bits == last.bits[1]) {
+    i = 1;
+  } else {
+    i = last.next;
+    last.next = 1 - i;
+    last.c[i] = std::cos(yaw);
+    last.s[i] = std::sin(yaw);
+    last.bits[i] = bits;
   }
-  *c = last.c;
-  *s = last.s;
+  *c = last.c[i];
+  *s = last.s[i];
 }
 
 }  // namespace
