@@ -55,8 +55,8 @@ std::array<Vec2, 4> OrientedBox::corners2() const {
   const double hw = 0.5 * size.y();
   double cy, sy;
   cosSin(yaw, &cy, &sy);
-  const Vec2 u(cy, sy);  // body x in the world
-  const Vec2 v(-u.y(), u.x());                 // body y in the world
+  const Vec2 u(cy, sy);         // body x in the world
+  const Vec2 v(-u.y(), u.x());  // body y in the world
   const Vec2 c = center2();
   return {c - hl * u - hw * v, c + hl * u - hw * v, c + hl * u + hw * v, c - hl * u + hw * v};
 }
