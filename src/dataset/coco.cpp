@@ -144,7 +144,7 @@ std::string cocoJson(const std::vector<const FrameRecord*>& frames,
   }
   w.endArray();
   w.endObject();
-  return w.str();
+  return w.take();
 }
 
 std::string yoloDataYaml(const std::vector<std::string>& splits,

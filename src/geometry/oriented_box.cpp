@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace hameritt::geometry {
 
@@ -13,13 +15,48 @@ double boxTolerance(const OrientedBox& b) {
   return kEpsilon * std::max({1.0, b.center.cwiseAbs().maxCoeff(), b.size.cwiseAbs().maxCoeff()});
 }
 
+// Cosine and sine of a yaw, remembered for the last two yaws seen on this thread: the same
+// boxes are often asked many times in a row (a box's corners, then points and segments
+// against it; pairs of boxes in footprintDistance). The values are those std::cos and
+// std::sin return; yaws are compared by their bits, so -0 and +0 are kept apart.
+struct YawTrig {
+  std::uint64_t bits[2];
+  double c[2], s[2];
+  int next;  // the entry to replace on a miss
+};
+// Starts with yaw +0 in both entries: cos(+0) = 1 and sin(+0) = +0 exactly.
+__attribute__((tls_model("initial-exec"))) thread_local YawTrig t_last_yaw = {
+    {0, 0}, {1.0, 1.0}, {0.0, 0.0}, 0};
+
+inline void cosSin(double yaw, double* c, double* s) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &yaw, sizeof(bits));
+  YawTrig& last = t_last_yaw;
+  int i;
+  if (bits == last.bits[0]) {
+    i = 0;
+  } else if (bits == last.bits[1]) {
+    i = 1;
+  } else {
+    i = last.next;
+    last.next = 1 - i;
+    last.c[i] = std::cos(yaw);
+    last.s[i] = std::sin(yaw);
+    last.bits[i] = bits;
+  }
+  *c = last.c[i];
+  *s = last.s[i];
+}
+
 }  // namespace
 
 std::array<Vec2, 4> OrientedBox::corners2() const {
   const double hl = 0.5 * size.x();
   const double hw = 0.5 * size.y();
-  const Vec2 u(std::cos(yaw), std::sin(yaw));  // body x in the world
-  const Vec2 v(-u.y(), u.x());                 // body y in the world
+  double cy, sy;
+  cosSin(yaw, &cy, &sy);
+  const Vec2 u(cy, sy);         // body x in the world
+  const Vec2 v(-u.y(), u.x());  // body y in the world
   const Vec2 c = center2();
   return {c - hl * u - hw * v, c + hl * u - hw * v, c + hl * u + hw * v, c - hl * u + hw * v};
 }
@@ -41,8 +78,8 @@ Aabb2 OrientedBox::bounds2() const {
 
 Vec3 OrientedBox::toBody(const Vec3& p) const {
   const Vec3 d = p - center;
-  const double cy = std::cos(yaw);
-  const double sy = std::sin(yaw);
+  double cy, sy;
+  cosSin(yaw, &cy, &sy);
   return Vec3(cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z());
 }
 
@@ -57,8 +94,8 @@ bool OrientedBox::contains(const Vec3& p) const {
 bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b) const {
   if (!a.allFinite() || !b.allFinite()) return false;
   // toBody() for both ends, with one sine and cosine.
-  const double cy = std::cos(yaw);
-  const double sy = std::sin(yaw);
+  double cy, sy;
+  cosSin(yaw, &cy, &sy);
   auto body = [&](const Vec3& w) {
     const Vec3 q = w - center;
     return Vec3(cy * q.x() + sy * q.y(), -sy * q.x() + cy * q.y(), q.z());

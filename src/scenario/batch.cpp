@@ -68,7 +68,7 @@ std::string manifestJson(const World& world, const BatchRequest& req,
   }
   w.endArray();
   w.endObject();
-  return w.str();
+  return w.take();
 }
 
 }  // namespace

@@ -89,7 +89,20 @@ geometry::OrientedBox boxFromPose(const geometry::Vec3& bottom_center, double ya
 }
 
 double roundMilli(double v) {
-  const double r = std::round(v * 1000.0) / 1000.0;
+  // std::round inline where it is exact: below 2^52, x - trunc(x) has no rounding error, so
+  // comparing it with +-0.5 rounds half away from zero as std::round does. (A zero's sign may
+  // differ from std::round's; zeros are returned as +0 below.)
+  const double x = v * 1000.0;
+  double n;
+  if (std::abs(x) < 4503599627370496.0) {
+    n = static_cast<double>(static_cast<long long>(x));
+    const double rest = x - n;
+    if (rest >= 0.5) n += 1.0;
+    if (rest <= -0.5) n -= 1.0;
+  } else {
+    n = std::round(x);
+  }
+  const double r = n / 1000.0;
   return r == 0.0 ? 0.0 : r;  // no negative zero in the output
 }
 

@@ -412,38 +412,46 @@ class ScenarioBuilder {
     const double dt = cfg_.relations.eventually_dt;
     const double end = traj.back().t;
     const std::vector<Subject> parked = parkedSubjects(target.id);
+    // Entities whose three sideways operators are all seen: skipped without building keys.
+    std::vector<char> world_done(world_.entities().size(), 0), parked_done(parked.size(), 0);
     for (int k = 1; k * dt <= end && static_cast<int>(out.size()) < want; ++k) {
       const double t = k * dt;
       Subject s = subjectOf(target);
       s.box = poseBox(target.box, sampleTrajectory(traj, t));
       constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf,
                                      RelationOp::kRightOf};
+      // Returns true when all three operators are now seen with rel: then it never needs to
+      // be considered again (seen only grows), which the callers remember by index.
       auto consider = [&](const Subject& rel, double distance) {
         std::string keys[3];
-        bool open = false;  // some operator not yet seen with this entity
+        bool has[3];
         for (int j = 0; j < 3; ++j) {
           keys[j] = rel.id + toString(kOps[j]);
-          open = open || !seen.count(keys[j]);
+          has[j] = seen.count(keys[j]) != 0;
         }
-        if (!open) return;
+        if (has[0] && has[1] && has[2]) return true;
         const RelationFacts f = eval_.measureSideways(s, rel, distance);
         for (int j = 0; j < 3; ++j) {
           const RelationOp op = kOps[j];
-          const std::string& key = keys[j];
-          if (seen.count(key) || !eval_.holds(op, f, rel.cls)) continue;
-          seen.insert(key);
+          if (has[j] || !eval_.holds(op, f, rel.cls)) continue;
+          seen.insert(keys[j]);
+          has[j] = true;
           if (rel.cls == EntityClass::kStreet || rel.cls == EntityClass::kFence) continue;
           SceneRelation r = makeRelation(s, rel, op, f);
           r.eventually = true;
           r.time = t;
           out.push_back(r);
         }
+        return has[0] && has[1] && has[2];
       };
-      for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box))
-        consider(worldSubject(world_, i), d);
-      for (const auto& p : parked) {
-        const double d = geometry::footprintDistance(s.box, p.box);
-        if (d <= cfg_.relations.radius) consider(p, d);
+      for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box)) {
+        char& done = world_done[static_cast<std::size_t>(i)];
+        if (!done && consider(worldSubject(world_, i), d)) done = 1;
+      }
+      for (std::size_t j = 0; j < parked.size(); ++j) {
+        if (parked_done[j]) continue;
+        const double d = geometry::footprintDistance(s.box, parked[j].box);
+        if (d <= cfg_.relations.radius && consider(parked[j], d)) parked_done[j] = 1;
       }
     }
     if (static_cast<int>(out.size()) > want) out.resize(static_cast<std::size_t>(want));

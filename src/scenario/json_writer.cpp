@@ -3,14 +3,35 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace hameritt::scenario {
 
+namespace {
+
+// A comma, a newline and an indent of up to 64 spaces: separators are appended from it at once.
+constexpr std::string_view kCommaIndent =
+    ",\n                                                                ";
+
+// True when s needs no escaping.
+bool plainText(std::string_view s) {
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && c != '"' && c != '\\';
+  });
+}
+
+}  // namespace
+
 void JsonWriter::newline() {
   if (!pretty_ || inline_depth_ > 0) return;
-  out_ += '\n';
-  out_.append(2 * has_items_.size(), ' ');
+  const std::size_t n = 1 + 2 * has_items_.size();
+  if (n + 1 <= kCommaIndent.size()) {
+    out_.append(kCommaIndent.data() + 1, n);
+  } else {
+    out_ += '\n';
+    out_.append(n - 1, ' ');
+  }
 }
 
 void JsonWriter::separate() {
@@ -19,11 +40,18 @@ void JsonWriter::separate() {
     return;
   }
   if (!has_items_.empty()) {
-    if (has_items_.back()) {
+    const bool had = has_items_.back();
+    has_items_.back() = true;
+    const std::size_t n = 2 + 2 * has_items_.size();  // comma, newline, indent
+    if (pretty_ && inline_depth_ == 0 && n <= kCommaIndent.size()) {
+      // The comma (if any), the newline and the indent in one append.
+      out_.append(kCommaIndent.data() + (had ? 0 : 1), had ? n : n - 1);
+      return;
+    }
+    if (had) {
       out_ += ',';
       if (inline_depth_ > 0 && pretty_) out_ += ' ';
     }
-    has_items_.back() = true;
     newline();
   }
 }
@@ -60,19 +88,29 @@ JsonWriter& JsonWriter::endArray() {
 
 JsonWriter& JsonWriter::key(std::string_view k) {
   separate();
+  after_key_ = true;
+  char buf[96];
+  if (k.size() + 4 <= sizeof(buf) && plainText(k)) {
+    // The quoted key and the colon in one append.
+    std::size_t n = 0;
+    buf[n++] = '"';
+    std::memcpy(buf + n, k.data(), k.size());
+    n += k.size();
+    buf[n++] = '"';
+    buf[n++] = ':';
+    if (pretty_) buf[n++] = ' ';
+    out_.append(buf, n);
+    return *this;
+  }
   escape(k);
   out_ += pretty_ ? ": " : ":";
-  after_key_ = true;
   return *this;
 }
 
 void JsonWriter::escape(std::string_view s) {
   out_ += '"';
   // Plain text (the usual case: ids, keys, names) is copied at once.
-  const bool plain = std::all_of(s.begin(), s.end(), [](char c) {
-    return static_cast<unsigned char>(c) >= 0x20 && c != '"' && c != '\\';
-  });
-  if (plain) {
+  if (plainText(s)) {
     out_.append(s);
     out_ += '"';
     return;
@@ -109,11 +147,46 @@ void JsonWriter::escape(std::string_view s) {
 
 JsonWriter& JsonWriter::value(std::string_view s) {
   separate();
+  char buf[96];
+  if (s.size() + 2 <= sizeof(buf) && plainText(s)) {
+    // A short plain string with its quotes in one append.
+    buf[0] = '"';
+    std::memcpy(buf + 1, s.data(), s.size());
+    buf[s.size() + 1] = '"';
+    out_.append(buf, s.size() + 2);
+    return *this;
+  }
   escape(s);
   return *this;
 }
 
 namespace {
+
+// "00" "01" ... "99".
+constexpr char kDigitPairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+// Writes a's decimal digits just before end, two at a time; returns where they start. (Called
+// with 32-bit values where they fit: their division by 100 is cheaper.)
+template <typename U>
+char* digitsBefore(U a, char* end) {
+  char* q = end;
+  while (a >= 100) {
+    const unsigned r = static_cast<unsigned>(a % 100);
+    a /= 100;
+    q -= 2;
+    std::memcpy(q, kDigitPairs + 2 * r, 2);
+  }
+  if (a >= 10) {
+    q -= 2;
+    std::memcpy(q, kDigitPairs + 2 * a, 2);
+  } else {
+    *--q = static_cast<char>('0' + a);
+  }
+  return q;
+}
 
 // Writes a finite number at p (room for 40 characters); returns the end.
 char* writeNumber(double d, char* p) {
@@ -132,15 +205,22 @@ char* writeNumber(double d, char* p) {
     if (static_cast<double>(k) / 1000.0 == d) {
       unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
       if (k < 0) *p++ = '-';
-      const unsigned long long whole = a / 1000, frac = a % 1000;
-      p = std::to_chars(p, end, whole).ptr;
+      // All digits of a (at least four), two at a time from a table, then the whole part,
+      // the point and the fraction without its trailing zeros. Copies have fixed sizes
+      // (inlined); bytes past the number are overwritten later or lie past the returned end.
+      const unsigned frac = static_cast<unsigned>(a % 1000);
+      char tmp[64];
+      char* const tend = tmp + 40;
+      char* q = a <= 0xffffffffULL ? digitsBefore(static_cast<std::uint32_t>(a), tend)
+                                   : digitsBefore(a, tend);
+      while (tend - q < 4) *--q = '0';
+      const std::size_t whole_len = static_cast<std::size_t>(tend - q) - 3;  // at most 12
+      std::memcpy(p, q, 16);
+      p += whole_len;
       if (frac != 0) {
-        *p++ = '.';
-        char digits[3] = {static_cast<char>('0' + frac / 100), static_cast<char>('0' + frac / 10 % 10),
-                          static_cast<char>('0' + frac % 10)};
-        int n = 3;
-        while (digits[n - 1] == '0') --n;
-        for (int i = 0; i < n; ++i) *p++ = digits[i];
+        *p = '.';
+        std::memcpy(p + 1, tend - 3, 4);
+        p += frac % 100 == 0 ? 2 : frac % 10 == 0 ? 3 : 4;
       }
       return p;
     }
@@ -189,7 +269,6 @@ JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
     if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   }
   separate();
-  const std::string_view sep = pretty_ ? ", " : ",";
   char buf[512];
   std::size_t k = 0;
   buf[k++] = '[';
@@ -199,7 +278,8 @@ JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
       k = 0;
     }
     if (d != v.begin()) {
-      for (char c : sep) buf[k++] = c;
+      buf[k++] = ',';
+      if (pretty_) buf[k++] = ' ';
     }
     k = static_cast<std::size_t>(writeNumber(*d, buf + k) - buf);
   }

@@ -196,11 +196,15 @@ std::string missionJson(const Mission& m) {
   }
   w.endArray();
   w.endObject();
-  return w.str();
+  return w.take();
 }
 
 std::string simConfigJson(const SimConfig& s) {
-  JsonWriter w;
+  // Room for the whole document up front (a trajectory point takes about 60 characters):
+  // growing a 100 KB buffer by doubling would copy it several times.
+  std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;
+  for (const auto& se : s.entities) points += se.trajectory.size() + 8;
+  JsonWriter w(true, 8192 + 64 * points);
   w.beginObject();
   writeHeader(w, "hameritt/sim_config", s.scenario_id, s.cls, s.seed);
   w.key("duration").value(s.duration);
@@ -290,13 +294,13 @@ std::string simConfigJson(const SimConfig& s) {
   w.key("motion_blur_px").value(s.perturbations.motion_blur_px);
   w.endObject().endObject();
   w.endObject();
-  return w.str();
+  return w.take();
 }
 
 std::string worldParamsJson(const WorldParams& p) {
   JsonWriter w;
   writeWorldParams(w, p);
-  return w.str();
+  return w.take();
 }
 
 std::string worldJson(const World& world) {
@@ -353,7 +357,7 @@ std::string worldJson(const World& world) {
   }
   w.endArray();
   w.endObject();
-  return w.str();
+  return w.take();
 }
 
 void writeFileAtomic(const std::string& path, const std::string& content) {

@@ -120,10 +120,13 @@ Trajectory planDrive(const std::vector<Vec2>& path, const DriveSpec& spec) {
     const double avg = std::max(0.5 * (v[i] + v[i - 1]), 0.05);
     t[i] = t[i - 1] + l / avg;
   }
-  auto heading = [&](std::size_t i) {
+  // Heading at each vertex, computed once (each is asked for up to four times below).
+  std::vector<double> headings(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const Vec3 d = i + 1 < n ? fine[i + 1].p - fine[i].p : fine[i].p - fine[i - 1].p;
-    return std::atan2(d.y(), d.x());
-  };
+    headings[i] = std::atan2(d.y(), d.x());
+  }
+  auto heading = [&](std::size_t i) { return headings[i]; };
   Trajectory out;
   const double yaw0 = spec.from_kerb ? spec.from_kerb_yaw : heading(0);
   if (spec.depart_delay > 0) out.push_back(rounded(spec.start_time, fine[0].p, yaw0));

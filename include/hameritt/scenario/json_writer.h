@@ -4,16 +4,21 @@
 // byte-identical for identical values on every run. Used for the generator's hot path, where
 // building a DOM first would cost more than the geometry.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace hameritt::scenario {
 
 class JsonWriter {
  public:
-  explicit JsonWriter(bool pretty = true) : pretty_(pretty) { out_.reserve(1 << 14); }
+  // reserve: bytes to allocate up front (a good guess saves regrowing the buffer).
+  explicit JsonWriter(bool pretty = true, std::size_t reserve = 1 << 14) : pretty_(pretty) {
+    out_.reserve(reserve);
+  }
 
   JsonWriter& beginObject();
   JsonWriter& endObject();
@@ -35,6 +40,11 @@ class JsonWriter {
 
   // The document (call after the outermost end*()); ends with a newline.
   std::string str() const { return out_ + "\n"; }
+  // The same document as str(), moved out without a copy; the writer is empty afterwards.
+  std::string take() {
+    out_ += '\n';
+    return std::move(out_);
+  }
 
  private:
   void separate();
