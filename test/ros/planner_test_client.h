@@ -67,12 +67,27 @@ class FollowerClient {
       p.pose.orientation.w = 1.0;
       path.poses.push_back(p);
     }
-    waypoints_pub_.publish(path);
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(60);
-    while (progress.state != "following" && progress.state != "failed" &&
-           ros::WallTime::now() < until) {
-      ros::spinOnce();
-      ros::WallDuration(0.005).sleep();
+    // The planner answers "failed: no odometry yet" when its odometry subscription connected
+    // after the one step connect() took (the simulator is paused): step once more, so that it
+    // publishes odometry again, and send the waypoints again.
+    bool sent = false;
+    while (!sent || (progress.state == "failed" &&
+                     progress.message.rfind("no odometry", 0) == 0 && ros::WallTime::now() < until)) {
+      if (sent) {
+        hameritt::StepSimulation step;
+        step.request.steps = 1;
+        EXPECT_TRUE(ros::service::call("/simulator/step", step)) << "step";
+        ros::WallDuration(0.1).sleep();
+      }
+      progress.state.clear();
+      waypoints_pub_.publish(path);
+      sent = true;
+      while (progress.state != "following" && progress.state != "failed" &&
+             ros::WallTime::now() < until) {
+        ros::spinOnce();
+        ros::WallDuration(0.005).sleep();
+      }
     }
     hameritt::SetPaused run;
     run.request.paused = false;
