@@ -14,19 +14,9 @@
 namespace fs = std::filesystem;
 using namespace hameritt::scenario;
 using hameritt::scenario::testing::freshTempDir;
+using hameritt::scenario::testing::slurp;
 using hameritt::scenario::testing::shippedConfig;
 using hameritt::scenario::testing::shippedWorld;
-
-namespace {
-
-std::string readAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
-}  // namespace
 
 TEST(BatchSliceTest, SlicesEqualTheSameIndicesOfTheWholeBatch) {
   BatchRequest req;
@@ -55,14 +45,14 @@ TEST(BatchSliceTest, SlicesEqualTheSameIndicesOfTheWholeBatch) {
       EXPECT_EQ(e.seed, w.seed);
       EXPECT_EQ(e.cls, w.cls);
       for (const char* f : {"mission.json", "sim_config.json"}) {
-        const std::string a = readAll(whole_dir + "/" + w.id + "/" + f);
+        const std::string a = slurp(whole_dir + "/" + w.id + "/" + f);
         ASSERT_FALSE(a.empty()) << w.id << "/" << f;
-        EXPECT_EQ(a, readAll(req.out_dir + "/" + e.id + "/" + f)) << e.id << "/" << f;
+        EXPECT_EQ(a, slurp(req.out_dir + "/" + e.id + "/" + f)) << e.id << "/" << f;
         ++compared;
       }
     }
-    EXPECT_EQ(readAll(whole_dir + "/world.json"), readAll(req.out_dir + "/world.json"));
-    const auto m = nlohmann::json::parse(readAll(req.out_dir + "/manifest.json"));
+    EXPECT_EQ(slurp(whole_dir + "/world.json"), slurp(req.out_dir + "/world.json"));
+    const auto m = nlohmann::json::parse(slurp(req.out_dir + "/manifest.json"));
     EXPECT_EQ(m["scenarios"][0]["index"].get<int>(), firsts[s]);
     if (firsts[s] == 0) {
       EXPECT_FALSE(m.contains("first"));  // a batch from 0 keeps its manifest unchanged

@@ -17,16 +17,11 @@
 namespace fs = std::filesystem;
 using namespace hameritt::scenario;
 using hameritt::scenario::testing::freshTempDir;
+using hameritt::scenario::testing::slurp;
 using hameritt::scenario::testing::shippedConfig;
 
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
 
 // A world no other test of this process uses, so that its caches start empty here.
 const World& freshWorld() {

@@ -22,6 +22,7 @@ namespace fs = std::filesystem;
 using namespace hameritt::scenario;
 using hameritt::geometry::Vec2;
 using hameritt::scenario::testing::freshTempDir;
+using hameritt::scenario::testing::slurp;
 using hameritt::scenario::testing::shippedConfig;
 using hameritt::scenario::testing::shippedWorld;
 
@@ -30,12 +31,6 @@ namespace {
 const ScenarioClass kClasses[] = {ScenarioClass::kAreaSearch, ScenarioClass::kRouteSearch,
                                   ScenarioClass::kPursuit};
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
 
 const ScenarioEntity* findEntity(const Scenario& s, const std::string& id) {
   for (const auto& e : s.sim.entities) {

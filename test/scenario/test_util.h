@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "hameritt/scenario/generator.h"
@@ -19,6 +21,14 @@ inline const GeneratorConfig& shippedConfig() {
 inline const World& shippedWorld() {
   static const World w = generateWorld(loadWorldParams(defaultConfigDir() + "/world.json"));
   return w;
+}
+
+// The whole file as bytes ("" if it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
 }
 
 // A fresh, empty temporary directory unique to this process and tag.
