@@ -14,6 +14,6 @@ int main(int argc, char** argv) {
     ROS_FATAL("color_shape_detector: %s", e.what());
     return 1;
   }
-  ros::spin();
+  node->spin();
   return 0;
 }

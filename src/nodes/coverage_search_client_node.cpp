@@ -14,6 +14,6 @@ int main(int argc, char** argv) {
     ROS_FATAL("coverage_search_client: %s", e.what());
     return 1;
   }
-  ros::spin();
+  node->spin();
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <ros/ros.h>
 
 #include "hameritt/ros/conversions.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/sim_config_io.h"
 
@@ -24,23 +25,32 @@ int main(int argc, char** argv) {
     if (!(lead >= 0 && lead <= 5)) throw std::runtime_error("~lead: expected [0, 5] seconds");
     const auto config = hameritt::scenario::loadSimConfig(sim_config);
     if (!config.uav.perception_path || config.uav.perception_path->trajectory.size() < 2) {
-      throw std::runtime_error(sim_config + ": uav.perception_path: absent or empty (generate the "
+      throw std::runtime_error(sim_config +
+                               ": uav.perception_path: absent or empty (generate the "
                                "scenario with \"perception_paths\": true)");
     }
     path = config.uav.perception_path->trajectory;
     ROS_INFO("path_player: %zu poses, %.1f s, status %s, camera %s", path.size(), path.back().t,
-             config.uav.perception_path->status.c_str(), config.uav.perception_path->camera.c_str());
+             config.uav.perception_path->status.c_str(),
+             config.uav.perception_path->camera.c_str());
   } catch (const std::exception& e) {
     ROS_FATAL("path_player: %s", e.what());
     return 1;
   }
-  ros::Publisher pub = nh.advertise<geometry_msgs::PoseStamped>("uav/cmd_pose", 10);
-  ros::Timer timer = nh.createTimer(ros::Duration(1.0 / rate_hz), [&](const ros::TimerEvent&) {
+  std::unique_ptr<hameritt::ros_wrappers::LockstepGate> gate;
+  try {
+    gate = std::make_unique<hameritt::ros_wrappers::LockstepGate>(nh, pnh);
+  } catch (const std::exception& e) {
+    ROS_FATAL("path_player: %s", e.what());
+    return 1;
+  }
+  ros::Publisher pub = gate->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
+  gate->every(nh, 1.0 / rate_hz, [&] {
     const double t = ros::Time::now().toSec();
     if (t <= 0) return;  // no /clock yet
-    pub.publish(hameritt::ros_wrappers::toPoseMsg(hameritt::scenario::sampleTrajectory(path, t + lead),
-                                                  ros::Time::now()));
+    gate->publish(pub, hameritt::ros_wrappers::toPoseMsg(
+                           hameritt::scenario::sampleTrajectory(path, t + lead), ros::Time::now()));
   });
-  ros::spin();
+  gate->spin();
   return 0;
 }

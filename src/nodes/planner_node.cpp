@@ -13,6 +13,6 @@ int main(int argc, char** argv) {
     ROS_FATAL("planner: %s", e.what());
     return 1;
   }
-  ros::spin();
+  node->spin();
   return 0;
 }

@@ -39,6 +39,7 @@ ros::Time stampOf(double t) {
 void AdkRos::requestStop() { g_stop = true; }
 
 AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  gate_ = std::make_unique<LockstepGate>(nh, pnh);
   std::string mission_path, sim_config_path;
   if (!pnh.getParam("mission", mission_path) || mission_path.empty()) {
     throw ConfigError("~mission: required parameter (path of a mission.json)");
@@ -130,30 +131,47 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   metrics_ = std::make_unique<adk::MetricsAccumulator>(mission_, objective);
   lifecycle_ = std::make_unique<adk::MissionLifecycle>(time_limit);
 
-  mission_pub_ = nh.advertise<hameritt::Mission>("mission", 1, true);
-  markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("mission/markers", 1, true);
-  constraints_pub_ = nh.advertise<hameritt::ConstraintStatus>("adk/constraints", 10);
-  events_pub_ = nh.advertise<hameritt::ConstraintEvent>("adk/constraint_events", 100);
-  perception_pub_ = nh.advertise<hameritt::PerceptionReport>("adk/perfect_perception", 20);
-  scores_pub_ = nh.advertise<hameritt::DetectionScore>("adk/detection_scores", 100);
-  state_pub_ = nh.advertise<hameritt::MissionState>("adk/state", 10, true);
-  metrics_pub_ = nh.advertise<hameritt::MissionMetrics>("adk/metrics", 1, true);
+  mission_pub_ = gate_->advertise<hameritt::Mission>(nh, "mission", 1, true);
+  markers_pub_ = gate_->advertise<visualization_msgs::MarkerArray>(nh, "mission/markers", 1, true);
+  constraints_pub_ = gate_->advertise<hameritt::ConstraintStatus>(nh, "adk/constraints", 10);
+  events_pub_ = gate_->advertise<hameritt::ConstraintEvent>(nh, "adk/constraint_events", 100);
+  perception_pub_ = gate_->advertise<hameritt::PerceptionReport>(nh, "adk/perfect_perception", 20);
+  scores_pub_ = gate_->advertise<hameritt::DetectionScore>(nh, "adk/detection_scores", 100);
+  state_pub_ = gate_->advertise<hameritt::MissionState>(nh, "adk/state", 10, true);
+  metrics_pub_ = gate_->advertise<hameritt::MissionMetrics>(nh, "adk/metrics", 1, true);
 
-  clock_sub_ = nh.subscribe("/clock", 10, &AdkRos::onClock, this);
-  odom_sub_ = nh.subscribe("uav/odom", 1000, &AdkRos::onOdometry, this);
-  truth_sub_ = nh.subscribe("ground_truth/entities", 100, &AdkRos::onTruth, this);
-  crash_sub_ = nh.subscribe("uav/crash", 10, &AdkRos::onCrash, this);
-  detection_sub_ = nh.subscribe("perception/detections", 100, &AdkRos::onDetection, this);
+  if (gate_->enabled()) {
+    // Lock-step: the turn carries the sim time (README "Lock-step missions").
+    gate_->onTurn([this](const ros::Time& t) {
+      auto c = boost::make_shared<rosgraph_msgs::Clock>();
+      c->clock = t;
+      onClock(c);
+    });
+  } else {
+    clock_sub_ = nh.subscribe("/clock", 10, &AdkRos::onClock, this);
+  }
+  odom_sub_ = gate_->subscribe(nh, "uav/odom", 1000, &AdkRos::onOdometry, this);
+  truth_sub_ = gate_->subscribe(nh, "ground_truth/entities", 100, &AdkRos::onTruth, this);
+  crash_sub_ = gate_->subscribe(nh, "uav/crash", 10, &AdkRos::onCrash, this);
+  detection_sub_ = gate_->subscribe(nh, "perception/detections", 100, &AdkRos::onDetection, this);
   for (std::size_t i = 0; i < sim_config_.uav.cameras.size(); ++i) {
     const std::string topic = "uav/camera/" + sim_config_.uav.cameras[i].name + "/boxes";
-    box_subs_.push_back(nh.subscribe<hameritt::BoundingBoxArray>(
-        topic, 20, [this, i](const hameritt::BoundingBoxArray::ConstPtr& m) { onBoxes(i, m); }));
+    box_subs_.push_back(gate_->subscribe<hameritt::BoundingBoxArray>(
+        nh, topic, 20,
+        [this, i](const hameritt::BoundingBoxArray::ConstPtr& m) { onBoxes(i, m); }));
   }
-  state_timer_ = nh.createWallTimer(ros::WallDuration(1.0), &AdkRos::onStateTimer, this);
+  // The state again every second (wall time; sim time in lock-step), until the mission ends.
+  gate_->every(
+      nh, 1.0,
+      [this] {
+        if (!gate_->enabled() || !finished_) publishState();
+      },
+      /*wall=*/true);
 
   const ros::Time stamp = stampOf(0.0);
-  mission_pub_.publish(toMsg(mission_, stamp));
-  markers_pub_.publish(missionMarkers(mission_, sim_config_.uav.altitude_max + 20.0, stamp));
+  gate_->publish(mission_pub_, toMsg(mission_, stamp));
+  gate_->publish(markers_pub_,
+                 missionMarkers(mission_, sim_config_.uav.altitude_max + 20.0, stamp));
   publishState();
   ROS_INFO(
       "adk: %s (%s), mode %s, perfect perception %s, time limit %.1f s, %zu cameras, "
@@ -182,14 +200,12 @@ void AdkRos::publishState() {
   s.elapsed = lifecycle_->ended() ? lifecycle_->endTime() : now_;
   s.time_limit = lifecycle_->timeLimit();
   s.reason = lifecycle_->reason();
-  state_pub_.publish(s);
+  gate_->publish(state_pub_, s);
 }
 
 void AdkRos::publishConstraints(double t) {
-  constraints_pub_.publish(toMsg(*monitor_, stampOf(t)));
+  gate_->publish(constraints_pub_, toMsg(*monitor_, stampOf(t)));
 }
-
-void AdkRos::onStateTimer(const ros::WallTimerEvent&) { publishState(); }
 
 void AdkRos::onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
   if (finished_) return;
@@ -231,7 +247,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   const Eigen::Vector3d p = pose.translation();
   const Eigen::Vector3d v = worldVelocityOf(*msg);
   try {
-    for (const auto& e : monitor_->add(t, p)) events_pub_.publish(toMsg(e));
+    for (const auto& e : monitor_->add(t, p)) gate_->publish(events_pub_, toMsg(e));
     metrics_->addState(t, p, v);
   } catch (const adk::InputError& e) {
     HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", odom_sub_.getTopic().c_str(), e.what());
@@ -339,7 +355,7 @@ void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::Const
     metrics_->addSighting(box.entity_id, stamp, 1.0 / cam.rate_hz);
     report.entities.push_back(pe);
   }
-  if (perfect_perception_) perception_pub_.publish(report);
+  if (perfect_perception_) gate_->publish(perception_pub_, report);
   checkObjective(std::max(now_, stamp));
 }
 
@@ -364,7 +380,7 @@ void AdkRos::onDetection(const hameritt::Detection::ConstPtr& msg) {
   s.matched_role = v.role;
   s.position_error = v.position_error;
   s.first_correct = v.first_correct;
-  scores_pub_.publish(s);
+  gate_->publish(scores_pub_, s);
   checkObjective(std::max(now_, claim.stamp));
 }
 
@@ -402,7 +418,7 @@ void AdkRos::finish() {
   }
   const ros::Time stamp = stampOf(lifecycle_->endTime());
   if (monitor_->sampleCount() > 0) publishConstraints(monitor_->lastTime());
-  metrics_pub_.publish(toMsg(m, file, stamp));
+  gate_->publish(metrics_pub_, toMsg(m, file, stamp));
   publishState();
   ROS_INFO(
       "adk: mission %s at t = %.3f s (%s); %zu keep-out violations, path %.1f m, "
@@ -412,9 +428,8 @@ void AdkRos::finish() {
 }
 
 int AdkRos::spin() {
-  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
   while (true) {
-    queue->callAvailable(ros::WallDuration(0.02));
+    gate_->spinOnce(0.02);
     if (!finished_) {
       const std::string stalled = watchdog_->stalled(ros::WallTime::now().toSec());
       if (!stalled.empty()) {
@@ -436,6 +451,7 @@ int AdkRos::spin() {
       break;
     }
   }
+  gate_->leave();
   ros::shutdown();
   return write_failed_ ? 1 : 0;
 }

@@ -13,6 +13,7 @@
 #include "hameritt/render/renderer.h"
 #include "hameritt/ros/conversions.h"
 #include "hameritt/ros/image_compression.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/error.h"
 
 namespace hameritt::ros_wrappers {
@@ -113,6 +114,9 @@ CameraRig::CameraRig(ros::NodeHandle& nh, const scenario::World& world,
     }
     cam->info_pub = nh.advertise<sensor_msgs::CameraInfo>(ns + "camera_info", 4);
     cam->boxes_pub = nh.advertise<hameritt::BoundingBoxArray>(ns + "boxes", 4);
+    if (options.gate) {
+      for (const ros::Publisher* p : cam->publishers()) options.gate->watch(*p);
+    }
     cameras_.push_back(std::move(cam));
   }
   if (cameras_.empty()) return;
@@ -303,6 +307,9 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
   };
   const bool decimated = cam.decimated(frame);
   auto wants = [](const ros::Publisher& p) { return p && p.getNumSubscribers() > 0; };
+  auto counted = [this](const ros::Publisher& p) {
+    if (options_.gate) options_.gate->count(p.getTopic());
+  };
   struct Plane {
     std::string encoding;
     int bytes = 0;
@@ -317,14 +324,21 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
     if (wants(full)) {
       full_msg = image(full_plane.encoding, full_plane.bytes, full_plane.data);
       full.publish(full_msg);
+      counted(full);
     }
     if (!decimated || !(wants(dec) || wants(png))) return;
     const sensor_msgs::ImagePtr m =
         (full_msg && dec_plane.data == full_plane.data)
             ? full_msg
             : image(dec_plane.encoding, dec_plane.bytes, dec_plane.data);
-    if (wants(dec)) dec.publish(m);
-    if (wants(png)) png.publish(toPngCompressed(*m, options_.decimated_png_level));
+    if (wants(dec)) {
+      dec.publish(m);
+      counted(dec);
+    }
+    if (wants(png)) {
+      png.publish(toPngCompressed(*m, options_.decimated_png_level));
+      counted(png);
+    }
   };
   namespace enc = sensor_msgs::image_encodings;
   const Plane rgb{enc::RGB8, 3, fs.rgb.data()};
@@ -346,7 +360,9 @@ void CameraRig::publish(const Camera& cam, std::uint64_t frame, double time, con
   const Plane inst{enc::TYPE_16UC1, 2, fs.instance.data()};
   send(cam.instances, cam.inst_pub, cam.inst_dec, cam.inst_png, inst, inst);
   cam.info_pub.publish(toCameraInfoMsg(fs.intrinsics, header));
+  counted(cam.info_pub);
   cam.boxes_pub.publish(toBoxesMsg(fs.boxes, cam.spec.name, header));
+  counted(cam.boxes_pub);
 }
 
 }  // namespace hameritt::ros_wrappers

@@ -1,5 +1,7 @@
 #include "hameritt/ros/color_shape_detector_ros.h"
 
+#include <tf2_msgs/TFMessage.h>
+
 #include <boost/bind/bind.hpp>
 #include <set>
 
@@ -73,6 +75,7 @@ void loadColors(ros::NodeHandle& pnh, clients::DetectorSettings* s) {
 }  // namespace
 
 ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  gate_ = std::make_unique<LockstepGate>(nh, pnh);
   std::string sim_path;
   if (!pnh.getParam("sim_config", sim_path)) {
     throw scenario::ConfigError("~sim_config: required parameter (path of a sim_config.json)");
@@ -113,6 +116,25 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
 
   // Both payload cameras: the front camera (oblique) sees targets the down camera cannot reach
   // (under vantage-denial keep-out zones).
+  if (gate_->enabled()) {
+    // Subscribed before the images: a turn hands the transforms over before the frames.
+    auto feed = [this](bool is_static) {
+      return std::function<void(const tf2_msgs::TFMessage::ConstPtr&)>(
+          [this, is_static](const tf2_msgs::TFMessage::ConstPtr& m) {
+            for (const auto& t : m->transforms) {
+              try {
+                tf_.setTransform(t, "lockstep", is_static);
+              } catch (const std::exception& e) {
+                ROS_WARN_THROTTLE(10.0, "%s: tf: %s", kClientName, e.what());
+              }
+            }
+          });
+    };
+    tf_sub_ = gate_->subscribe<tf2_msgs::TFMessage>(nh, "/tf", 1000, feed(false));
+    tf_static_sub_ = gate_->subscribe<tf2_msgs::TFMessage>(nh, "/tf_static", 100, feed(true));
+  } else {
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_);
+  }
   std::vector<std::string> names{"down", "front"};
   pnh.param("cameras", names, names);
   if (names.empty()) throw scenario::ConfigError("~cameras: expected at least one camera name");
@@ -131,29 +153,34 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
                                   name + "'");
     }
     const std::string ns = "uav/camera/" + name + "/";
-    cam->image_sub =
-        std::make_unique<message_filters::Subscriber<sensor_msgs::Image>>(nh, ns + "image_raw", 4);
-    cam->depth_sub =
-        std::make_unique<message_filters::Subscriber<sensor_msgs::Image>>(nh, ns + "depth", 4);
+    Camera* raw = cam.get();
+    using ImageFn = std::function<void(const sensor_msgs::Image::ConstPtr&)>;
+    cam->image_sub = gate_->subscribe<sensor_msgs::Image>(
+        nh, ns + "image_raw", 4,
+        ImageFn([raw](const sensor_msgs::Image::ConstPtr& m) { raw->image_in.add(m); }));
+    cam->depth_sub = gate_->subscribe<sensor_msgs::Image>(
+        nh, ns + "depth", 4,
+        ImageFn([raw](const sensor_msgs::Image::ConstPtr& m) { raw->depth_in.add(m); }));
     cam->sync =
         std::make_unique<message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::Image>>(
-            *cam->image_sub, *cam->depth_sub, 8);
-    Camera* raw = cam.get();
+            cam->image_in, cam->depth_in, 8);
     cam->sync->registerCallback(boost::bind(&ColorShapeDetectorRos::onFrame, this, raw,
                                             boost::placeholders::_1, boost::placeholders::_2));
-    cam->info_sub = nh.subscribe<sensor_msgs::CameraInfo>(
-        ns + "camera_info", 1, [raw](const sensor_msgs::CameraInfo::ConstPtr& m) {
-          try {
-            raw->intrinsics = fromMsg(*m);
-          } catch (const std::exception& e) {
-            ROS_WARN_THROTTLE(10.0, "%s: %s: %s", kClientName, raw->name.c_str(), e.what());
-          }
-        });
+    cam->info_sub = gate_->subscribe<sensor_msgs::CameraInfo>(
+        nh, ns + "camera_info", 1,
+        std::function<void(const sensor_msgs::CameraInfo::ConstPtr&)>(
+            [raw](const sensor_msgs::CameraInfo::ConstPtr& m) {
+              try {
+                raw->intrinsics = fromMsg(*m);
+              } catch (const std::exception& e) {
+                ROS_WARN_THROTTLE(10.0, "%s: %s: %s", kClientName, raw->name.c_str(), e.what());
+              }
+            }));
     cameras_.push_back(std::move(cam));
   }
-  detection_pub_ = nh.advertise<hameritt::Detection>("perception/detections", 50);
-  mission_sub_ = nh.subscribe("mission", 1, &ColorShapeDetectorRos::onMission, this);
-  state_sub_ = nh.subscribe("adk/state", 10, &ColorShapeDetectorRos::onState, this);
+  detection_pub_ = gate_->advertise<hameritt::Detection>(nh, "perception/detections", 50);
+  mission_sub_ = gate_->subscribe(nh, "mission", 1, &ColorShapeDetectorRos::onMission, this);
+  state_sub_ = gate_->subscribe(nh, "adk/state", 10, &ColorShapeDetectorRos::onState, this);
   ROS_INFO("%s: %zu camera(s), waiting for the mission", kClientName, cameras_.size());
 }
 
@@ -183,18 +210,23 @@ void ColorShapeDetectorRos::onState(const topic_tools::ShapeShifter::ConstPtr& m
 
 std::optional<Eigen::Isometry3d> ColorShapeDetectorRos::cameraPose(
     const Camera& camera, const sensor_msgs::Image& image) const {
-  const ros::Duration wait(0.05);
+  // In lock-step every transform up to the image has been handed over already: no waiting
+  // (tf2_ros refuses a timeout without a listener thread).
+  const bool wait = !gate_->enabled();
+  auto lookup = [&](const std::string& frame) {
+    return wait ? tf_.lookupTransform("map", frame, image.header.stamp, ros::Duration(0.05))
+                : tf_.lookupTransform("map", frame, image.header.stamp);
+  };
   // An optical frame (z forward, x right, y down) from tf as it is; anything else (no frame, a
   // camera link frame) from the body pose and the sim_config's mount.
   if (image.header.frame_id.find("optical") != std::string::npos) {
     try {
-      return toIsometry(
-          tf_.lookupTransform("map", image.header.frame_id, image.header.stamp, wait).transform);
+      return toIsometry(lookup(image.header.frame_id).transform);
     } catch (const tf2::TransformException&) {
     }
   }
   try {
-    const auto base = tf_.lookupTransform("map", "uav/base_link", image.header.stamp, wait);
+    const auto base = lookup("uav/base_link");
     return clients::opticalPose(toIsometry(base.transform), camera.spec.mount_xyz,
                                 camera.spec.mount_rpy);
   } catch (const tf2::TransformException& e) {
@@ -256,8 +288,8 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
         const double confidence =
             clients::claimConfidence(c.size_score, v.relations_checked, v.relations_skipped);
         if (confidence < min_confidence_ || !claims_.claim(c.position, t)) continue;
-        detection_pub_.publish(
-            makeDetection(kClientName, target, c.position, confidence, image->header.stamp));
+        gate_->publish(detection_pub_, makeDetection(kClientName, target, c.position, confidence,
+                                                     image->header.stamp));
         ROS_INFO(
             "%s: claim: %s at (%.1f, %.1f) from the %s camera, %.1f x %.1f m, confidence "
             "%.2f (%s)",

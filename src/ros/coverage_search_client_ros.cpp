@@ -30,6 +30,7 @@ geometry_msgs::PoseStamped poseAt(const geometry::Vec3& p, const ros::Time& stam
 }  // namespace
 
 CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  gate_ = std::make_unique<LockstepGate>(nh, pnh);
   std::string sim_path, camera = "down";
   if (!pnh.getParam("sim_config", sim_path)) {
     throw scenario::ConfigError("~sim_config: required parameter (path of a sim_config.json)");
@@ -69,20 +70,20 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
     world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
   }
 
-  waypoints_pub_ = nh.advertise<nav_msgs::Path>("planner/waypoints", 1, true);
-  plan_pub_ = pnh.advertise<nav_msgs::Path>("plan", 1, true);
-  mission_sub_ = nh.subscribe("mission", 1, &CoverageSearchClientRos::onMission, this);
-  odom_sub_ = nh.subscribe("uav/odom", 10, &CoverageSearchClientRos::onOdometry, this);
-  progress_sub_ = nh.subscribe("planner/progress", 50, &CoverageSearchClientRos::onProgress, this);
-  state_sub_ = nh.subscribe("adk/state", 10, &CoverageSearchClientRos::onState, this);
-  detection_sub_ =
-      nh.subscribe("perception/detections", 50, &CoverageSearchClientRos::onDetection, this);
+  waypoints_pub_ = gate_->advertise<nav_msgs::Path>(nh, "planner/waypoints", 1, true);
+  plan_pub_ = gate_->advertise<nav_msgs::Path>(pnh, "plan", 1, true);
+  using Self = CoverageSearchClientRos;
+  mission_sub_ = gate_->subscribe(nh, "mission", 1, &Self::onMission, this);
+  odom_sub_ = gate_->subscribe(nh, "uav/odom", 10, &Self::onOdometry, this);
+  progress_sub_ = gate_->subscribe(nh, "planner/progress", 50, &Self::onProgress, this);
+  state_sub_ = gate_->subscribe(nh, "adk/state", 10, &Self::onState, this);
+  detection_sub_ = gate_->subscribe(nh, "perception/detections", 50, &Self::onDetection, this);
   if (claim_) {
-    detection_pub_ = nh.advertise<hameritt::Detection>("perception/detections", 50);
-    perfect_sub_ = nh.subscribe("adk/perfect_perception", 20,
-                                &CoverageSearchClientRos::onPerfectPerception, this);
+    detection_pub_ = gate_->advertise<hameritt::Detection>(nh, "perception/detections", 50);
+    perfect_sub_ =
+        gate_->subscribe(nh, "adk/perfect_perception", 20, &Self::onPerfectPerception, this);
   }
-  timer_ = nh.createTimer(ros::Duration(1.0 / rate), &CoverageSearchClientRos::onTick, this);
+  gate_->every(nh, 1.0 / rate, [this] { onTick(); });
   ROS_INFO("%s: %s camera, altitude %.1f m, swath %.1f m, lines %.1f m apart%s", kClientName,
            camera.c_str(), settings_.altitude, settings_.footprint.across,
            settings_.footprint.across * (1 - settings_.overlap),
@@ -150,7 +151,7 @@ void CoverageSearchClientRos::sendIfDue() {
       path.header.frame_id = "map";
       const auto& p = odom_->pose.pose.position;
       path.poses.push_back(poseAt(geometry::Vec3(p.x, p.y, p.z), path.header.stamp));
-      waypoints_pub_.publish(path);
+      gate_->publish(waypoints_pub_, path);
     }
     return;
   }
@@ -161,7 +162,7 @@ void CoverageSearchClientRos::sendIfDue() {
   path.header.stamp = ros::Time::now();
   path.header.frame_id = "map";
   for (const auto& w : leg.waypoints) path.poses.push_back(poseAt(w.position, path.header.stamp));
-  waypoints_pub_.publish(path);
+  gate_->publish(waypoints_pub_, path);
   sent_ = true;
   acked_ = false;
   ROS_INFO("%s: leg %zu/%zu: %s %s (p %.3f), %zu waypoints", kClientName, leg_ + 1,
@@ -270,13 +271,14 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     if (!claims_.claim(p, t)) continue;
     const double confidence =
         clients::claimConfidence(1.0, v.relations_checked, v.relations_skipped);
-    detection_pub_.publish(makeDetection(kClientName, target, p, confidence, msg->header.stamp));
+    gate_->publish(detection_pub_,
+                   makeDetection(kClientName, target, p, confidence, msg->header.stamp));
     ROS_INFO("%s: claim: %s at (%.1f, %.1f), confidence %.2f (%s)", kClientName,
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
   }
 }
 
-void CoverageSearchClientRos::onTick(const ros::TimerEvent&) {
+void CoverageSearchClientRos::onTick() {
   if (!mission_ || stopped_) return;
   if (mission_->time_limit > 0 && missionTime() > mission_->time_limit) {
     stop("the mission's time limit has passed");
@@ -298,7 +300,7 @@ void CoverageSearchClientRos::stop(const std::string& why) {
     const double z = std::clamp(p.z, sim_.uav.altitude_min + 1.5, sim_.uav.altitude_max - 1.5);
     path.poses.push_back(poseAt(geometry::Vec3(p.x, p.y, z), path.header.stamp));
   }
-  waypoints_pub_.publish(path);
+  gate_->publish(waypoints_pub_, path);
 }
 
 void CoverageSearchClientRos::publishPlan() {
@@ -310,7 +312,7 @@ void CoverageSearchClientRos::publishPlan() {
       path.poses.push_back(poseAt(w.position, ros::Time(std::max(0.0, w.eta + mission_start_))));
     }
   }
-  plan_pub_.publish(path);
+  gate_->publish(plan_pub_, path);
 }
 
 }  // namespace hameritt::ros_wrappers

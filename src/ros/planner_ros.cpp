@@ -29,6 +29,7 @@ geometry::Vec3 toVec(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
 }  // namespace
 
 PlannerRos::PlannerRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  gate_ = std::make_unique<LockstepGate>(nh, pnh);
   std::string mission_path, sim_path, algorithm;
   if (!pnh.getParam("mission", mission_path)) {
     throw scenario::ConfigError("~mission: required parameter (path of a mission.json)");
@@ -69,13 +70,13 @@ PlannerRos::PlannerRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   settings_.validate();
   full_validity_ = std::make_unique<planning::WorldValidity>(*world_, mission_, validity_settings_);
 
-  setpoint_pub_ = nh.advertise<geometry_msgs::PoseStamped>("uav/cmd_pose", 10);
-  path_pub_ = pnh.advertise<nav_msgs::Path>("path", 1, true);
-  progress_pub_ = pnh.advertise<hameritt::FollowProgress>("progress", 10, true);
-  odom_sub_ = nh.subscribe("uav/odom", 10, &PlannerRos::onOdometry, this);
-  waypoints_sub_ = pnh.subscribe("waypoints", 1, &PlannerRos::onWaypoints, this);
+  setpoint_pub_ = gate_->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
+  path_pub_ = gate_->advertise<nav_msgs::Path>(pnh, "path", 1, true);
+  progress_pub_ = gate_->advertise<hameritt::FollowProgress>(pnh, "progress", 10, true);
+  odom_sub_ = gate_->subscribe(nh, "uav/odom", 10, &PlannerRos::onOdometry, this);
+  waypoints_sub_ = gate_->subscribe(pnh, "waypoints", 1, &PlannerRos::onWaypoints, this);
   plan_srv_ = pnh.advertiseService("plan_path", &PlannerRos::onPlan, this);
-  timer_ = nh.createTimer(ros::Duration(1.0 / rate), &PlannerRos::onTick, this);
+  gate_->every(nh, 1.0 / rate, [this] { onTick(); });
   publishProgress("idle", "waiting for waypoints on " + waypoints_sub_.getTopic());
   ROS_INFO("planner: %s, %zu keep-out zones, altitude %.0f..%.0f m", mission_.scenario_id.c_str(),
            mission_.kozs.size(), validity_settings_.altitude_min, validity_settings_.altitude_max);
@@ -204,13 +205,13 @@ bool PlannerRos::replan(double t, const std::string& why) {
   committed_.clear();
   for (const auto& k : zones) committed_.insert(k.id);
   if (why != "new waypoints") ++replans_;
-  path_pub_.publish(toPathMsg(path_, ros::Time::now()));
+  gate_->publish(path_pub_, toPathMsg(path_, ros::Time::now()));
   publishProgress("following", why + ": planned " + std::to_string(r.path.size()) + " samples");
   ROS_INFO("planner: %s: %s path of %.1f m", why.c_str(), planning::toString(r.status), r.length);
   return true;
 }
 
-void PlannerRos::onTick(const ros::TimerEvent&) {
+void PlannerRos::onTick() {
   if (!active_ || !have_odom_ || path_.empty()) return;
   const double t = ros::Time::now().toSec();
   const auto& p = odom_.pose.pose.position;
@@ -275,7 +276,7 @@ void PlannerRos::onTick(const ros::TimerEvent&) {
   }
   for (const auto& k : zones) committed_.insert(k.id);
   const scenario::TrajectoryPoint sp = scenario::sampleTrajectory(path_, plan_t + lookahead_);
-  setpoint_pub_.publish(toPoseMsg(sp, ros::Time::now()));
+  gate_->publish(setpoint_pub_, toPoseMsg(sp, ros::Time::now()));
   publishProgress("following", "");
 }
 
@@ -292,7 +293,7 @@ void PlannerRos::publishProgress(const std::string& state, const std::string& me
   }
   m.replans = replans_;
   m.message = message;
-  progress_pub_.publish(m);
+  gate_->publish(progress_pub_, m);
 }
 
 }  // namespace hameritt::ros_wrappers

@@ -2,6 +2,7 @@
 
 #include <ros/callback_queue.h>
 #include <rosgraph_msgs/Clock.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 
@@ -36,6 +37,21 @@ int ratio(double physics_hz, double rate_hz, const char* name) {
   return static_cast<int>(std::round(steps));
 }
 
+// Comma-separated names, each trimmed and resolved; empty ones dropped.
+std::vector<std::string> resolvedList(const std::string& list) {
+  std::vector<std::string> out;
+  for (std::size_t a = 0; a < list.size();) {
+    std::size_t b = list.find(',', a);
+    if (b == std::string::npos) b = list.size();
+    std::string t = list.substr(a, b - a);
+    t.erase(0, t.find_first_not_of(' '));
+    t.erase(t.find_last_not_of(' ') + 1);
+    if (!t.empty()) out.push_back(ros::names::resolve(t));
+    a = b + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
@@ -60,17 +76,26 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   std::string wait_for;
   pnh.param<std::string>("wait_for", wait_for, "");
   pnh.param("wait_timeout", wait_timeout_, wait_timeout_);
-  for (std::size_t a = 0; a < wait_for.size();) {
-    std::size_t b = wait_for.find(',', a);
-    if (b == std::string::npos) b = wait_for.size();
-    std::string t = wait_for.substr(a, b - a);
-    t.erase(0, t.find_first_not_of(' '));
-    t.erase(t.find_last_not_of(' ') + 1);
-    if (!t.empty()) wait_for_.push_back(ros::names::resolve(t));
-    a = b + 1;
-  }
+  wait_for_ = resolvedList(wait_for);
   steps_per_publish_ = ratio(settings.physics_rate_hz, publish_hz, "publish_rate_hz");
   steps_per_ground_truth_ = ratio(settings.physics_rate_hz, truth_hz, "ground_truth_rate_hz");
+  gate_ = std::make_unique<LockstepGate>(nh, pnh, LockstepGate::Role::kCoordinator);
+  if (gate_->enabled()) {
+    std::string participants;
+    pnh.param<std::string>("lockstep_participants", participants, "");
+    lockstep_participants_ = resolvedList(participants);
+    double period = 0.02;
+    pnh.param("lockstep_period", period, period);
+    const double steps = period * settings.physics_rate_hz;
+    if (!(steps >= 1 && std::abs(steps - std::round(steps)) < 1e-6 &&
+          static_cast<long>(std::round(steps)) % steps_per_publish_ == 0)) {
+      throw scenario::ConfigError(
+          "~lockstep_period: expected a multiple of the publish period (" +
+          std::to_string(steps_per_publish_ / settings.physics_rate_hz) + " s), got " +
+          std::to_string(period));
+    }
+    steps_per_cycle_ = static_cast<int>(std::round(steps));
+  }
 
   config_ = scenario::loadSimConfig(sim_config);
   if (duration_ <= 0) duration_ = config_.duration;
@@ -124,6 +149,7 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     if (co.queue_depth < 1) {
       throw scenario::ConfigError("~render_queue_depth: expected >= 1, got " + std::to_string(co.queue_depth));
     }
+    co.gate = gate_.get();
     cameras_ = std::make_unique<CameraRig>(nh, *world_, config_, co);
     ROS_INFO("simulator: %zu cameras rendered with %s", config_.uav.cameras.size(),
              cameras_->glRenderer().c_str());
@@ -131,18 +157,23 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 
   // A lock-step call publishes a burst of ticks at once: with a queue of 10, a recorder lost
   // about half of them at 25 ticks per call (test_mission_replay), differently in every run.
-  clock_pub_ = nh.advertise<rosgraph_msgs::Clock>("/clock", 1000);
-  odom_pub_ = nh.advertise<nav_msgs::Odometry>("uav/odom", 50);
-  imu_pub_ = nh.advertise<sensor_msgs::Imu>("uav/imu", 50);
-  truth_pub_ = nh.advertise<hameritt::EntityStateArray>("ground_truth/entities", 10);
-  crash_pub_ = nh.advertise<hameritt::CrashEvent>("uav/crash", 1, true);
-  vel_sub_ = nh.subscribe("uav/cmd_vel", 10, &SimulatorRos::onVelocity, this);
-  pose_sub_ = nh.subscribe("uav/cmd_pose", 10, &SimulatorRos::onPose, this);
+  clock_pub_ = gate_->advertise<rosgraph_msgs::Clock>(nh, "/clock", 1000);
+  odom_pub_ = gate_->advertise<nav_msgs::Odometry>(nh, "uav/odom", 50);
+  imu_pub_ = gate_->advertise<sensor_msgs::Imu>(nh, "uav/imu", 50);
+  truth_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "ground_truth/entities", 10);
+  crash_pub_ = gate_->advertise<hameritt::CrashEvent>(nh, "uav/crash", 1, true);
+  // The tf broadcasters' topics (the same publications as theirs), for the connect phase.
+  tf_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf", 100);
+  tf_static_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf_static", 100, true);
+  vel_sub_ = gate_->subscribe(nh, "uav/cmd_vel", 10, &SimulatorRos::onVelocity, this);
+  pose_sub_ = gate_->subscribe(nh, "uav/cmd_pose", 10, &SimulatorRos::onPose, this);
   step_srv_ = pnh.advertiseService("step", &SimulatorRos::onStep, this);
   pause_srv_ = pnh.advertiseService("set_paused", &SimulatorRos::onPause, this);
   reset_srv_ = pnh.advertiseService("reset", &SimulatorRos::onReset, this);
   publishStaticFrames();
-  publishState(true);
+  // In lock-step nothing is published before the connect phase but latched messages (a
+  // subscriber that connects later gets exactly the one message counted).
+  if (!gate_->enabled()) publishState(true);
   ROS_INFO("simulator: %s, %zu world entities, %zu scenario entities, %.0f Hz physics, %s",
            config_.scenario_id.c_str(), world_->entities().size(), config_.entities.size(),
            settings.physics_rate_hz, paused_ ? "paused" : "running");
@@ -157,6 +188,7 @@ void SimulatorRos::publishStaticFrames() {
     }
   }
   static_tf_.sendTransform(frames);
+  gate_->count("/tf_static");
 }
 
 void SimulatorRos::publishGroundTruth() {
@@ -170,8 +202,11 @@ void SimulatorRos::publishGroundTruth() {
     truth.entities.push_back(toMsg(e, stamp));
     if (e.role != "static") tfs.push_back(toEntityTransform(e, stamp));
   }
-  truth_pub_.publish(truth);
-  if (!tfs.empty()) tf_.sendTransform(tfs);
+  gate_->publish(truth_pub_, truth);
+  if (!tfs.empty()) {
+    tf_.sendTransform(tfs);
+    gate_->count("/tf");
+  }
 }
 
 void SimulatorRos::publishState(bool force_ground_truth) {
@@ -180,10 +215,11 @@ void SimulatorRos::publishState(bool force_ground_truth) {
   stamp.fromSec(s.t);
   rosgraph_msgs::Clock clock;
   clock.clock = stamp;
-  clock_pub_.publish(clock);
-  odom_pub_.publish(toOdometryMsg(s, stamp));
-  imu_pub_.publish(toImuMsg(s, stamp));
+  gate_->publish(clock_pub_, clock);
+  gate_->publish(odom_pub_, toOdometryMsg(s, stamp));
+  gate_->publish(imu_pub_, toImuMsg(s, stamp));
   tf_.sendTransform(toBaseTransform(s, stamp));
+  gate_->count("/tf");
   if (force_ground_truth) publishGroundTruth();
   if (s.crashed && !crash_reported_) {
     crash_reported_ = true;
@@ -195,7 +231,7 @@ void SimulatorRos::publishState(bool force_ground_truth) {
     ev.position.y = s.position.y();
     ev.position.z = s.position.z();
     ev.speed = s.velocity.norm();
-    crash_pub_.publish(ev);
+    gate_->publish(crash_pub_, ev);
     ROS_WARN("simulator: UAV crashed into %s at t=%.3f s", s.crashed_into.c_str(), s.crash_time);
   }
 }
@@ -248,7 +284,58 @@ void SimulatorRos::waitForSubscribers() {
   }
 }
 
+void SimulatorRos::spinLockstep() {
+  waitForSubscribers();
+  if (!gate_->start(lockstep_participants_)) return;
+  const ros::WallTime run_start = ros::WallTime::now();
+  ros::WallTime wall_start = run_start;
+  double sim_start = sim_->time();
+  double next_report = 10.0;
+  std::uint64_t cycle = 0;
+  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+  bool ended = false;
+  while (ros::ok()) {
+    if (!ended && sim_->time() >= duration_) {
+      ended = true;
+      ROS_INFO("simulator: lock-step: stopped at the duration, sim %.3f s, cycle %llu, in wall "
+               "%.1f s; %zu participants left",
+               sim_->time(), static_cast<unsigned long long>(cycle),
+               (ros::WallTime::now() - run_start).toSec(), gate_->participants().size());
+    }
+    if (paused_ || sim_->time() >= duration_) {
+      queue->callAvailable(ros::WallDuration(0.01));
+      sim_start = sim_->time();
+      wall_start = ros::WallTime::now();
+      continue;
+    }
+    gate_->beforeCycle();
+    advance(steps_per_cycle_);
+    if (cameras_) cameras_->flush();
+    ros::Time stamp;
+    stamp.fromSec(sim_->time());
+    if (!gate_->afterCycle(++cycle, stamp)) break;
+    if (sim_->time() >= next_report) {
+      const double wall = (ros::WallTime::now() - run_start).toSec();
+      ROS_INFO("simulator: lock-step cycle %llu, sim %.1f s in wall %.1f s (%.2fx real time), %zu "
+               "participants",
+               static_cast<unsigned long long>(cycle), sim_->time(), wall,
+               sim_->time() / std::max(wall, 1e-9), gate_->participants().size());
+      next_report += 10.0;
+    }
+    queue->callAvailable(ros::WallDuration(0));
+    if (real_time_factor_ > 0) {
+      const double due = (sim_->time() - sim_start) / real_time_factor_;
+      const double ahead = due - (ros::WallTime::now() - wall_start).toSec();
+      if (ahead > 0) ros::WallDuration(ahead).sleep();
+    }
+  }
+}
+
 void SimulatorRos::spin() {
+  if (gate_->enabled()) {
+    spinLockstep();
+    return;
+  }
   waitForSubscribers();
   ros::WallTime wall_start = ros::WallTime::now();
   double sim_start = sim_->time();

@@ -23,6 +23,7 @@
 #include "hameritt/adk/coverage.h"
 #include "hameritt/adk/detection_scoring.h"
 #include "hameritt/adk/metrics.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 
@@ -58,7 +59,6 @@ class AdkRos {
   void onCrash(const hameritt::CrashEvent::ConstPtr& msg);
   void onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
-  void onStateTimer(const ros::WallTimerEvent&);
 
   // Scenario entities at time t (ground truth history when there is one, else their
   // sim_config trajectories) and parked world cars.
@@ -72,6 +72,8 @@ class AdkRos {
   // Configuration.
   scenario::Mission mission_;
   scenario::SimConfig sim_config_;
+  // First, destroyed last: the subscriptions and periodic work go through it.
+  std::unique_ptr<LockstepGate> gate_;
   std::unique_ptr<scenario::World> world_;
   std::string mode_, output_dir_;
   bool perfect_perception_ = false;
@@ -108,7 +110,6 @@ class AdkRos {
       scores_pub_, state_pub_, metrics_pub_;
   ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_;
   std::vector<ros::Subscriber> box_subs_;
-  ros::WallTimer state_timer_;
 };
 
 }  // namespace hameritt::ros_wrappers

@@ -28,6 +28,8 @@ struct FrameSet;
 
 namespace hameritt::ros_wrappers {
 
+class LockstepGate;
+
 struct CameraRigOptions {
   std::string backend = "auto";  // EGL backend (render::RendererOptions::backend)
   std::string models_dir;        // "" = the package's models/
@@ -54,6 +56,8 @@ struct CameraRigOptions {
   // Also publish the compact stream as sensor_msgs/CompressedImage PNG on <topic>/compressed
   // (ros_wrappers::toPngCompressed; depth only as 16UC1), at this zlib level (0-9; < 0: off).
   int decimated_png_level = -1;
+  // Lock-step missions: every publisher is watched and every message counted (not owned).
+  LockstepGate* gate = nullptr;
 };
 
 class CameraRig {

@@ -3,7 +3,7 @@
 // UAV's cameras, with the symbolic context (clients::ContextFilter over the public map) rejecting
 // look-alikes, publishing one hameritt/Detection per candidate location.
 
-#include <message_filters/subscriber.h>
+#include <message_filters/pass_through.h>
 #include <message_filters/time_synchronizer.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -22,6 +22,7 @@
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/color_detector.h"
 #include "hameritt/clients/context_filter.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 
@@ -44,6 +45,8 @@ class ColorShapeDetectorRos {
  public:
   // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
   ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  // Serves callbacks until shutdown (in turns when ~lockstep).
+  void spin() { gate_->spin(); }
 
  private:
   struct Camera {
@@ -51,9 +54,11 @@ class ColorShapeDetectorRos {
     scenario::CameraSpec spec;
     std::optional<clients::PinholeCamera> intrinsics;  // from camera_info
     double last_processed = -1e18;
-    std::unique_ptr<message_filters::Subscriber<sensor_msgs::Image>> image_sub, depth_sub;
+    // The subscriptions feed the pass-throughs, the pass-throughs the synchronizer (the
+    // subscriptions are declared last, so they go first).
+    message_filters::PassThrough<sensor_msgs::Image> image_in, depth_in;
     std::unique_ptr<message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::Image>> sync;
-    ros::Subscriber info_sub;
+    ros::Subscriber image_sub, depth_sub, info_sub;
   };
 
   void onMission(const hameritt::Mission::ConstPtr& msg);
@@ -64,6 +69,8 @@ class ColorShapeDetectorRos {
   std::optional<Eigen::Isometry3d> cameraPose(const Camera& camera,
                                               const sensor_msgs::Image& image) const;
 
+  // First, destroyed last: the subscriptions go through it.
+  std::unique_ptr<LockstepGate> gate_;
   scenario::SimConfig sim_;  // public part only
   std::unique_ptr<scenario::World> world_;
   clients::ContextSettings context_settings_;
@@ -75,7 +82,9 @@ class ColorShapeDetectorRos {
   bool ended_ = false;
 
   tf2_ros::Buffer tf_;
-  tf2_ros::TransformListener tf_listener_{tf_};
+  // Fills tf_ on its own thread; in lock-step, gated /tf and /tf_static subscriptions do.
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Subscriber tf_sub_, tf_static_sub_;
   std::vector<std::unique_ptr<Camera>> cameras_;
   ros::Publisher detection_pub_;
   ros::Subscriber mission_sub_, state_sub_;

@@ -21,6 +21,7 @@
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/context_filter.h"
 #include "hameritt/clients/coverage.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 
@@ -42,6 +43,8 @@ class CoverageSearchClientRos {
  public:
   // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
   CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  // Serves callbacks until shutdown (in turns when ~lockstep).
+  void spin() { gate_->spin(); }
 
  private:
   void onMission(const hameritt::Mission::ConstPtr& msg);
@@ -50,7 +53,7 @@ class CoverageSearchClientRos {
   void onState(const topic_tools::ShapeShifter::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
   void onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg);
-  void onTick(const ros::TimerEvent&);
+  void onTick();
 
   double missionTime() const;
   void replan(const std::string& why);
@@ -62,6 +65,8 @@ class CoverageSearchClientRos {
   void publishPlan();
 
   scenario::SimConfig sim_;  // public part only
+  // First, destroyed last: the subscriptions and the tick go through it.
+  std::unique_ptr<LockstepGate> gate_;
   std::unique_ptr<scenario::World> world_;
   clients::CoverageSettings settings_;
   std::optional<scenario::Mission> mission_;
@@ -81,7 +86,6 @@ class CoverageSearchClientRos {
 
   ros::Publisher waypoints_pub_, plan_pub_, detection_pub_;
   ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_;
-  ros::Timer timer_;
 };
 
 }  // namespace hameritt::ros_wrappers

@@ -15,6 +15,7 @@
 #include "hameritt/PlanPath.h"
 #include "hameritt/planning/uav_planner.h"
 #include "hameritt/planning/validity.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 
@@ -35,12 +36,14 @@ class PlannerRos {
  public:
   // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
   PlannerRos(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  // Serves callbacks until shutdown (in turns when ~lockstep).
+  void spin() { gate_->spin(); }
 
  private:
   bool onPlan(hameritt::PlanPath::Request& req, hameritt::PlanPath::Response& res);
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   void onWaypoints(const nav_msgs::Path::ConstPtr& msg);
-  void onTick(const ros::TimerEvent&);
+  void onTick();
   // Keep-out zones the follower commits to at time t: active now or opening within the horizon.
   std::vector<scenario::KeepOutZone> committedZones(double t) const;
   bool replan(double t, const std::string& why);
@@ -48,6 +51,8 @@ class PlannerRos {
 
   scenario::Mission mission_;
   scenario::SimConfig sim_;
+  // First, destroyed last: the subscriptions and the tick go through it.
+  std::unique_ptr<LockstepGate> gate_;
   std::unique_ptr<scenario::World> world_;
   planning::ValiditySettings validity_settings_;
   std::unique_ptr<planning::WorldValidity> full_validity_;
@@ -70,7 +75,6 @@ class PlannerRos {
   ros::Publisher setpoint_pub_, path_pub_, progress_pub_;
   ros::Subscriber odom_sub_, waypoints_sub_;
   ros::ServiceServer plan_srv_;
-  ros::Timer timer_;
 };
 
 }  // namespace hameritt::ros_wrappers

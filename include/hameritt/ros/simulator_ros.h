@@ -15,6 +15,7 @@
 #include "hameritt/SetPaused.h"
 #include "hameritt/StepSimulation.h"
 #include "hameritt/ros/camera_rig.h"
+#include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 #include "hameritt/sim/setpoint_guard.h"
@@ -35,7 +36,10 @@ namespace hameritt::ros_wrappers {
 //   ~record_image_rate (0: also publish camera images decimated to this rate for recording),
 //   ~wait_for (comma-separated topics of this node; the clock starts once each has a
 //   subscriber, or after ~wait_timeout wall seconds, 60), ~geofence_margin (50 m: the UAV is
-//   kept inside the neighborhood bounds grown by this and below altitude_max + this).
+//   kept inside the neighborhood bounds grown by this and below altitude_max + this),
+//   ~lockstep (false: README "Lock-step missions"; the simulator coordinates the turns of
+//   ~lockstep_participants, comma-separated node names in turn order, every ~lockstep_period
+//   s of sim time, 0.02, a multiple of the publish period; ~lockstep_timeout wall s, 120).
 class SimulatorRos {
  public:
   // Throws scenario::ConfigError (bad parameters or sim_config): the node exits with ROS_FATAL.
@@ -46,6 +50,8 @@ class SimulatorRos {
 
  private:
   void advance(int steps);
+  // The lock-step loop (~lockstep true).
+  void spinLockstep();
   // Re-applies the last velocity command through the geofence (every publish tick).
   void applyVelocity();
   void waitForSubscribers();
@@ -59,6 +65,10 @@ class SimulatorRos {
   bool onPause(hameritt::SetPaused::Request& req, hameritt::SetPaused::Response& res);
   bool onReset(hameritt::ResetSimulation::Request& req, hameritt::ResetSimulation::Response& res);
 
+  // Declared first: the subscriptions and publishers below go through it.
+  std::unique_ptr<LockstepGate> gate_;
+  std::vector<std::string> lockstep_participants_;
+  int steps_per_cycle_ = 10;
   scenario::SimConfig config_;
   std::unique_ptr<scenario::World> world_;
   std::unique_ptr<sim::Simulator> sim_;
@@ -78,7 +88,7 @@ class SimulatorRos {
   int steps_per_ground_truth_ = 1;
   long long step_count_ = 0;
 
-  ros::Publisher clock_pub_, odom_pub_, imu_pub_, truth_pub_, crash_pub_;
+  ros::Publisher clock_pub_, odom_pub_, imu_pub_, truth_pub_, crash_pub_, tf_watch_, tf_static_watch_;
   ros::Subscriber vel_sub_, pose_sub_;
   ros::ServiceServer step_srv_, pause_srv_, reset_srv_;
   tf2_ros::TransformBroadcaster tf_;
