@@ -9,7 +9,11 @@ reported a dropped message. Prints the real-time factor and per-topic counts.
 
   /usr/bin/python3 bench/bench_mission.py [--sim-seconds 60] [--real-time-factor 0]
       [--record-all] [--record-png] [--record-depth 16UC1|32FC1] [--record-rgb-noise]
-      [--compression lz4|bz2] [--mode end_to_end] [--out DIR]
+      [--compression lz4|bz2] [--mode end_to_end] [--lockstep [--lockstep-period 0.02]]
+      [--out DIR]
+
+With --lockstep the mission runs in lock-step (README "Lock-step missions"; the simulator stops
+at --sim-seconds) and the real-time factor is the lock-step loop's.
 
 Also prints the bag's MB per sim second and its bytes per topic group (uncompressed), so that
 the recording's size can be traced to its streams.
@@ -55,6 +59,8 @@ def main():
     ap.add_argument("--record-rgb-noise", action="store_true", help="compact colour image with noise")
     ap.add_argument("--compression", default="lz4", choices=["lz4", "bz2"])
     ap.add_argument("--mode", default="end_to_end")
+    ap.add_argument("--lockstep", action="store_true", help="run the mission in lock-step")
+    ap.add_argument("--lockstep-period", type=float, default=0.02)
     ap.add_argument("--out", default="")
     args = ap.parse_args()
 
@@ -70,6 +76,9 @@ def main():
            "record_rgb_noise:=" + ("true" if args.record_rgb_noise else "false"),
            "real_time_factor:=%g" % args.real_time_factor, "time_limit:=%g" % args.sim_seconds,
            "record_compression:=" + args.compression, "output_dir:=" + out]
+    if args.lockstep:
+        cmd += ["lockstep:=true", "lockstep_period:=%g" % args.lockstep_period,
+                "duration:=%g" % args.sim_seconds]
     log_path = os.path.join(out, "roslaunch.log")
     t0 = time.time()
     recorder = {}
@@ -127,9 +136,12 @@ def main():
     missing = {t: (e, counts.get(t, 0)) for t, e in expected.items() if counts.get(t, 0) < e}
     # The simulator logs sim time against wall time since its clock started, every 10 sim s.
     m = re.findall(r"simulator: sim ([0-9.]+) s in wall ([0-9.]+) s", log_text)
+    # In lock-step: once the simulator stops at the duration.
+    m += re.findall(r"lock-step: stopped at the duration, sim ([0-9.]+) s, cycle \d+, in wall ([0-9.]+) s",
+                    log_text)
     rt_sim, rt_wall = (float(m[-1][0]), float(m[-1][1])) if m else (sim_seconds, wall_total)
     size_mb = os.path.getsize(bag_path) / 1e6
-    print("scenario:      %s (mode %s, %s recording%s)" % (cfg["scenario_id"], args.mode, "full" if args.record_all else "compact", "" if args.record_all else ", depth %s, colour %s%s, %s chunks" % (args.record_depth, "noisy" if args.record_rgb_noise else "noise-free", ", PNG" if args.record_png else "", args.compression)))
+    print("scenario:      %s (mode %s%s, %s recording%s)" % (cfg["scenario_id"], args.mode, ", lock-step %g s" % args.lockstep_period if args.lockstep else "", "full" if args.record_all else "compact", "" if args.record_all else ", depth %s, colour %s%s, %s chunks" % (args.record_depth, "noisy" if args.record_rgb_noise else "noise-free", ", PNG" if args.record_png else "", args.compression)))
     print("sim time:      %.1f s; simulator clock: %.1f sim s in %.1f wall s -> real-time factor %.2fx (launch total %.1f s wall)" % (sim_seconds, rt_sim, rt_wall, rt_sim / max(rt_wall, 1e-9), wall_total))
     print("bag:           %.1f MB (%.2f MB per sim second), %d topics" % (size_mb, size_mb / max(sim_seconds, 1e-9), len(counts)))
     print("rosbag drops:  %d 'Dropping' warnings" % dropped_log)
