@@ -29,6 +29,8 @@ import time
 import rosbag
 import rosgraph
 
+from graph_util import subscribed, wait_for  # test/scripts/graph_util.py
+
 SRC = os.environ["HAMERITT_SOURCE_DIR"]
 PORT = 18000 + os.getpid() % 2000
 os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
@@ -47,23 +49,6 @@ MUST = ["/clock", "/uav/odom", "/ground_truth/entities", "/mission", "/adk/state
         "/adk/constraints", "/uav/cmd_pose", "/planner/path", "/planner/progress",
         "/planner/waypoints", "/uav/camera/down/image_raw", "/uav/camera/front/boxes"]
 MODES = [("end_to_end", 6.0, []), ("maneuver_only", 5.0, ["/adk/perfect_perception"])]
-
-
-def wait_for(cond, seconds, what):
-    end = time.time() + seconds
-    while time.time() < end:
-        if cond():
-            return
-        time.sleep(0.05)
-    raise RuntimeError("timed out waiting for " + what)
-
-
-def subscribed(node):
-    try:
-        _, subs, _ = rosgraph.Master("/lockstep_replay").getSystemState()
-    except Exception:
-        return set()
-    return {t for t, nodes in subs if node in nodes}
 
 
 def run_mission(base, name, mode, limit, period=0.02):

@@ -23,6 +23,8 @@ from geometry_msgs.msg import Twist
 
 from hameritt.srv import StepSimulation
 
+from graph_util import subscribed, wait_for  # test/scripts/graph_util.py
+
 SRC = os.environ["HAMERITT_SOURCE_DIR"]
 PORT = 16000 + os.getpid() % 2000
 os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
@@ -33,23 +35,6 @@ for cam in ["down", "front"]:
 # (sim time from which it holds, vx, vy, vz, yaw rate)
 SCHEDULE = [(0.0, 0.0, 0.0, 2.0, 0.0), (1.0, 3.0, 1.0, 1.0, 0.3), (2.0, -2.0, 2.5, 0.0, -0.5)]
 STEPS, CHUNK = 1500, 50
-
-
-def wait_for(cond, seconds, what):
-    end = time.time() + seconds
-    while time.time() < end:
-        if cond():
-            return
-        time.sleep(0.05)
-    raise RuntimeError("timed out waiting for " + what)
-
-
-def subscribed(node):
-    try:
-        _, subs, _ = rosgraph.Master("/replay").getSystemState()
-    except Exception:
-        return set()
-    return {t for t, nodes in subs if node in nodes}
 
 
 def record_run(out, bag_path):
