@@ -60,6 +60,7 @@ LockstepGate::LockstepGate(ros::NodeHandle& nh, ros::NodeHandle& pnh, Role role)
     ops.init<hameritt::LockstepTurn>(
         kTurnTopic, 100, [this](const hameritt::LockstepTurn::ConstPtr& m) { onTurnMsg(m); });
     ops.callback_queue = &recv_queue_;
+    ops.transport_hints = ros::TransportHints().tcpNoDelay();
     turn_sub_ = nh.subscribe(ops);
     ack_pub_ = nh.advertise<hameritt::LockstepAck>(kAckTopic, 100);
   } else {
@@ -68,6 +69,7 @@ LockstepGate::LockstepGate(ros::NodeHandle& nh, ros::NodeHandle& pnh, Role role)
     ops.init<hameritt::LockstepAck>(kAckTopic, 1000,
                                     [this](const hameritt::LockstepAck::ConstPtr& m) { onAck(m); });
     ops.callback_queue = &recv_queue_;
+    ops.transport_hints = ros::TransportHints().tcpNoDelay();
     ack_sub_ = nh.subscribe(ops);
   }
   recv_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &recv_queue_);

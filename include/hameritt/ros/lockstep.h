@@ -185,6 +185,8 @@ ros::Subscriber LockstepGate::subscribe(ros::NodeHandle& nh, const std::string& 
         receive(index, ev.getPublisherName(), [fn, msg] { fn(msg); });
       });
   ops.callback_queue = &recv_queue_;
+  // Small messages go out at once (no Nagle delay): every turn waits for them.
+  ops.transport_hints = ros::TransportHints().tcpNoDelay();
   ros::Subscriber s = nh.subscribe(ops);
   watched_.push_back({s.getTopic(), false, [s] { return static_cast<int>(s.getNumPublishers()); }});
   return s;
