@@ -78,6 +78,11 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     throw ConfigError("~clock_timeout: expected wall seconds in [0, 3600] (0 = off), got " +
                       scenario::formatNumber(clock_timeout));
   }
+  if (gate_->enabled() && clock_timeout > 0) {
+    // In lock-step the clock also waits while another participant takes its turn, which the
+    // simulator allows for up to the lock-step timeout: only a longer silence is a stall.
+    clock_timeout = std::max(clock_timeout, gate_->timeout() + 10.0);
+  }
   watchdog_ = std::make_unique<adk::ClockWatchdog>(clock_timeout);
   adk::ScoringSettings scoring;
   pnh.param("car_gate", scoring.car_gate, scoring.car_gate);

@@ -50,6 +50,8 @@ class LockstepGate {
   LockstepGate& operator=(const LockstepGate&) = delete;
 
   bool enabled() const { return enabled_; }
+  // Wall seconds a turn, an ack or a connection is waited for.
+  double timeout() const { return timeout_; }
 
   // A subscription whose callback runs at once (off) or in this node's turns (lock-step).
   template <class M>
