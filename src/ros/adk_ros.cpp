@@ -3,6 +3,7 @@
 #include <ros/callback_queue.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
