@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -188,6 +189,19 @@ char* digitsBefore(U a, char* end) {
   return q;
 }
 
+// The decimal digits of v < 10^8, most significant first, one per byte (values 0-9), all
+// eight computed at once: v is split into two halves of four digits in 32-bit lanes, each half
+// into two pairs in 16-bit lanes, each pair into two digits in bytes (division by 100 and by 10
+// as multiply-and-shift, exact in these ranges).
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "eightDigits: byte 0 is written first");
+inline std::uint64_t eightDigits(std::uint32_t v) {
+  const std::uint64_t x = (v / 10000) | (static_cast<std::uint64_t>(v % 10000) << 32);
+  const std::uint64_t hundreds = ((x * 10486) >> 20) & 0x0000007F0000007FULL;
+  const std::uint64_t pairs = hundreds | ((x - 100 * hundreds) << 16);
+  const std::uint64_t tens = ((pairs * 103) >> 10) & 0x000F000F000F000FULL;
+  return tens | ((pairs - 10 * tens) << 8);
+}
+
 // Writes a finite number at p (room for 40 characters); returns the end.
 char* writeNumber(double d, char* p) {
   if (d == 0.0) d = 0.0;  // no "-0"
@@ -205,6 +219,24 @@ char* writeNumber(double d, char* p) {
     if (static_cast<double>(k) / 1000.0 == d) {
       unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
       if (k < 0) *p++ = '-';
+      if (a < 100000000ULL) {
+        // Up to 99999.999 (nearly every value): the eight digits with leading zeros, then the
+        // whole part from its first non-zero digit (at least the units) and the fraction
+        // without its trailing zeros, as below. Copies write 8 and 4 bytes; bytes past the
+        // number are overwritten later or lie past the returned end.
+        const std::uint64_t digits = eightDigits(static_cast<std::uint32_t>(a));
+        const int lead = digits == 0 ? 4 : std::min(4, __builtin_ctzll(digits) / 8);
+        const std::uint64_t text = (digits + 0x3030303030303030ULL) >> (8 * lead);
+        std::memcpy(p, &text, 8);
+        p += 5 - lead;
+        const std::uint64_t frac = digits >> 40;  // the three fraction digits, first in byte 0
+        if (frac != 0) {
+          const std::uint32_t tail = '.' | static_cast<std::uint32_t>((frac + 0x303030) << 8);
+          std::memcpy(p, &tail, 4);
+          p += 2 + (63 - __builtin_clzll(frac)) / 8;  // up to the last non-zero digit
+        }
+        return p;
+      }
       // All digits of a (at least four), two at a time from a table, then the whole part,
       // the point and the fraction without its trailing zeros. Copies have fixed sizes
       // (inlined); bytes past the number are overwritten later or lie past the returned end.
