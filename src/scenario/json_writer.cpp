@@ -28,12 +28,16 @@ void JsonWriter::newline() {
   if (!pretty_ || inline_depth_ > 0) return;
   const std::size_t n = 1 + 2 * has_items_.size();
   if (n + 1 <= kCommaIndent.size()) {
-    out_.append(kCommaIndent.data() + 1, n);
+    put(kCommaIndent.data() + 1, n);
   } else {
-    out_ += '\n';
-    out_.append(n - 1, ' ');
+    char* p = room(n);
+    p[0] = '\n';
+    std::memset(p + 1, ' ', n - 1);
+    len_ += n;
   }
 }
+
+void JsonWriter::grow(std::size_t n) { out_.resize(std::max(2 * out_.size(), len_ + n)); }
 
 void JsonWriter::separate() {
   if (after_key_) {
@@ -46,12 +50,12 @@ void JsonWriter::separate() {
     const std::size_t n = 2 + 2 * has_items_.size();  // comma, newline, indent
     if (pretty_ && inline_depth_ == 0 && n <= kCommaIndent.size()) {
       // The comma (if any), the newline and the indent in one append.
-      out_.append(kCommaIndent.data() + (had ? 0 : 1), had ? n : n - 1);
+      put(kCommaIndent.data() + (had ? 0 : 1), had ? n : n - 1);
       return;
     }
     if (had) {
-      out_ += ',';
-      if (inline_depth_ > 0 && pretty_) out_ += ' ';
+      put(',');
+      if (inline_depth_ > 0 && pretty_) put(' ');
     }
     newline();
   }
@@ -59,7 +63,7 @@ void JsonWriter::separate() {
 
 JsonWriter& JsonWriter::beginObject() {
   separate();
-  out_ += '{';
+  put('{');
   has_items_.push_back(false);
   return *this;
 }
@@ -68,13 +72,13 @@ JsonWriter& JsonWriter::endObject() {
   const bool had = has_items_.back();
   has_items_.pop_back();
   if (had) newline();
-  out_ += '}';
+  put('}');
   return *this;
 }
 
 JsonWriter& JsonWriter::beginArray() {
   separate();
-  out_ += '[';
+  put('[');
   has_items_.push_back(false);
   return *this;
 }
@@ -83,78 +87,79 @@ JsonWriter& JsonWriter::endArray() {
   const bool had = has_items_.back();
   has_items_.pop_back();
   if (had) newline();
-  out_ += ']';
+  put(']');
   return *this;
 }
 
 JsonWriter& JsonWriter::key(std::string_view k) {
   separate();
   after_key_ = true;
-  char buf[96];
-  if (k.size() + 4 <= sizeof(buf) && plainText(k)) {
-    // The quoted key and the colon in one append.
+  if (plainText(k)) {
+    // The quoted key and the colon written at once.
+    char* const p = room(k.size() + 4);
     std::size_t n = 0;
-    buf[n++] = '"';
-    std::memcpy(buf + n, k.data(), k.size());
+    p[n++] = '"';
+    std::memcpy(p + n, k.data(), k.size());
     n += k.size();
-    buf[n++] = '"';
-    buf[n++] = ':';
-    if (pretty_) buf[n++] = ' ';
-    out_.append(buf, n);
+    p[n++] = '"';
+    p[n++] = ':';
+    if (pretty_) p[n++] = ' ';
+    len_ += n;
     return *this;
   }
   escape(k);
-  out_ += pretty_ ? ": " : ":";
+  if (pretty_) put(": ", 2);
+  else put(':');
   return *this;
 }
 
 void JsonWriter::escape(std::string_view s) {
-  out_ += '"';
+  put('"');
   // Plain text (the usual case: ids, keys, names) is copied at once.
   if (plainText(s)) {
-    out_.append(s);
-    out_ += '"';
+    put(s.data(), s.size());
+    put('"');
     return;
   }
   for (char c : s) {
     switch (c) {
       case '"':
-        out_ += "\\\"";
+        put("\\\"", 2);
         break;
       case '\\':
-        out_ += "\\\\";
+        put("\\\\", 2);
         break;
       case '\n':
-        out_ += "\\n";
+        put("\\n", 2);
         break;
       case '\t':
-        out_ += "\\t";
+        put("\\t", 2);
         break;
       case '\r':
-        out_ += "\\r";
+        put("\\r", 2);
         break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
           std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-          out_ += buf;
+          put(buf, 6);
         } else {
-          out_ += c;
+          put(c);
         }
     }
   }
-  out_ += '"';
+  put('"');
 }
 
 JsonWriter& JsonWriter::value(std::string_view s) {
   separate();
-  char buf[96];
-  if (s.size() + 2 <= sizeof(buf) && plainText(s)) {
-    // A short plain string with its quotes in one append.
-    buf[0] = '"';
-    std::memcpy(buf + 1, s.data(), s.size());
-    buf[s.size() + 1] = '"';
-    out_.append(buf, s.size() + 2);
+  if (plainText(s)) {
+    // A plain string with its quotes written at once.
+    char* const p = room(s.size() + 2);
+    p[0] = '"';
+    std::memcpy(p + 1, s.data(), s.size());
+    p[s.size() + 1] = '"';
+    len_ += s.size() + 2;
     return *this;
   }
   escape(s);
@@ -265,58 +270,57 @@ char* writeNumber(double d, char* p) {
 JsonWriter& JsonWriter::value(double d) {
   if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   separate();
-  char buf[40];
-  out_.append(buf, writeNumber(d, buf));
+  char* const p = room(40);
+  len_ += static_cast<std::size_t>(writeNumber(d, p) - p);
   return *this;
 }
 
 JsonWriter& JsonWriter::value(std::int64_t i) {
   separate();
-  out_ += std::to_string(i);
+  char* const p = room(24);
+  len_ += static_cast<std::size_t>(std::to_chars(p, p + 24, i).ptr - p);
   return *this;
 }
 
 JsonWriter& JsonWriter::value(std::uint64_t u) {
   separate();
-  out_ += std::to_string(u);
+  char* const p = room(24);
+  len_ += static_cast<std::size_t>(std::to_chars(p, p + 24, u).ptr - p);
   return *this;
 }
 
 JsonWriter& JsonWriter::value(bool b) {
   separate();
-  out_ += b ? "true" : "false";
+  if (b) put("true", 4);
+  else put("false", 5);
   return *this;
 }
 
 JsonWriter& JsonWriter::null() {
   separate();
-  out_ += "null";
+  put("null", 4);
   return *this;
 }
 
 // The same characters as beginArray(), value() per number and the closing bracket, formatted
-// into one buffer and appended at once.
+// straight into the document (room for 48 characters per number is made first).
 JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
   for (double d : v) {
     if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   }
   separate();
-  char buf[512];
-  std::size_t k = 0;
-  buf[k++] = '[';
+  char* const start = room(2 + 48 * v.size());
+  char* p = start;
+  *p++ = '[';
   for (const double* d = v.begin(); d != v.end(); ++d) {
-    if (k + 48 > sizeof(buf)) {  // long lists go out in pieces
-      out_.append(buf, k);
-      k = 0;
-    }
     if (d != v.begin()) {
-      buf[k++] = ',';
-      if (pretty_) buf[k++] = ' ';
+      *p++ = ',';
+      if (pretty_) *p++ = ' ';
     }
-    k = static_cast<std::size_t>(writeNumber(*d, buf + k) - buf);
+    p = writeNumber(*d, p);
   }
-  buf[k++] = ']';
-  out_.append(buf, k);
+  *p++ = ']';
+  len_ += static_cast<std::size_t>(p - start);
   return *this;
 }
 
