@@ -37,7 +37,13 @@ void JsonWriter::newline() {
   }
 }
 
-void JsonWriter::grow(std::size_t n) { out_.resize(std::max(2 * out_.size(), len_ + n)); }
+void JsonWriter::grow(std::size_t n) {
+  const std::size_t cap = std::max(2 * cap_, len_ + n);
+  std::unique_ptr<char[]> buf(new char[cap]);
+  std::memcpy(buf.get(), buf_.get(), len_);
+  buf_ = std::move(buf);
+  cap_ = cap;
+}
 
 void JsonWriter::separate() {
   if (after_key_) {

@@ -140,3 +140,30 @@ TEST(JsonWriterTest, MillimetreValuesMatchFixedPointText) {
   }
   EXPECT_EQ(checked, static_cast<int>(ks.size()));
 }
+
+// A writer reused after clear() (as writeScenarioDir() reuses one per thread) writes the same
+// bytes as a fresh one, also when a document outgrows its buffer; finish() is str() in place.
+TEST(JsonWriterTest, ReusedWriterWritesTheSameDocuments) {
+  const auto document = [](JsonWriter& w, int n) {
+    w.beginObject().key("name").value("doc").key("points").beginArray();
+    for (int i = 0; i < n; ++i) w.numbers({i * 0.001, -i * 1.5, 1e-7 * i});
+    w.endArray().key("last").value(std::int64_t{n}).endObject();
+  };
+  JsonWriter reused(true, 64);
+  for (int n : {3, 2000, 0, 40, 5000, 1}) {
+    JsonWriter fresh;
+    document(fresh, n);
+    reused.clear(n % 2 == 0 ? 64 * static_cast<std::size_t>(n) : 0);
+    document(reused, n);
+    const std::string expected = fresh.str();
+    ASSERT_EQ(reused.str(), expected) << n;
+    ASSERT_EQ(std::string(reused.finish()), expected) << n;
+    ASSERT_EQ(nlohmann::json::parse(expected)["points"].size(), static_cast<std::size_t>(n));
+  }
+  JsonWriter taken(false, 64);
+  document(taken, 100);
+  const std::string text = taken.take();
+  EXPECT_EQ(text.back(), '\n');
+  document(taken, 100);  // empty after take(): the same document again
+  EXPECT_EQ(taken.str(), text);
+}

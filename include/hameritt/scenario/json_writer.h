@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -18,9 +19,8 @@ namespace hameritt::scenario {
 class JsonWriter {
  public:
   // reserve: bytes to allocate up front (a good guess saves regrowing the buffer).
-  explicit JsonWriter(bool pretty = true, std::size_t reserve = 1 << 14) : pretty_(pretty) {
-    out_.resize(std::max<std::size_t>(reserve, 64));
-  }
+  explicit JsonWriter(bool pretty = true, std::size_t reserve = 1 << 14)
+      : pretty_(pretty), cap_(std::max<std::size_t>(reserve, 64)), buf_(new char[cap_]) {}
 
   JsonWriter& beginObject();
   JsonWriter& endObject();
@@ -41,13 +41,32 @@ class JsonWriter {
   JsonWriter& numbers(std::initializer_list<double> v);
 
   // The document (call after the outermost end*()); ends with a newline.
-  std::string str() const { return out_.substr(0, len_) + "\n"; }
-  // The same document as str(), moved out without a copy; the writer is empty afterwards.
+  std::string str() const {
+    std::string s;
+    s.reserve(len_ + 1);
+    s.append(buf_.get(), len_);
+    s += '\n';
+    return s;
+  }
+  // The same document as str(); the writer is empty afterwards (see clear()).
   std::string take() {
-    out_.resize(len_);
-    out_ += '\n';
+    std::string s = str();
+    clear();
+    return s;
+  }
+  // The document with its final newline, in the writer's own buffer (no copy): valid until
+  // the writer is changed or destroyed. Call once, after the outermost end*().
+  std::string_view finish() {
+    put('\n');
+    return {buf_.get(), len_};
+  }
+  // Empties the writer for a new document; its buffer is kept (and grown to at least reserve
+  // bytes), so a writer reused for document after document allocates nothing.
+  void clear(std::size_t reserve = 0) {
     len_ = 0;
-    return std::move(out_);
+    has_items_.clear();
+    after_key_ = false;
+    if (reserve > cap_) grow(reserve);
   }
 
  private:
@@ -57,8 +76,8 @@ class JsonWriter {
   // Room for n more characters at the end of the document; returns where they go (the caller
   // writes them and adds what it used to len_).
   char* room(std::size_t n) {
-    if (out_.size() - len_ < n) grow(n);
-    return out_.data() + len_;
+    if (cap_ - len_ < n) grow(n);
+    return buf_.get() + len_;
   }
   void grow(std::size_t n);
   void put(const char* s, std::size_t n) {
@@ -71,9 +90,10 @@ class JsonWriter {
   }
 
   bool pretty_;
-  // The document is out_'s first len_ characters: out_ is sized ahead (doubling when full), so
-  // that appending is a bounds check and a copy into its buffer.
-  std::string out_;
+  // The document is the first len_ characters of buf_ (cap_ bytes, not initialized; doubled
+  // when full), so that appending is a bounds check and a copy.
+  std::size_t cap_;
+  std::unique_ptr<char[]> buf_;
   std::size_t len_ = 0;
   // Per open container: whether it already has an element; and whether it is inline.
   std::vector<unsigned char> has_items_;
