@@ -181,6 +181,8 @@ void OccluderIndex::cellRange(const Aabb2& b, int* x0, int* y0, int* x1, int* y1
 // covers the tolerance rotated into the world frame) overlap.
 void OccluderIndex::build() {
   cells_.clear();
+  trig_.clear();
+  for (const OrientedBox& b : boxes_) trig_.emplace_back(std::cos(b.yaw), std::sin(b.yaw));
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
     const double pad = 2.0 * boxTolerance(boxes_[i]);
     const Aabb2 b{bounds_[i].min - Vec2::Constant(pad), bounds_[i].max + Vec2::Constant(pad)};
@@ -210,7 +212,8 @@ bool OccluderIndex::clear(const Vec3& a, const Vec3& b, const std::vector<int>& 
   if (!a.allFinite() || !b.allFinite()) throw GeometryError("OccluderIndex::clear: non-finite");
   for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>(),
                                        &t_candidates)) {
-    if (!ignored(ignore, i) && boxes_[i].intersectsSegment(a, b)) return false;
+    const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
+    if (!ignored(ignore, i) && boxes_[i].intersectsSegment(a, b, c, s)) return false;
   }
   return true;
 }
@@ -223,7 +226,10 @@ bool OccluderIndex::clear2(const Vec2& a, const Vec2& b, const std::vector<int>&
   for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a, b, &t_candidates)) {
     if (ignored(ignore, i)) continue;
     const double z = boxes_[i].center.z();
-    if (boxes_[i].intersectsSegment(Vec3(a.x(), a.y(), z), Vec3(b.x(), b.y(), z))) return false;
+    const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
+    if (boxes_[i].intersectsSegment(Vec3(a.x(), a.y(), z), Vec3(b.x(), b.y(), z), c, s)) {
+      return false;
+    }
   }
   return true;
 }
@@ -241,7 +247,7 @@ std::vector<int> OccluderIndex::near(const Vec2& p, double radius) const {
     // Exact point-to-rectangle distance in the box frame.
     const OrientedBox& b = boxes_[i];
     const Vec2 d = p - b.center2();
-    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+    const auto& [c, s] = trig_[static_cast<std::size_t>(i)];  // std::cos, std::sin of b.yaw
     const double lx = std::max(std::abs(c * d.x() + s * d.y()) - 0.5 * b.size.x(), 0.0);
     const double ly = std::max(std::abs(-s * d.x() + c * d.y()) - 0.5 * b.size.y(), 0.0);
     const double scale = std::max({1.0, p.cwiseAbs().maxCoeff(), b.size.x(), b.size.y(),

@@ -93,9 +93,14 @@ bool OrientedBox::contains(const Vec3& p) const {
 // its body frame; all intervals closed, so grazing an edge or a corner counts as touching.
 bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b) const {
   if (!a.allFinite() || !b.allFinite()) return false;
-  // toBody() for both ends, with one sine and cosine.
   double cy, sy;
   cosSin(yaw, &cy, &sy);
+  return intersectsSegment(a, b, cy, sy);
+}
+
+bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b, double cy, double sy) const {
+  if (!a.allFinite() || !b.allFinite()) return false;
+  // toBody() for both ends, with one sine and cosine.
   auto body = [&](const Vec3& w) {
     const Vec3 q = w - center;
     return Vec3(cy * q.x() + sy * q.y(), -sy * q.x() + cy * q.y(), q.z());

@@ -2,6 +2,7 @@
 // Line of sight against the static scene, accelerated by a uniform grid over the plane.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "hameritt/geometry/oriented_box.h"
@@ -42,6 +43,8 @@ class OccluderIndex {
   double cell_;
   std::vector<OrientedBox> boxes_;
   std::vector<Aabb2> bounds_;
+  // Per box: std::cos and std::sin of its yaw (filled by build()).
+  std::vector<std::pair<double, double>> trig_;
   // Sorted (cell key, box index) pairs; kept flat for speed and determinism.
   std::vector<std::pair<std::int64_t, int>> cells_;
   bool dirty_ = false;

@@ -27,6 +27,9 @@ struct OrientedBox {
   bool contains(const Vec3& p) const;
   // True when the closed 3D segment [a, b] touches the box (slab test in the box frame).
   bool intersectsSegment(const Vec3& a, const Vec3& b) const;
+  // The same test with the yaw's cosine and sine given (they must be std::cos(yaw) and
+  // std::sin(yaw)), for callers that keep them per box.
+  bool intersectsSegment(const Vec3& a, const Vec3& b, double cos_yaw, double sin_yaw) const;
   // Converts a world point into the box's body frame (origin at the centre).
   Vec3 toBody(const Vec3& p) const;
 };
