@@ -22,7 +22,7 @@ double boxTolerance(const OrientedBox& b) {
 struct YawTrig {
   std::uint64_t bits[2];
   double c[2], s[2];
-  int next;  // the entry to replace on a miss
+  int next;  // the entry to replace on a miss (the one not used last)
 };
 // Starts with yaw +0 in both entries: cos(+0) = 1 and sin(+0) = +0 exactly.
 __attribute__((tls_model("initial-exec"))) thread_local YawTrig t_last_yaw = {
@@ -39,11 +39,11 @@ inline void cosSin(double yaw, double* c, double* s) {
     i = 1;
   } else {
     i = last.next;
-    last.next = 1 - i;
     last.c[i] = std::cos(yaw);
     last.s[i] = std::sin(yaw);
     last.bits[i] = bits;
   }
+  last.next = 1 - i;  // the least recently used entry goes first
   *c = last.c[i];
   *s = last.s[i];
 }
