@@ -28,7 +28,8 @@ void JsonWriter::newline() {
   if (!pretty_ || inline_depth_ > 0) return;
   const std::size_t n = 1 + 2 * has_items_.size();
   if (n + 1 <= kCommaIndent.size()) {
-    put(kCommaIndent.data() + 1, n);
+    std::memcpy(room(kCommaIndent.size()), kCommaIndent.data() + 1, kCommaIndent.size() - 1);
+    len_ += n;
   } else {
     char* p = room(n);
     p[0] = '\n';
@@ -55,8 +56,11 @@ void JsonWriter::separate() {
     has_items_.back() = true;
     const std::size_t n = 2 + 2 * has_items_.size();  // comma, newline, indent
     if (pretty_ && inline_depth_ == 0 && n <= kCommaIndent.size()) {
-      // The comma (if any), the newline and the indent in one append.
-      put(kCommaIndent.data() + (had ? 0 : 1), had ? n : n - 1);
+      // The comma (if any), the newline and the indent in one copy of fixed size (inlined;
+      // the characters past the separator are overwritten next).
+      char* const p = room(kCommaIndent.size());
+      std::memcpy(p, kCommaIndent.data() + (had ? 0 : 1), kCommaIndent.size() - 1);
+      len_ += had ? n : n - 1;
       return;
     }
     if (had) {
