@@ -84,7 +84,14 @@ Vec3 OrientedBox::toBody(const Vec3& p) const {
 }
 
 bool OrientedBox::contains(const Vec3& p) const {
-  const Vec3 q = toBody(p).cwiseAbs();
+  double cy, sy;
+  cosSin(yaw, &cy, &sy);
+  return contains(p, cy, sy);
+}
+
+bool OrientedBox::contains(const Vec3& p, double cy, double sy) const {
+  const Vec3 d = p - center;  // toBody() with the given cosine and sine
+  const Vec3 q = Vec3(cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z()).cwiseAbs();
   const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(boxTolerance(*this));
   return q.x() <= half.x() && q.y() <= half.y() && q.z() <= half.z();
 }

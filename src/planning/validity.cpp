@@ -230,7 +230,8 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
   auto inside = [&](int i) {
     geometry::OrientedBox b = index.box(i);
     if (slack > 0) b.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
-    return b.contains(p);
+    const auto& [c, s] = index.trig(i);
+    return b.contains(p, c, s);
   };
   if (const std::vector<int>* cell = obstacles_->at(q)) {
     for (int i : *cell) {

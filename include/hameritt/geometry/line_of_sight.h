@@ -21,6 +21,10 @@ class OccluderIndex {
   int add(const OrientedBox& box);
   std::size_t size() const { return boxes_.size(); }
   const OrientedBox& box(int i) const { return boxes_.at(static_cast<std::size_t>(i)); }
+  // std::cos and std::sin of box(i)'s yaw (after build()).
+  const std::pair<double, double>& trig(int i) const {
+    return trig_.at(static_cast<std::size_t>(i));
+  }
 
   // Builds the grid; must be called after the last add() and before any query (queries on a
   // stale index throw std::logic_error). Const queries are then safe from many threads.

@@ -25,6 +25,8 @@ struct OrientedBox {
   Aabb2 bounds2() const;
   // Point containment (boundary counts as inside).
   bool contains(const Vec3& p) const;
+  // The same test with the yaw's cosine and sine given (std::cos(yaw), std::sin(yaw)).
+  bool contains(const Vec3& p, double cos_yaw, double sin_yaw) const;
   // True when the closed 3D segment [a, b] touches the box (slab test in the box frame).
   bool intersectsSegment(const Vec3& a, const Vec3& b) const;
   // The same test with the yaw's cosine and sine given (they must be std::cos(yaw) and
