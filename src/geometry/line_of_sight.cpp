@@ -210,8 +210,8 @@ void OccluderIndex::requireBuilt() const {
 bool OccluderIndex::clear(const Vec3& a, const Vec3& b, const std::vector<int>& ignore) const {
   requireBuilt();
   if (!a.allFinite() || !b.allFinite()) throw GeometryError("OccluderIndex::clear: non-finite");
-  for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>(),
-                                       &t_candidates)) {
+  for (int i :
+       segmentCandidates(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>(), &t_candidates)) {
     const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
     if (!ignored(ignore, i) && boxes_[i].intersectsSegment(a, b, c, s)) return false;
   }

@@ -408,8 +408,7 @@ class ScenarioBuilder {
                                                  const std::vector<SceneRelation>& at_start,
                                                  int want) {
     std::vector<SceneRelation> out;
-    constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf,
-                                   RelationOp::kRightOf};
+    constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf};
     // The sideways operators already seen per related id (bit j for kOps[j]): those holding at
     // t = 0, then those found. Each world and parked entity finds its entry once and keeps a
     // pointer to it (entries are never moved or erased); entities sharing an id share it.

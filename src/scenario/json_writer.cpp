@@ -118,8 +118,7 @@ JsonWriter& JsonWriter::key(std::string_view k) {
     return *this;
   }
   escape(k);
-  if (pretty_) put(": ", 2);
-  else put(':');
+  pretty_ ? put(": ", 2) : put(':');
   return *this;
 }
 
@@ -302,8 +301,7 @@ JsonWriter& JsonWriter::value(std::uint64_t u) {
 
 JsonWriter& JsonWriter::value(bool b) {
   separate();
-  if (b) put("true", 4);
-  else put("false", 5);
+  b ? put("true", 4) : put("false", 5);
   return *this;
 }
 

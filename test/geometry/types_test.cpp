@@ -69,11 +69,18 @@ TEST(TypesTest, DegreeConversionAndCross) {
 TEST(TypesTest, MinSqrtEqualsMinOfTheRoot) {
   std::mt19937_64 gen(7);
   std::uniform_real_distribution<double> speed(0.0, 40.0), rel(-1e-6, 1e-6);
-  std::vector<std::pair<double, double>> cases = {
-      {0.0, 0.0}, {0.0, 5.0}, {3.0, 9.0}, {3.0, std::nextafter(9.0, 10.0)},
-      {3.0, std::nextafter(9.0, 0.0)}, {1e-160, 1e-320}, {1e-200, 4.9e-324},
-      {2.0, std::numeric_limits<double>::infinity()}, {std::numeric_limits<double>::infinity(), 4.0},
-      {2.0, std::nan("")}, {std::nan(""), 4.0}, {-1.0, 4.0}};
+  std::vector<std::pair<double, double>> cases = {{0.0, 0.0},
+                                                  {0.0, 5.0},
+                                                  {3.0, 9.0},
+                                                  {3.0, std::nextafter(9.0, 10.0)},
+                                                  {3.0, std::nextafter(9.0, 0.0)},
+                                                  {1e-160, 1e-320},
+                                                  {1e-200, 4.9e-324},
+                                                  {2.0, std::numeric_limits<double>::infinity()},
+                                                  {std::numeric_limits<double>::infinity(), 4.0},
+                                                  {2.0, std::nan("")},
+                                                  {std::nan(""), 4.0},
+                                                  {-1.0, 4.0}};
   for (int i = 0; i < 200000; ++i) {
     const double cap = speed(gen);
     double x = cap * cap * (1.0 + rel(gen));

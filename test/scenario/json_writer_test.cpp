@@ -1,4 +1,6 @@
 // The streaming JSON writer: valid JSON, and numbers that read back to the same double.
+#include "hameritt/scenario/json_writer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include <vector>
 
 #include "hameritt/scenario/entity.h"
-#include "hameritt/scenario/json_writer.h"
 
 using hameritt::scenario::JsonWriter;
 using hameritt::scenario::roundMilli;
