@@ -51,10 +51,14 @@ inline void cosSin(double yaw, double* c, double* s) {
 }  // namespace
 
 std::array<Vec2, 4> OrientedBox::corners2() const {
-  const double hl = 0.5 * size.x();
-  const double hw = 0.5 * size.y();
   double cy, sy;
   cosSin(yaw, &cy, &sy);
+  return corners2(cy, sy);
+}
+
+std::array<Vec2, 4> OrientedBox::corners2(double cy, double sy) const {
+  const double hl = 0.5 * size.x();
+  const double hw = 0.5 * size.y();
   const Vec2 u(cy, sy);         // body x in the world
   const Vec2 v(-u.y(), u.x());  // body y in the world
   const Vec2 c = center2();
@@ -166,13 +170,9 @@ double pointSegmentDistanceSq(const Vec2& p, const Vec2& a, const Vec2& b) {
   return (a + t * ab - p).squaredNorm();
 }
 
-}  // namespace
-
 // Rectangles are convex: when they are apart, the closest pair is a corner of one and an edge
 // of the other, so 32 corner-edge distances give the exact answer without building polygons.
-double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
-  const auto ca = a.corners2();
-  const auto cb = b.corners2();
+double cornersDistance(const std::array<Vec2, 4>& ca, const std::array<Vec2, 4>& cb) {
   if (rectanglesOverlap(ca, cb)) return 0.0;
   double best = 1e300;
   for (int i = 0; i < 4; ++i) {
@@ -186,6 +186,16 @@ double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
     }
   }
   return std::sqrt(best);
+}
+
+}  // namespace
+
+double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
+  return cornersDistance(a.corners2(), b.corners2());
+}
+
+double footprintDistance(const OrientedBox& a, const OrientedBox& b, double cos_b, double sin_b) {
+  return cornersDistance(a.corners2(), b.corners2(cos_b, sin_b));
 }
 
 bool footprintsOverlap(const OrientedBox& a, const OrientedBox& b) {
