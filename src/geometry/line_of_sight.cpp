@@ -71,10 +71,13 @@ void sortUnique(std::vector<int>* v) {
 // Candidate boxes for the 2D segment [a, b]: walks the grid column by column and, in each,
 // looks up only the cells spanned by the part of the segment inside that column (padded by a
 // rounding margin; boxes are padded by their own tolerance when filed). Falls back to every box
-// for a segment crossing too many cells or reaching past the clamped grid.
-std::vector<int> segmentCandidates(const std::vector<Entry>& cells, double cell, std::size_t boxes,
-                                   const Vec2& a, const Vec2& b) {
-  std::vector<int> out;
+// for a segment crossing too many cells or reaching past the clamped grid. The result is
+// written into *out_vec (emptied first), which callers keep per thread: its storage is reused.
+const std::vector<int>& segmentCandidates(const std::vector<Entry>& cells, double cell,
+                                          std::size_t boxes, const Vec2& a, const Vec2& b,
+                                          std::vector<int>* out_vec) {
+  std::vector<int>& out = *out_vec;
+  out.clear();
   const double m = kEpsilon * std::max({1.0, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
   const Vec2 lo = a.cwiseMin(b) - Vec2::Constant(m);
   const Vec2 hi = a.cwiseMax(b) + Vec2::Constant(m);
@@ -113,10 +116,13 @@ std::vector<int> segmentCandidates(const std::vector<Entry>& cells, double cell,
 }
 
 // Candidate boxes filed under any cell that the (non-NaN) rectangle overlaps, ascending;
-// every box when that is more cells than boxes are worth.
-std::vector<int> areaCandidates(const std::vector<Entry>& cells, double cell, std::size_t boxes,
-                                const Aabb2& area) {
-  std::vector<int> out;
+// every box when that is more cells than boxes are worth. Written into *out_vec like
+// segmentCandidates().
+const std::vector<int>& areaCandidates(const std::vector<Entry>& cells, double cell,
+                                       std::size_t boxes, const Aabb2& area,
+                                       std::vector<int>* out_vec) {
+  std::vector<int>& out = *out_vec;
+  out.clear();
   if (!(area.min.x() <= area.max.x() && area.min.y() <= area.max.y())) return out;
   const int x0 = cellIndex(area.min.x(), cell);
   const int y0 = cellIndex(area.min.y(), cell);
@@ -128,12 +134,14 @@ std::vector<int> areaCandidates(const std::vector<Entry>& cells, double cell, st
     collectAll(boxes, &out);
     return out;
   }
-  out.reserve(64);  // typical queries return a few dozen boxes: avoid regrowing
   collectGlobal(cells, &out);
   for (int ix = x0; ix <= x1; ++ix) collectColumn(cells, ix, y0, y1, &out);
   sortUnique(&out);
   return out;
 }
+
+// Per-thread candidate lists for the queries below (none of them re-enters another).
+thread_local std::vector<int> t_candidates;
 
 bool ignored(const std::vector<int>& ignore, int i) {
   return std::find(ignore.begin(), ignore.end(), i) != ignore.end();
@@ -173,6 +181,8 @@ void OccluderIndex::cellRange(const Aabb2& b, int* x0, int* y0, int* x1, int* y1
 // covers the tolerance rotated into the world frame) overlap.
 void OccluderIndex::build() {
   cells_.clear();
+  trig_.clear();
+  for (const OrientedBox& b : boxes_) trig_.emplace_back(std::cos(b.yaw), std::sin(b.yaw));
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
     const double pad = 2.0 * boxTolerance(boxes_[i]);
     const Aabb2 b{bounds_[i].min - Vec2::Constant(pad), bounds_[i].max + Vec2::Constant(pad)};
@@ -200,8 +210,10 @@ void OccluderIndex::requireBuilt() const {
 bool OccluderIndex::clear(const Vec3& a, const Vec3& b, const std::vector<int>& ignore) const {
   requireBuilt();
   if (!a.allFinite() || !b.allFinite()) throw GeometryError("OccluderIndex::clear: non-finite");
-  for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>())) {
-    if (!ignored(ignore, i) && boxes_[i].intersectsSegment(a, b)) return false;
+  for (int i :
+       segmentCandidates(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>(), &t_candidates)) {
+    const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
+    if (!ignored(ignore, i) && boxes_[i].intersectsSegment(a, b, c, s)) return false;
   }
   return true;
 }
@@ -211,10 +223,13 @@ bool OccluderIndex::clear(const Vec3& a, const Vec3& b, const std::vector<int>& 
 bool OccluderIndex::clear2(const Vec2& a, const Vec2& b, const std::vector<int>& ignore) const {
   requireBuilt();
   if (!a.allFinite() || !b.allFinite()) throw GeometryError("OccluderIndex::clear2: non-finite");
-  for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a, b)) {
+  for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a, b, &t_candidates)) {
     if (ignored(ignore, i)) continue;
     const double z = boxes_[i].center.z();
-    if (boxes_[i].intersectsSegment(Vec3(a.x(), a.y(), z), Vec3(b.x(), b.y(), z))) return false;
+    const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
+    if (boxes_[i].intersectsSegment(Vec3(a.x(), a.y(), z), Vec3(b.x(), b.y(), z), c, s)) {
+      return false;
+    }
   }
   return true;
 }
@@ -228,11 +243,11 @@ std::vector<int> OccluderIndex::near(const Vec2& p, double radius) const {
   if (radius < 0.0) return out;
   const double pad = radius + 2.0 * kEpsilon * std::max(1.0, p.cwiseAbs().maxCoeff());
   const Aabb2 area{p - Vec2::Constant(pad), p + Vec2::Constant(pad)};
-  for (int i : areaCandidates(cells_, cell_, boxes_.size(), area)) {
+  for (int i : areaCandidates(cells_, cell_, boxes_.size(), area, &t_candidates)) {
     // Exact point-to-rectangle distance in the box frame.
     const OrientedBox& b = boxes_[i];
     const Vec2 d = p - b.center2();
-    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+    const auto& [c, s] = trig_[static_cast<std::size_t>(i)];  // std::cos, std::sin of b.yaw
     const double lx = std::max(std::abs(c * d.x() + s * d.y()) - 0.5 * b.size.x(), 0.0);
     const double ly = std::max(std::abs(-s * d.x() + c * d.y()) - 0.5 * b.size.y(), 0.0);
     const double scale = std::max({1.0, p.cwiseAbs().maxCoeff(), b.size.x(), b.size.y(),
@@ -250,7 +265,7 @@ std::vector<int> OccluderIndex::candidates(const Aabb2& area) const {
     throw GeometryError("OccluderIndex::candidates: NaN area");
   }
   std::vector<int> out;
-  for (int i : areaCandidates(cells_, cell_, boxes_.size(), area)) {
+  for (int i : areaCandidates(cells_, cell_, boxes_.size(), area, &t_candidates)) {
     if (bounds_[i].overlaps(area)) out.push_back(i);
   }
   return out;

@@ -22,7 +22,7 @@ double boxTolerance(const OrientedBox& b) {
 struct YawTrig {
   std::uint64_t bits[2];
   double c[2], s[2];
-  int next;  // the entry to replace on a miss
+  int next;  // the entry to replace on a miss (the one not used last)
 };
 // Starts with yaw +0 in both entries: cos(+0) = 1 and sin(+0) = +0 exactly.
 __attribute__((tls_model("initial-exec"))) thread_local YawTrig t_last_yaw = {
@@ -39,11 +39,11 @@ inline void cosSin(double yaw, double* c, double* s) {
     i = 1;
   } else {
     i = last.next;
-    last.next = 1 - i;
     last.c[i] = std::cos(yaw);
     last.s[i] = std::sin(yaw);
     last.bits[i] = bits;
   }
+  last.next = 1 - i;  // the least recently used entry goes first
   *c = last.c[i];
   *s = last.s[i];
 }
@@ -51,10 +51,14 @@ inline void cosSin(double yaw, double* c, double* s) {
 }  // namespace
 
 std::array<Vec2, 4> OrientedBox::corners2() const {
-  const double hl = 0.5 * size.x();
-  const double hw = 0.5 * size.y();
   double cy, sy;
   cosSin(yaw, &cy, &sy);
+  return corners2(cy, sy);
+}
+
+std::array<Vec2, 4> OrientedBox::corners2(double cy, double sy) const {
+  const double hl = 0.5 * size.x();
+  const double hw = 0.5 * size.y();
   const Vec2 u(cy, sy);         // body x in the world
   const Vec2 v(-u.y(), u.x());  // body y in the world
   const Vec2 c = center2();
@@ -84,7 +88,14 @@ Vec3 OrientedBox::toBody(const Vec3& p) const {
 }
 
 bool OrientedBox::contains(const Vec3& p) const {
-  const Vec3 q = toBody(p).cwiseAbs();
+  double cy, sy;
+  cosSin(yaw, &cy, &sy);
+  return contains(p, cy, sy);
+}
+
+bool OrientedBox::contains(const Vec3& p, double cy, double sy) const {
+  const Vec3 d = p - center;  // toBody() with the given cosine and sine
+  const Vec3 q = Vec3(cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y(), d.z()).cwiseAbs();
   const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(boxTolerance(*this));
   return q.x() <= half.x() && q.y() <= half.y() && q.z() <= half.z();
 }
@@ -93,9 +104,14 @@ bool OrientedBox::contains(const Vec3& p) const {
 // its body frame; all intervals closed, so grazing an edge or a corner counts as touching.
 bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b) const {
   if (!a.allFinite() || !b.allFinite()) return false;
-  // toBody() for both ends, with one sine and cosine.
   double cy, sy;
   cosSin(yaw, &cy, &sy);
+  return intersectsSegment(a, b, cy, sy);
+}
+
+bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b, double cy, double sy) const {
+  if (!a.allFinite() || !b.allFinite()) return false;
+  // toBody() for both ends, with one sine and cosine.
   auto body = [&](const Vec3& w) {
     const Vec3 q = w - center;
     return Vec3(cy * q.x() + sy * q.y(), -sy * q.x() + cy * q.y(), q.z());
@@ -154,13 +170,9 @@ double pointSegmentDistanceSq(const Vec2& p, const Vec2& a, const Vec2& b) {
   return (a + t * ab - p).squaredNorm();
 }
 
-}  // namespace
-
 // Rectangles are convex: when they are apart, the closest pair is a corner of one and an edge
 // of the other, so 32 corner-edge distances give the exact answer without building polygons.
-double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
-  const auto ca = a.corners2();
-  const auto cb = b.corners2();
+double cornersDistance(const std::array<Vec2, 4>& ca, const std::array<Vec2, 4>& cb) {
   if (rectanglesOverlap(ca, cb)) return 0.0;
   double best = 1e300;
   for (int i = 0; i < 4; ++i) {
@@ -174,6 +186,16 @@ double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
     }
   }
   return std::sqrt(best);
+}
+
+}  // namespace
+
+double footprintDistance(const OrientedBox& a, const OrientedBox& b) {
+  return cornersDistance(a.corners2(), b.corners2());
+}
+
+double footprintDistance(const OrientedBox& a, const OrientedBox& b, double cos_b, double sin_b) {
+  return cornersDistance(a.corners2(), b.corners2(cos_b, sin_b));
 }
 
 bool footprintsOverlap(const OrientedBox& a, const OrientedBox& b) {

@@ -105,9 +105,9 @@ scenario::Trajectory timeParameterize(const std::vector<Vec3>& polyline, double 
   }
   const double a = limits.accel;
   for (std::size_t i = 0; i < n; ++i)
-    v[i + 1] = std::min(v[i + 1], std::sqrt(v[i] * v[i] + 2 * a * len[i]));
+    v[i + 1] = geometry::minSqrt(v[i + 1], v[i] * v[i] + 2 * a * len[i]);
   for (std::size_t i = n; i-- > 0;)
-    v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * a * len[i]));
+    v[i] = geometry::minSqrt(v[i], v[i + 1] * v[i + 1] + 2 * a * len[i]);
 
   double t = t0;
   auto emit = [&](const Vec3& q, double time, double heading) {

@@ -111,7 +111,7 @@ class SegmentBoxes {
     for (int i :
          o.index.candidates(geometry::Aabb2{lo - Vec2(kPad, kPad), hi + Vec2(kPad, kPad)})) {
       const geometry::OrientedBox& b = o.index.box(i);
-      boxes_.push_back({b, b.bounds2()});
+      boxes_.push_back({b, b.bounds2(), o.index.trig(i)});
     }
     return last;
   }
@@ -123,7 +123,7 @@ class SegmentBoxes {
       if (!n.bounds.overlaps(box)) continue;
       geometry::OrientedBox o = n.box;
       o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
-      if (o.intersectsSegment(a, b)) return false;
+      if (o.intersectsSegment(a, b, n.trig.first, n.trig.second)) return false;
     }
     return true;
   }
@@ -134,6 +134,7 @@ class SegmentBoxes {
   struct Near {
     geometry::OrientedBox box;
     geometry::Aabb2 bounds;
+    std::pair<double, double> trig;  // std::cos, std::sin of box.yaw
   };
   std::vector<Near> boxes_;
 };
@@ -230,7 +231,8 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
   auto inside = [&](int i) {
     geometry::OrientedBox b = index.box(i);
     if (slack > 0) b.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
-    return b.contains(p);
+    const auto& [c, s] = index.trig(i);
+    return b.contains(p, c, s);
   };
   if (const std::vector<int>* cell = obstacles_->at(q)) {
     for (int i : *cell) {
@@ -252,7 +254,8 @@ bool WorldValidity::staticSegmentValid(const Vec3& a, const Vec3& b, double slac
   for (int i : obstacles_->index.candidates(box)) {
     geometry::OrientedBox o = obstacles_->index.box(i);
     o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);
-    if (o.intersectsSegment(a, b)) return false;
+    const auto& [c, s] = obstacles_->index.trig(i);
+    if (o.intersectsSegment(a, b, c, s)) return false;
   }
   return true;
 }

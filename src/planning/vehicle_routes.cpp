@@ -610,9 +610,9 @@ RouteResult planVehicleRoute(const World& w, const scenario::TrajectoryPoint& st
   }
   for (std::size_t i = 1; i + 1 < n; ++i) v[i] = cap[i];
   for (std::size_t i = 1; i < n; ++i)
-    v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * speed.accel * ds[i]));
+    v[i] = geometry::minSqrt(v[i], v[i - 1] * v[i - 1] + 2 * speed.accel * ds[i]);
   for (std::size_t i = n - 1; i-- > 0;)
-    v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * speed.decel * ds[i + 1]));
+    v[i] = geometry::minSqrt(v[i], v[i + 1] * v[i + 1] + 2 * speed.decel * ds[i + 1]);
   using scenario::roundMilli;
   double t = start.t, since = 0.0;
   r.trajectory.push_back({roundMilli(t), roundMilli(dense[0].p.x()), roundMilli(dense[0].p.y()),

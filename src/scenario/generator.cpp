@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 #include <set>
+#include <unordered_map>
 
 #include "hameritt/geometry/segment.h"
 #include "hameritt/planning/look_at.h"
@@ -407,51 +408,58 @@ class ScenarioBuilder {
                                                  const std::vector<SceneRelation>& at_start,
                                                  int want) {
     std::vector<SceneRelation> out;
-    std::set<std::string> seen;
-    for (const auto& r : at_start) seen.insert(r.related_id + toString(r.op));
+    constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf, RelationOp::kRightOf};
+    // The sideways operators already seen per related id (bit j for kOps[j]): those holding at
+    // t = 0, then those found. Each world and parked entity finds its entry once and keeps a
+    // pointer to it (entries are never moved or erased); entities sharing an id share it.
+    std::unordered_map<std::string, unsigned char> seen;
+    for (const auto& r : at_start) {
+      for (int j = 0; j < 3; ++j) {
+        if (r.op == kOps[j]) seen[r.related_id] |= static_cast<unsigned char>(1 << j);
+      }
+    }
     const double dt = cfg_.relations.eventually_dt;
     const double end = traj.back().t;
     const std::vector<Subject> parked = parkedSubjects(target.id);
-    // Entities whose three sideways operators are all seen: skipped without building keys.
+    // Entities whose three sideways operators are all seen: skipped by index.
     std::vector<char> world_done(world_.entities().size(), 0), parked_done(parked.size(), 0);
+    std::vector<unsigned char*> world_seen(world_.entities().size(), nullptr);
+    std::vector<unsigned char*> parked_seen(parked.size(), nullptr);
     for (int k = 1; k * dt <= end && static_cast<int>(out.size()) < want; ++k) {
       const double t = k * dt;
       Subject s = subjectOf(target);
       s.box = poseBox(target.box, sampleTrajectory(traj, t));
-      constexpr RelationOp kOps[] = {RelationOp::kNextTo, RelationOp::kLeftOf,
-                                     RelationOp::kRightOf};
       // Returns true when all three operators are now seen with rel: then it never needs to
       // be considered again (seen only grows), which the callers remember by index.
-      auto consider = [&](const Subject& rel, double distance) {
-        std::string keys[3];
-        bool has[3];
-        for (int j = 0; j < 3; ++j) {
-          keys[j] = rel.id + toString(kOps[j]);
-          has[j] = seen.count(keys[j]) != 0;
-        }
-        if (has[0] && has[1] && has[2]) return true;
+      auto consider = [&](const Subject& rel, double distance, unsigned char** entry) {
+        if (*entry == nullptr) *entry = &seen[rel.id];
+        unsigned char& has = **entry;
+        if (has == 7) return true;
         const RelationFacts f = eval_.measureSideways(s, rel, distance);
         for (int j = 0; j < 3; ++j) {
           const RelationOp op = kOps[j];
-          if (has[j] || !eval_.holds(op, f, rel.cls)) continue;
-          seen.insert(keys[j]);
-          has[j] = true;
+          if ((has & (1 << j)) != 0 || !eval_.holds(op, f, rel.cls)) continue;
+          has |= static_cast<unsigned char>(1 << j);
           if (rel.cls == EntityClass::kStreet || rel.cls == EntityClass::kFence) continue;
           SceneRelation r = makeRelation(s, rel, op, f);
           r.eventually = true;
           r.time = t;
           out.push_back(r);
         }
-        return has[0] && has[1] && has[2];
+        return has == 7;
       };
       for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box)) {
-        char& done = world_done[static_cast<std::size_t>(i)];
-        if (!done && consider(worldSubject(world_, i), d)) done = 1;
+        const auto w = static_cast<std::size_t>(i);
+        if (!world_done[w] && consider(worldSubject(world_, i), d, &world_seen[w])) {
+          world_done[w] = 1;
+        }
       }
       for (std::size_t j = 0; j < parked.size(); ++j) {
         if (parked_done[j]) continue;
         const double d = geometry::footprintDistance(s.box, parked[j].box);
-        if (d <= cfg_.relations.radius && consider(parked[j], d)) parked_done[j] = 1;
+        if (d <= cfg_.relations.radius && consider(parked[j], d, &parked_seen[j])) {
+          parked_done[j] = 1;
+        }
       }
     }
     if (static_cast<int>(out.size()) > want) out.resize(static_cast<std::size_t>(want));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 
@@ -27,11 +28,22 @@ void JsonWriter::newline() {
   if (!pretty_ || inline_depth_ > 0) return;
   const std::size_t n = 1 + 2 * has_items_.size();
   if (n + 1 <= kCommaIndent.size()) {
-    out_.append(kCommaIndent.data() + 1, n);
+    std::memcpy(room(kCommaIndent.size()), kCommaIndent.data() + 1, kCommaIndent.size() - 1);
+    len_ += n;
   } else {
-    out_ += '\n';
-    out_.append(n - 1, ' ');
+    char* p = room(n);
+    p[0] = '\n';
+    std::memset(p + 1, ' ', n - 1);
+    len_ += n;
   }
+}
+
+void JsonWriter::grow(std::size_t n) {
+  const std::size_t cap = std::max(2 * cap_, len_ + n);
+  std::unique_ptr<char[]> buf(new char[cap]);
+  std::memcpy(buf.get(), buf_.get(), len_);
+  buf_ = std::move(buf);
+  cap_ = cap;
 }
 
 void JsonWriter::separate() {
@@ -44,13 +56,16 @@ void JsonWriter::separate() {
     has_items_.back() = true;
     const std::size_t n = 2 + 2 * has_items_.size();  // comma, newline, indent
     if (pretty_ && inline_depth_ == 0 && n <= kCommaIndent.size()) {
-      // The comma (if any), the newline and the indent in one append.
-      out_.append(kCommaIndent.data() + (had ? 0 : 1), had ? n : n - 1);
+      // The comma (if any), the newline and the indent in one copy of fixed size (inlined;
+      // the characters past the separator are overwritten next).
+      char* const p = room(kCommaIndent.size());
+      std::memcpy(p, kCommaIndent.data() + (had ? 0 : 1), kCommaIndent.size() - 1);
+      len_ += had ? n : n - 1;
       return;
     }
     if (had) {
-      out_ += ',';
-      if (inline_depth_ > 0 && pretty_) out_ += ' ';
+      put(',');
+      if (inline_depth_ > 0 && pretty_) put(' ');
     }
     newline();
   }
@@ -58,7 +73,7 @@ void JsonWriter::separate() {
 
 JsonWriter& JsonWriter::beginObject() {
   separate();
-  out_ += '{';
+  put('{');
   has_items_.push_back(false);
   return *this;
 }
@@ -67,13 +82,13 @@ JsonWriter& JsonWriter::endObject() {
   const bool had = has_items_.back();
   has_items_.pop_back();
   if (had) newline();
-  out_ += '}';
+  put('}');
   return *this;
 }
 
 JsonWriter& JsonWriter::beginArray() {
   separate();
-  out_ += '[';
+  put('[');
   has_items_.push_back(false);
   return *this;
 }
@@ -82,78 +97,78 @@ JsonWriter& JsonWriter::endArray() {
   const bool had = has_items_.back();
   has_items_.pop_back();
   if (had) newline();
-  out_ += ']';
+  put(']');
   return *this;
 }
 
 JsonWriter& JsonWriter::key(std::string_view k) {
   separate();
   after_key_ = true;
-  char buf[96];
-  if (k.size() + 4 <= sizeof(buf) && plainText(k)) {
-    // The quoted key and the colon in one append.
+  if (plainText(k)) {
+    // The quoted key and the colon written at once.
+    char* const p = room(k.size() + 4);
     std::size_t n = 0;
-    buf[n++] = '"';
-    std::memcpy(buf + n, k.data(), k.size());
+    p[n++] = '"';
+    std::memcpy(p + n, k.data(), k.size());
     n += k.size();
-    buf[n++] = '"';
-    buf[n++] = ':';
-    if (pretty_) buf[n++] = ' ';
-    out_.append(buf, n);
+    p[n++] = '"';
+    p[n++] = ':';
+    if (pretty_) p[n++] = ' ';
+    len_ += n;
     return *this;
   }
   escape(k);
-  out_ += pretty_ ? ": " : ":";
+  pretty_ ? put(": ", 2) : put(':');
   return *this;
 }
 
 void JsonWriter::escape(std::string_view s) {
-  out_ += '"';
+  put('"');
   // Plain text (the usual case: ids, keys, names) is copied at once.
   if (plainText(s)) {
-    out_.append(s);
-    out_ += '"';
+    put(s.data(), s.size());
+    put('"');
     return;
   }
   for (char c : s) {
     switch (c) {
       case '"':
-        out_ += "\\\"";
+        put("\\\"", 2);
         break;
       case '\\':
-        out_ += "\\\\";
+        put("\\\\", 2);
         break;
       case '\n':
-        out_ += "\\n";
+        put("\\n", 2);
         break;
       case '\t':
-        out_ += "\\t";
+        put("\\t", 2);
         break;
       case '\r':
-        out_ += "\\r";
+        put("\\r", 2);
         break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
           std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-          out_ += buf;
+          put(buf, 6);
         } else {
-          out_ += c;
+          put(c);
         }
     }
   }
-  out_ += '"';
+  put('"');
 }
 
 JsonWriter& JsonWriter::value(std::string_view s) {
   separate();
-  char buf[96];
-  if (s.size() + 2 <= sizeof(buf) && plainText(s)) {
-    // A short plain string with its quotes in one append.
-    buf[0] = '"';
-    std::memcpy(buf + 1, s.data(), s.size());
-    buf[s.size() + 1] = '"';
-    out_.append(buf, s.size() + 2);
+  if (plainText(s)) {
+    // A plain string with its quotes written at once.
+    char* const p = room(s.size() + 2);
+    p[0] = '"';
+    std::memcpy(p + 1, s.data(), s.size());
+    p[s.size() + 1] = '"';
+    len_ += s.size() + 2;
     return *this;
   }
   escape(s);
@@ -188,8 +203,22 @@ char* digitsBefore(U a, char* end) {
   return q;
 }
 
+// The decimal digits of v < 10^8, most significant first, one per byte (values 0-9), all
+// eight computed at once: v is split into two halves of four digits in 32-bit lanes, each half
+// into two pairs in 16-bit lanes, each pair into two digits in bytes (division by 100 and by 10
+// as multiply-and-shift, exact in these ranges).
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "eightDigits: byte 0 is written first");
+inline std::uint64_t eightDigits(std::uint32_t v) {
+  const std::uint64_t x = (v / 10000) | (static_cast<std::uint64_t>(v % 10000) << 32);
+  const std::uint64_t hundreds = ((x * 10486) >> 20) & 0x0000007F0000007FULL;
+  const std::uint64_t pairs = hundreds | ((x - 100 * hundreds) << 16);
+  const std::uint64_t tens = ((pairs * 103) >> 10) & 0x000F000F000F000FULL;
+  return tens | ((pairs - 10 * tens) << 8);
+}
+
 // Writes a finite number at p (room for 40 characters); returns the end.
-char* writeNumber(double d, char* p) {
+// Inlined into numbers() and value(double): saves a call per number.
+__attribute__((always_inline)) inline char* writeNumber(double d, char* p) {
   if (d == 0.0) d = 0.0;  // no "-0"
   char* const end = p + 40;
   // Most values are millimetre-rounded (k / 1000): print k's digits with the decimal point
@@ -205,6 +234,24 @@ char* writeNumber(double d, char* p) {
     if (static_cast<double>(k) / 1000.0 == d) {
       unsigned long long a = k < 0 ? 0ULL - static_cast<unsigned long long>(k) : k;
       if (k < 0) *p++ = '-';
+      if (a < 100000000ULL) {
+        // Up to 99999.999 (nearly every value): the eight digits with leading zeros, then the
+        // whole part from its first non-zero digit (at least the units) and the fraction
+        // without its trailing zeros, as below. Copies write 8 and 4 bytes; bytes past the
+        // number are overwritten later or lie past the returned end.
+        const std::uint64_t digits = eightDigits(static_cast<std::uint32_t>(a));
+        const int lead = digits == 0 ? 4 : std::min(4, __builtin_ctzll(digits) / 8);
+        const std::uint64_t text = (digits + 0x3030303030303030ULL) >> (8 * lead);
+        std::memcpy(p, &text, 8);
+        p += 5 - lead;
+        const std::uint64_t frac = digits >> 40;  // the three fraction digits, first in byte 0
+        if (frac != 0) {
+          const std::uint32_t tail = '.' | static_cast<std::uint32_t>((frac + 0x303030) << 8);
+          std::memcpy(p, &tail, 4);
+          p += 2 + (63 - __builtin_clzll(frac)) / 8;  // up to the last non-zero digit
+        }
+        return p;
+      }
       // All digits of a (at least four), two at a time from a table, then the whole part,
       // the point and the fraction without its trailing zeros. Copies have fixed sizes
       // (inlined); bytes past the number are overwritten later or lie past the returned end.
@@ -233,58 +280,56 @@ char* writeNumber(double d, char* p) {
 JsonWriter& JsonWriter::value(double d) {
   if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   separate();
-  char buf[40];
-  out_.append(buf, writeNumber(d, buf));
+  char* const p = room(40);
+  len_ += static_cast<std::size_t>(writeNumber(d, p) - p);
   return *this;
 }
 
 JsonWriter& JsonWriter::value(std::int64_t i) {
   separate();
-  out_ += std::to_string(i);
+  char* const p = room(24);
+  len_ += static_cast<std::size_t>(std::to_chars(p, p + 24, i).ptr - p);
   return *this;
 }
 
 JsonWriter& JsonWriter::value(std::uint64_t u) {
   separate();
-  out_ += std::to_string(u);
+  char* const p = room(24);
+  len_ += static_cast<std::size_t>(std::to_chars(p, p + 24, u).ptr - p);
   return *this;
 }
 
 JsonWriter& JsonWriter::value(bool b) {
   separate();
-  out_ += b ? "true" : "false";
+  b ? put("true", 4) : put("false", 5);
   return *this;
 }
 
 JsonWriter& JsonWriter::null() {
   separate();
-  out_ += "null";
+  put("null", 4);
   return *this;
 }
 
 // The same characters as beginArray(), value() per number and the closing bracket, formatted
-// into one buffer and appended at once.
+// straight into the document (room for 48 characters per number is made first).
 JsonWriter& JsonWriter::numbers(std::initializer_list<double> v) {
   for (double d : v) {
     if (!std::isfinite(d)) throw std::invalid_argument("JsonWriter: non-finite number");
   }
   separate();
-  char buf[512];
-  std::size_t k = 0;
-  buf[k++] = '[';
+  char* const start = room(2 + 48 * v.size());
+  char* p = start;
+  *p++ = '[';
   for (const double* d = v.begin(); d != v.end(); ++d) {
-    if (k + 48 > sizeof(buf)) {  // long lists go out in pieces
-      out_.append(buf, k);
-      k = 0;
-    }
     if (d != v.begin()) {
-      buf[k++] = ',';
-      if (pretty_) buf[k++] = ' ';
+      *p++ = ',';
+      if (pretty_) *p++ = ' ';
     }
-    k = static_cast<std::size_t>(writeNumber(*d, buf + k) - buf);
+    p = writeNumber(*d, p);
   }
-  buf[k++] = ']';
-  out_.append(buf, k);
+  *p++ = ']';
+  len_ += static_cast<std::size_t>(p - start);
   return *this;
 }
 

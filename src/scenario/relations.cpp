@@ -182,8 +182,10 @@ std::vector<std::pair<int, double>> RelationEvaluator::nearbyWorldDistances(
   const double reach = config_.radius + 0.5 * target.size.head<2>().norm();
   std::vector<std::pair<int, double>> out;
   for (int i : world_.footprints().near(target.center2(), reach)) {
-    const double d =
-        geometry::footprintDistance(target, world_.entities()[static_cast<std::size_t>(i)].box);
+    // The footprint index keeps every entity box's cosine and sine (box i is entity i's).
+    const auto& [c, s] = world_.footprints().trig(i);
+    const double d = geometry::footprintDistance(
+        target, world_.entities()[static_cast<std::size_t>(i)].box, c, s);
     if (d <= config_.radius) out.emplace_back(i, d);
   }
   return out;

@@ -90,8 +90,11 @@ std::string relationText(const SceneRelation& r) {
   return s;
 }
 
-std::string missionJson(const Mission& m) {
-  JsonWriter w;
+namespace {
+
+// mission.json into w (emptied first).
+void writeMission(JsonWriter& w, const Mission& m) {
+  w.clear();
   w.beginObject();
   writeHeader(w, "hameritt/mission", m.scenario_id, m.cls, m.seed);
   w.key("frame").beginObject();
@@ -196,15 +199,25 @@ std::string missionJson(const Mission& m) {
   }
   w.endArray();
   w.endObject();
+}
+
+}  // namespace
+
+std::string missionJson(const Mission& m) {
+  JsonWriter w;
+  writeMission(w, m);
   return w.take();
 }
 
-std::string simConfigJson(const SimConfig& s) {
+namespace {
+
+// sim_config.json into w (emptied first).
+void writeSimConfig(JsonWriter& w, const SimConfig& s) {
   // Room for the whole document up front (a trajectory point takes about 60 characters):
   // growing a 100 KB buffer by doubling would copy it several times.
   std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;
   for (const auto& se : s.entities) points += se.trajectory.size() + 8;
-  JsonWriter w(true, 8192 + 64 * points);
+  w.clear(8192 + 64 * points);
   w.beginObject();
   writeHeader(w, "hameritt/sim_config", s.scenario_id, s.cls, s.seed);
   w.key("duration").value(s.duration);
@@ -294,6 +307,13 @@ std::string simConfigJson(const SimConfig& s) {
   w.key("motion_blur_px").value(s.perturbations.motion_blur_px);
   w.endObject().endObject();
   w.endObject();
+}
+
+}  // namespace
+
+std::string simConfigJson(const SimConfig& s) {
+  JsonWriter w(true, 64);  // sized by writeSimConfig()
+  writeSimConfig(w, s);
   return w.take();
 }
 
@@ -390,7 +410,7 @@ std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
     }
   }
   try {
-    auto put = [&](const char* name, const std::string& content) {
+    auto put = [&](const char* name, std::string_view content) {
       const std::string p = tmp + "/" + name;
       const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
       if (fd < 0) throw OutputError(p + ": cannot write: " + std::strerror(errno));
@@ -407,8 +427,14 @@ std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
       }
       if (::close(fd) != 0) throw OutputError(p + ": write failed: " + std::strerror(errno));
     };
-    put("mission.json", missionJson(s.mission));
-    put("sim_config.json", simConfigJson(s.sim));
+    // Both documents are formatted in per-thread writers whose buffers are reused from one
+    // scenario to the next, and written from there (the same bytes as missionJson() and
+    // simConfigJson()).
+    thread_local JsonWriter t_writer;
+    writeMission(t_writer, s.mission);
+    put("mission.json", t_writer.finish());
+    writeSimConfig(t_writer, s.sim);
+    put("sim_config.json", t_writer.finish());
     if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) {
       // An older scenario of the same id: move it aside, then replace it.
       const std::string old = final_dir + ".old-" + std::to_string(::getpid());

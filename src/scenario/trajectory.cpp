@@ -106,11 +106,11 @@ Trajectory planDrive(const std::vector<Vec2>& path, const DriveSpec& spec) {
   for (std::size_t i = 0; i < n; ++i) v[i] = fine[i].vmax;
   for (std::size_t i = 1; i < n; ++i) {
     const double l = (fine[i].p - fine[i - 1].p).norm();
-    v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * spec.accel * l));
+    v[i] = geometry::minSqrt(v[i], v[i - 1] * v[i - 1] + 2 * spec.accel * l);
   }
   for (std::size_t i = n - 1; i-- > 0;) {
     const double l = (fine[i + 1].p - fine[i].p).norm();
-    v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * spec.decel * l));
+    v[i] = geometry::minSqrt(v[i], v[i + 1] * v[i + 1] + 2 * spec.decel * l);
   }
   // Times from the average speed on each piece (exact for constant acceleration).
   std::vector<double> t(n);

@@ -177,3 +177,32 @@ TEST(OrientedBoxTest, FootprintDistanceMatchesPolygonDistance) {
   }
   EXPECT_GT(overlapping, 100);  // both branches exercised
 }
+
+// The variants taking the yaw's cosine and sine (kept per box by OccluderIndex) give exactly
+// the answers of the plain ones.
+TEST(OrientedBoxTest, VariantsWithGivenTrigMatchExactly) {
+  using hameritt::geometry::OrientedBox;
+  using hameritt::geometry::Vec3;
+  std::mt19937_64 gen(25);
+  std::uniform_real_distribution<double> pos(-30.0, 30.0), len(0.5, 12.0), ang(-4.0, 4.0);
+  auto box = [&] {
+    OrientedBox b;
+    b.center = Vec3(pos(gen), pos(gen), len(gen));
+    b.size = Vec3(len(gen), len(gen), len(gen));
+    b.yaw = ang(gen);
+    return b;
+  };
+  int hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const OrientedBox a = box(), b = box();
+    const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+    ASSERT_EQ(hameritt::geometry::footprintDistance(a, b),
+              hameritt::geometry::footprintDistance(a, b, c, s));
+    ASSERT_EQ(b.corners2(), b.corners2(c, s));
+    const Vec3 p(pos(gen), pos(gen), len(gen)), q(pos(gen), pos(gen), len(gen));
+    ASSERT_EQ(b.contains(p), b.contains(p, c, s));
+    ASSERT_EQ(b.intersectsSegment(p, q), b.intersectsSegment(p, q, c, s));
+    hits += b.intersectsSegment(p, q);
+  }
+  EXPECT_GT(hits, 100);  // both answers exercised
+}

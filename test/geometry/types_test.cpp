@@ -2,6 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <utility>
+#include <vector>
+
 namespace hameritt::geometry {
 namespace {
 
@@ -55,3 +63,41 @@ TEST(TypesTest, DegreeConversionAndCross) {
 
 }  // namespace
 }  // namespace hameritt::geometry
+
+// minSqrt(cap, x) is std::min(cap, std::sqrt(x)) bit for bit, also for x just above and below
+// cap * cap, for zero and tiny caps, and for infinite and NaN arguments.
+TEST(TypesTest, MinSqrtEqualsMinOfTheRoot) {
+  std::mt19937_64 gen(7);
+  std::uniform_real_distribution<double> speed(0.0, 40.0), rel(-1e-6, 1e-6);
+  std::vector<std::pair<double, double>> cases = {{0.0, 0.0},
+                                                  {0.0, 5.0},
+                                                  {3.0, 9.0},
+                                                  {3.0, std::nextafter(9.0, 10.0)},
+                                                  {3.0, std::nextafter(9.0, 0.0)},
+                                                  {1e-160, 1e-320},
+                                                  {1e-200, 4.9e-324},
+                                                  {2.0, std::numeric_limits<double>::infinity()},
+                                                  {std::numeric_limits<double>::infinity(), 4.0},
+                                                  {2.0, std::nan("")},
+                                                  {std::nan(""), 4.0},
+                                                  {-1.0, 4.0}};
+  for (int i = 0; i < 200000; ++i) {
+    const double cap = speed(gen);
+    double x = cap * cap * (1.0 + rel(gen));
+    if (i % 4 == 0) x = std::nextafter(cap * cap * (1.0 + 1e-9), i % 8 == 0 ? 0.0 : 1e300);
+    if (i % 4 == 1) x = speed(gen) * speed(gen);
+    cases.emplace_back(cap, x);
+  }
+  int checked = 0;
+  for (const auto& [cap, x] : cases) {
+    const double expected = std::min(cap, std::sqrt(x));
+    const double got = hameritt::geometry::minSqrt(cap, x);
+    if (std::isnan(expected)) {
+      EXPECT_TRUE(std::isnan(got)) << cap << " " << x;
+    } else {
+      ASSERT_EQ(std::memcmp(&got, &expected, sizeof(got)), 0) << cap << " " << x;
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(cases.size()));
+}

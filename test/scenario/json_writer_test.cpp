@@ -1,12 +1,16 @@
 // The streaming JSON writer: valid JSON, and numbers that read back to the same double.
+#include "hameritt/scenario/json_writer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "hameritt/scenario/entity.h"
-#include "hameritt/scenario/json_writer.h"
 
 using hameritt::scenario::JsonWriter;
 using hameritt::scenario::roundMilli;
@@ -101,4 +105,66 @@ TEST(JsonWriterTest, PlainStringsCopiedAsTheyAre) {
   JsonWriter w(false);
   w.beginObject().key("name").value("caf\xc3\xa9 street_12").key("q").value("a\"b").endObject();
   EXPECT_EQ(w.str(), "{\"name\":\"caf\xc3\xa9 street_12\",\"q\":\"a\\\"b\"}\n");
+}
+
+// Millimetre values (k / 1000) print as printf's "%.3f" without trailing zeros (and without the
+// point when nothing follows it), on both sides of the eight-digit fast path (|k| < 10^8).
+TEST(JsonWriterTest, MillimetreValuesMatchFixedPointText) {
+  const auto expected = [](double d) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.3f", d);
+    std::string s(buf);
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s.pop_back();
+    return s == "-0" ? std::string("0") : s;
+  };
+  std::vector<long long> ks;
+  for (long long k = -20000; k <= 20000; ++k) ks.push_back(k);
+  for (long long k = 99990000; k <= 100010000; ++k) ks.push_back(k);
+  std::mt19937_64 gen(2026);
+  for (int i = 0; i < 100000; ++i) {
+    const long long mag = static_cast<long long>(gen() % 1000000000000000ULL);
+    ks.push_back(static_cast<long long>(mag % (1LL << (gen() % 50))) * (gen() % 2 ? 1 : -1));
+  }
+  int checked = 0;
+  for (long long k : ks) {
+    const double d = static_cast<double>(k) / 1000.0;
+    JsonWriter w(false);
+    w.value(d);
+    std::string text = w.str();
+    text.pop_back();  // the final newline
+    ASSERT_EQ(text, expected(d)) << k;
+    JsonWriter a(false);
+    a.numbers({d, -d});
+    ASSERT_EQ(a.str(), "[" + expected(d) + "," + expected(-d) + "]\n") << k;
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(ks.size()));
+}
+
+// A writer reused after clear() (as writeScenarioDir() reuses one per thread) writes the same
+// bytes as a fresh one, also when a document outgrows its buffer; finish() is str() in place.
+TEST(JsonWriterTest, ReusedWriterWritesTheSameDocuments) {
+  const auto document = [](JsonWriter& w, int n) {
+    w.beginObject().key("name").value("doc").key("points").beginArray();
+    for (int i = 0; i < n; ++i) w.numbers({i * 0.001, -i * 1.5, 1e-7 * i});
+    w.endArray().key("last").value(std::int64_t{n}).endObject();
+  };
+  JsonWriter reused(true, 64);
+  for (int n : {3, 2000, 0, 40, 5000, 1}) {
+    JsonWriter fresh;
+    document(fresh, n);
+    reused.clear(n % 2 == 0 ? 64 * static_cast<std::size_t>(n) : 0);
+    document(reused, n);
+    const std::string expected = fresh.str();
+    ASSERT_EQ(reused.str(), expected) << n;
+    ASSERT_EQ(std::string(reused.finish()), expected) << n;
+    ASSERT_EQ(nlohmann::json::parse(expected)["points"].size(), static_cast<std::size_t>(n));
+  }
+  JsonWriter taken(false, 64);
+  document(taken, 100);
+  const std::string text = taken.take();
+  EXPECT_EQ(text.back(), '\n');
+  document(taken, 100);  // empty after take(): the same document again
+  EXPECT_EQ(taken.str(), text);
 }

@@ -2,6 +2,7 @@
 // Line of sight against the static scene, accelerated by a uniform grid over the plane.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "hameritt/geometry/oriented_box.h"
@@ -20,6 +21,10 @@ class OccluderIndex {
   int add(const OrientedBox& box);
   std::size_t size() const { return boxes_.size(); }
   const OrientedBox& box(int i) const { return boxes_.at(static_cast<std::size_t>(i)); }
+  // std::cos and std::sin of box(i)'s yaw (after build()).
+  const std::pair<double, double>& trig(int i) const {
+    return trig_.at(static_cast<std::size_t>(i));
+  }
 
   // Builds the grid; must be called after the last add() and before any query (queries on a
   // stale index throw std::logic_error). Const queries are then safe from many threads.
@@ -42,6 +47,8 @@ class OccluderIndex {
   double cell_;
   std::vector<OrientedBox> boxes_;
   std::vector<Aabb2> bounds_;
+  // Per box: std::cos and std::sin of its yaw (filled by build()).
+  std::vector<std::pair<double, double>> trig_;
   // Sorted (cell key, box index) pairs; kept flat for speed and determinism.
   std::vector<std::pair<std::int64_t, int>> cells_;
   bool dirty_ = false;

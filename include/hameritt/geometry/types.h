@@ -2,6 +2,8 @@
 // Basic geometric types and angle helpers. Frame: ENU metres (x east, y north, z up);
 // angles in radians, counter-clockwise positive about +z; times in seconds from mission start.
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -33,6 +35,15 @@ double angleDiffDeg(double a_deg, double b_deg);
 
 inline double degToRad(double d) { return d * kPi / 180.0; }
 inline double radToDeg(double r) { return r * 180.0 / kPi; }
+
+// std::min(cap, std::sqrt(x)), the same value, without the square root when x is clearly
+// above cap * cap (relative margin 1e-9, far above the product's rounding error; cap large
+// enough for cap * cap to be a normal number): the root, rounded, is then at least cap, so the
+// minimum is cap. Speed profiles call it for every sample, most of which run at their cap.
+inline double minSqrt(double cap, double x) {
+  if (cap >= 1e-150 && x > cap * cap * (1.0 + 1e-9)) return cap;
+  return std::min(cap, std::sqrt(x));
+}
 
 // 2D cross product (z of the 3D cross product).
 inline double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
