@@ -135,7 +135,8 @@ def main():
     dropped_log = len(re.findall(r"Dropping", log_text))
     missing = {t: (e, counts.get(t, 0)) for t, e in expected.items() if counts.get(t, 0) < e}
     # The simulator logs sim time against wall time since its clock started, every 10 sim s.
-    m = re.findall(r"simulator: sim ([0-9.]+) s in wall ([0-9.]+) s", log_text)
+    m = re.findall(r"simulator: (?:lock-step cycle \d+: )?sim ([0-9.]+) s in wall ([0-9.]+) s",
+                   log_text)
     # In lock-step: once the simulator stops at the duration.
     m += re.findall(r"lock-step: stopped at the duration, sim ([0-9.]+) s, cycle \d+, in wall ([0-9.]+) s",
                     log_text)

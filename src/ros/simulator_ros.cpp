@@ -316,7 +316,7 @@ void SimulatorRos::spinLockstep() {
     if (!gate_->afterCycle(++cycle, stamp)) break;
     if (sim_->time() >= next_report) {
       const double wall = (ros::WallTime::now() - run_start).toSec();
-      ROS_INFO("simulator: lock-step cycle %llu, sim %.1f s in wall %.1f s (%.2fx real time), %zu "
+      ROS_INFO("simulator: lock-step cycle %llu: sim %.1f s in wall %.1f s (%.2fx real time), %zu "
                "participants",
                static_cast<unsigned long long>(cycle), sim_->time(), wall,
                sim_->time() / std::max(wall, 1e-9), gate_->participants().size());
