@@ -43,10 +43,27 @@ class SimClient {
     reset();
   }
 
+  // Resets the node to t = 0 and waits for the state it publishes then (a caller that reads
+  // `odom` right after must see the reset pose, not a default or earlier one). The state of a
+  // reset can be published before this client's connection to the node is up (a test that
+  // publishes odometry itself counts as a publisher already): then it resets again.
   void reset() {
-    hameritt::ResetSimulation r;
-    ASSERT_TRUE(ros::service::call("/simulator/reset", r));
-    ASSERT_TRUE(r.response.success);
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(15);
+    bool got = false;
+    while (!got && ros::WallTime::now() < until) {
+      have_odom = have_truth = false;
+      hameritt::ResetSimulation r;
+      ASSERT_TRUE(ros::service::call("/simulator/reset", r));
+      ASSERT_TRUE(r.response.success);
+      const ros::WallTime wait = ros::WallTime::now() + ros::WallDuration(0.5);
+      while (!got && ros::WallTime::now() < wait) {
+        ros::spinOnce();
+        ros::WallDuration(0.0005).sleep();
+        got = have_odom && odom.header.stamp.toSec() == 0.0 && have_truth &&
+              truth.header.stamp.toSec() == 0.0;
+      }
+    }
+    ASSERT_TRUE(got) << "no odometry and ground truth at t = 0 within 15 s of resetting";
     crashes.clear();
     drain();
   }
