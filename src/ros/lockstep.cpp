@@ -276,8 +276,6 @@ void LockstepGate::onAck(const hameritt::LockstepAck::ConstPtr& msg) {
   cv_.notify_all();
 }
 
-std::vector<sim::StreamCount> LockstepGate::totals() const { return tally_.streams(); }
-
 std::vector<std::string> LockstepGate::participants() const { return order_; }
 
 bool LockstepGate::waitForAck(const std::string& node, std::uint64_t cycle, double timeout,

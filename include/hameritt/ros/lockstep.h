@@ -133,7 +133,6 @@ class LockstepGate {
   void waitForConnections();
   // Waits until the inbox holds every counted message of `totals`; false on timeout.
   bool waitForInbox(const std::vector<sim::StreamCount>& totals, const std::string& what);
-  std::vector<sim::StreamCount> totals() const;
   // Coordinator: publishes the turn (again every 0.5 s while `resend`) until `node` answers
   // for `cycle`. False on timeout or shutdown.
   bool giveTurn(std::uint64_t cycle, const ros::Time& stamp, const std::string& node, bool resend);
