@@ -91,15 +91,6 @@ void LockstepGate::count(const std::string& topic, std::uint64_t n) {
   if (enabled_) published_.add(topic, n);
 }
 
-std::size_t LockstepGate::addSubscription(const std::string& topic) {
-  return inbox_.addSubscription(topic);
-}
-
-void LockstepGate::receive(std::size_t sub, const std::string& publisher,
-                           std::function<void()> deliver) {
-  inbox_.receive(sub, publisher, std::move(deliver));
-}
-
 void LockstepGate::every(ros::NodeHandle& nh, double period, std::function<void()> fn, bool wall) {
   if (enabled_) {
     periodic_.push_back({sim::PeriodicSchedule(period), std::move(fn)});

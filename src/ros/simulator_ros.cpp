@@ -162,9 +162,11 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   imu_pub_ = gate_->advertise<sensor_msgs::Imu>(nh, "uav/imu", 50);
   truth_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "ground_truth/entities", 10);
   crash_pub_ = gate_->advertise<hameritt::CrashEvent>(nh, "uav/crash", 1, true);
-  // The tf broadcasters' topics (the same publications as theirs), for the connect phase.
-  tf_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf", 100);
-  tf_static_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf_static", 100, true);
+  if (gate_->enabled()) {
+    // The tf broadcasters' topics (the same publications as theirs), for the connect phase.
+    tf_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf", 100);
+    tf_static_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf_static", 100, true);
+  }
   vel_sub_ = gate_->subscribe(nh, "uav/cmd_vel", 10, &SimulatorRos::onVelocity, this);
   pose_sub_ = gate_->subscribe(nh, "uav/cmd_pose", 10, &SimulatorRos::onPose, this);
   step_srv_ = pnh.advertiseService("step", &SimulatorRos::onStep, this);
@@ -284,74 +286,42 @@ void SimulatorRos::waitForSubscribers() {
   }
 }
 
-void SimulatorRos::spinLockstep() {
-  waitForSubscribers();
-  if (!gate_->start(lockstep_participants_)) return;
-  const ros::WallTime run_start = ros::WallTime::now();
-  ros::WallTime wall_start = run_start;
-  double sim_start = sim_->time();
-  double next_report = 10.0;
-  std::uint64_t cycle = 0;
-  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
-  bool ended = false;
-  while (ros::ok()) {
-    if (!ended && sim_->time() >= duration_) {
-      ended = true;
-      ROS_INFO("simulator: lock-step: stopped at the duration, sim %.3f s, cycle %llu, in wall "
-               "%.1f s; %zu participants left",
-               sim_->time(), static_cast<unsigned long long>(cycle),
-               (ros::WallTime::now() - run_start).toSec(), gate_->participants().size());
-    }
-    if (paused_ || sim_->time() >= duration_) {
-      queue->callAvailable(ros::WallDuration(0.01));
-      sim_start = sim_->time();
-      wall_start = ros::WallTime::now();
-      continue;
-    }
-    gate_->beforeCycle();
-    advance(steps_per_cycle_);
-    if (cameras_) cameras_->flush();
-    ros::Time stamp;
-    stamp.fromSec(sim_->time());
-    if (!gate_->afterCycle(++cycle, stamp)) break;
-    if (sim_->time() >= next_report) {
-      const double wall = (ros::WallTime::now() - run_start).toSec();
-      ROS_INFO("simulator: lock-step cycle %llu: sim %.1f s in wall %.1f s (%.2fx real time), %zu "
-               "participants",
-               static_cast<unsigned long long>(cycle), sim_->time(), wall,
-               sim_->time() / std::max(wall, 1e-9), gate_->participants().size());
-      next_report += 10.0;
-    }
-    queue->callAvailable(ros::WallDuration(0));
-    if (real_time_factor_ > 0) {
-      const double due = (sim_->time() - sim_start) / real_time_factor_;
-      const double ahead = due - (ros::WallTime::now() - wall_start).toSec();
-      if (ahead > 0) ros::WallDuration(ahead).sleep();
-    }
-  }
-}
-
 void SimulatorRos::spin() {
-  if (gate_->enabled()) {
-    spinLockstep();
-    return;
-  }
   waitForSubscribers();
+  // Lock-step: each step of the loop is a cycle with the participants' turns after it.
+  const bool lockstep = gate_->enabled();
+  if (lockstep && !gate_->start(lockstep_participants_)) return;
   ros::WallTime wall_start = ros::WallTime::now();
   double sim_start = sim_->time();
   // Progress: sim time against wall time since the clock started (the real-time factor).
   const ros::WallTime run_start = wall_start;
   double next_report = 10.0;
+  std::uint64_t cycle = 0;
   auto report = [&] {
     const double wall = (ros::WallTime::now() - run_start).toSec();
-    ROS_INFO("simulator: sim %.1f s in wall %.1f s (%.2fx real time), %llu camera frames", sim_->time(), wall,
-             sim_->time() / std::max(wall, 1e-9),
-             static_cast<unsigned long long>(cameras_ ? cameras_->framesPublished() : 0));
+    if (lockstep) {
+      ROS_INFO("simulator: lock-step cycle %llu: sim %.1f s in wall %.1f s (%.2fx real time), "
+               "%zu participants",
+               static_cast<unsigned long long>(cycle), sim_->time(), wall,
+               sim_->time() / std::max(wall, 1e-9), gate_->participants().size());
+    } else {
+      ROS_INFO("simulator: sim %.1f s in wall %.1f s (%.2fx real time), %llu camera frames",
+               sim_->time(), wall, sim_->time() / std::max(wall, 1e-9),
+               static_cast<unsigned long long>(cameras_ ? cameras_->framesPublished() : 0));
+    }
   };
   bool was_paused = paused_;
+  bool ended = false;
   while (ros::ok()) {
     const bool running = !paused_ && sim_->time() < duration_;
     if (!running) {
+      if (lockstep && !ended && sim_->time() >= duration_) {
+        ended = true;
+        ROS_INFO("simulator: lock-step: stopped at the duration, sim %.3f s, cycle %llu, in wall "
+                 "%.1f s; %zu participants left",
+                 sim_->time(), static_cast<unsigned long long>(cycle),
+                 (ros::WallTime::now() - run_start).toSec(), gate_->participants().size());
+      }
       ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
       was_paused = true;
       continue;
@@ -362,7 +332,16 @@ void SimulatorRos::spin() {
       wall_start = ros::WallTime::now();
       was_paused = false;
     }
-    advance(steps_per_publish_);
+    if (lockstep) {
+      gate_->beforeCycle();
+      advance(steps_per_cycle_);
+      if (cameras_) cameras_->flush();
+      ros::Time stamp;
+      stamp.fromSec(sim_->time());
+      if (!gate_->afterCycle(++cycle, stamp)) break;
+    } else {
+      advance(steps_per_publish_);
+    }
     if (sim_->time() >= next_report) {
       report();
       next_report += 10.0;

@@ -122,8 +122,6 @@ class LockstepGate {
     std::function<int()> connections;  // subscribers of a publisher, publishers of a subscriber
   };
 
-  std::size_t addSubscription(const std::string& topic);
-  void receive(std::size_t sub, const std::string& publisher, std::function<void()> deliver);
   void onTurnMsg(const hameritt::LockstepTurn::ConstPtr& msg);
   void onAck(const hameritt::LockstepAck::ConstPtr& msg);
   void runTurn(const hameritt::LockstepTurn& turn);
@@ -176,14 +174,14 @@ ros::Subscriber LockstepGate::subscribe(ros::NodeHandle& nh, const std::string& 
     return nh.subscribe<M>(topic, queue,
                            boost::function<void(const boost::shared_ptr<M const>&)>(fn));
   }
-  const std::size_t index = addSubscription(nh.resolveName(topic));
+  const std::size_t index = inbox_.addSubscription(nh.resolveName(topic));
   ros::SubscribeOptions ops;
   // Messages wait in the inbox, not in roscpp's queue: a deep queue never drops one.
   ops.initByFullCallbackType<const ros::MessageEvent<M const>&>(
       topic, std::max<std::uint32_t>(queue, 10000),
       [this, index, fn](const ros::MessageEvent<M const>& ev) {
         boost::shared_ptr<M const> msg = ev.getConstMessage();
-        receive(index, ev.getPublisherName(), [fn, msg] { fn(msg); });
+        inbox_.receive(index, ev.getPublisherName(), [fn, msg] { fn(msg); });
       });
   ops.callback_queue = &recv_queue_;
   // Small messages go out at once (no Nagle delay): every turn waits for them.

@@ -50,8 +50,6 @@ class SimulatorRos {
 
  private:
   void advance(int steps);
-  // The lock-step loop (~lockstep true).
-  void spinLockstep();
   // Re-applies the last velocity command through the geofence (every publish tick).
   void applyVelocity();
   void waitForSubscribers();
