@@ -38,6 +38,8 @@ HAMERITT_PACKAGES=(
   librosbag-storage-dev
   # Reliability: libFuzzer targets with clang (ASan/UBSan), the Shapely geometry oracle.
   clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-shapely
+  # Repeated builds (the sanitizer and workspace builds, a second clone) reuse objects.
+  ccache
 )
 
 install_deps() {
@@ -59,11 +61,19 @@ install_deps() {
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# ccache, keyed on paths relative to the checkout, so that two clones (or worktrees) share
+# their objects; -g builds (the sanitizers) do not hash the working directory either.
+export CCACHE_BASEDIR="$HAMERITT_ROOT" CCACHE_NOHASHDIR=1
+CCACHE_ARGS=()
+if command -v ccache >/dev/null 2>&1; then
+  CCACHE_ARGS=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+fi
+
 # Configures (always with testing on, so that switching between the two commands never
 # reconfigures; test programs are only built by the "tests" target) and builds.
 build() {
   cmake -S "$HAMERITT_ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release \
-    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON >/dev/null
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON "${CCACHE_ARGS[@]}" >/dev/null
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }
 

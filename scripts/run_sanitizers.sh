@@ -10,7 +10,7 @@ install_deps
 ASAN_BUILD_DIR="${HAMERITT_ASAN_BUILD_DIR:-$HAMERITT_ROOT/build/asan}"
 cmake -S "$HAMERITT_ROOT" -B "$ASAN_BUILD_DIR" -DCMAKE_BUILD_TYPE=Release \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON \
-  -DHAMERITT_SANITIZE=address,undefined >/dev/null
+  -DHAMERITT_SANITIZE=address,undefined "${CCACHE_ARGS[@]}" >/dev/null
 programs=("$@")
 if ((${#programs[@]} == 0)); then
   programs=(test_geometry test_scenario test_map test_sim test_planning test_render test_adk
