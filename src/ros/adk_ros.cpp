@@ -15,6 +15,7 @@
 #include "hameritt/MissionMetrics.h"
 #include "hameritt/MissionState.h"
 #include "hameritt/PerceptionReport.h"
+#include "hameritt/UavSpec.h"
 #include "hameritt/ros/adk_conversions.h"
 #include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
@@ -90,6 +91,7 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("pedestrian_gate", scoring.pedestrian_gate, scoring.pedestrian_gate);
   adk::ObjectiveSettings objective;
   pnh.param("found_by_sighting", objective.found_by_sighting, mode_ == "maneuver_only");
+  found_by_sighting_ = objective.found_by_sighting;
   pnh.param("track_fraction", objective.track_fraction, objective.track_fraction);
   double cell = 2.0;
   pnh.param("coverage_cell_size", cell, cell);
@@ -139,6 +141,7 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 
   mission_pub_ = gate_->advertise<hameritt::Mission>(nh, "mission", 1, true);
   markers_pub_ = gate_->advertise<visualization_msgs::MarkerArray>(nh, "mission/markers", 1, true);
+  uav_pub_ = gate_->advertise<hameritt::UavSpec>(nh, "mission/uav", 1, true);
   constraints_pub_ = gate_->advertise<hameritt::ConstraintStatus>(nh, "adk/constraints", 10);
   events_pub_ = gate_->advertise<hameritt::ConstraintEvent>(nh, "adk/constraint_events", 100);
   perception_pub_ = gate_->advertise<hameritt::PerceptionReport>(nh, "adk/perfect_perception", 20);
@@ -178,6 +181,9 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   gate_->publish(mission_pub_, toMsg(mission_, stamp));
   gate_->publish(markers_pub_,
                  missionMarkers(mission_, sim_config_.uav.altitude_max + 20.0, stamp));
+  hameritt::UavSpec uav = toMsg(sim_config_.uav, sim_config_.scenario_id);
+  uav.header.stamp = stamp;
+  gate_->publish(uav_pub_, uav);
   publishState();
   ROS_INFO(
       "adk: %s (%s), mode %s, perfect perception %s, time limit %.1f s, %zu cameras, "
@@ -304,8 +310,10 @@ void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {
 void AdkRos::checkObjective(double t) {
   if (lifecycle_->state() != adk::MissionState::kRunning || metrics_->isTrack()) return;
   if (!metrics_->objectiveMet(t)) return;
-  const std::string how = metrics_->targets().size() == 1 ? "the target" : "every target";
-  if (lifecycle_->succeed(t, how + (mode_ == "maneuver_only" ? " seen" : " correctly detected"))) {
+  // Says how the targets were found: sighted by a camera (~found_by_sighting) or claimed.
+  const std::string how = metrics_->targets().size() == 1 ? "target" : "every target";
+  if (lifecycle_->succeed(
+          t, how + (found_by_sighting_ ? " sighted" : " correctly claimed by the client"))) {
     publishState();
     finish();
   }

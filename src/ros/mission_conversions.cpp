@@ -1,6 +1,8 @@
 #include "hameritt/ros/mission_conversions.h"
 
+#include <cmath>
 #include <cstdlib>
+#include <utility>
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/scenario_io.h"
@@ -254,6 +256,90 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
     mission.relations.push_back(r);
   }
   return mission;
+}
+
+hameritt::UavSpec toMsg(const scenario::UavSpec& uav, const std::string& scenario_id) {
+  hameritt::UavSpec m;
+  m.header.frame_id = "map";
+  m.scenario_id = scenario_id;
+  m.model = uav.model;
+  m.altitude_min = uav.altitude_min;
+  m.altitude_max = uav.altitude_max;
+  m.max_speed = uav.max_speed;
+  m.start.x = uav.start.x;
+  m.start.y = uav.start.y;
+  m.start.z = uav.start.z;
+  m.start_yaw = uav.start.yaw;
+  for (const auto& c : uav.cameras) {
+    hameritt::CameraSpec cm;
+    cm.name = c.name;
+    cm.frame_id = "uav/camera_" + c.name + "_optical";
+    cm.mount_xyz.x = c.mount_xyz.x();
+    cm.mount_xyz.y = c.mount_xyz.y();
+    cm.mount_xyz.z = c.mount_xyz.z();
+    cm.mount_rpy_deg.x = c.mount_rpy.x();
+    cm.mount_rpy_deg.y = c.mount_rpy.y();
+    cm.mount_rpy_deg.z = c.mount_rpy.z();
+    cm.width = static_cast<std::uint32_t>(c.width);
+    cm.height = static_cast<std::uint32_t>(c.height);
+    cm.hfov_deg = c.hfov_deg;
+    cm.rate_hz = c.rate_hz;
+    cm.modalities = c.modalities;
+    m.cameras.push_back(std::move(cm));
+  }
+  return m;
+}
+
+scenario::UavSpec fromMsg(const hameritt::UavSpec& m) {
+  auto bad = [](const std::string& field, const std::string& what, double v) {
+    return scenario::ConfigError("uav message: " + field + ": expected " + what + ", got " +
+                                 scenario::formatNumber(v));
+  };
+  for (const auto& [field, v] : {std::pair<const char*, double>{"altitude_min", m.altitude_min},
+                                 {"altitude_max", m.altitude_max},
+                                 {"max_speed", m.max_speed},
+                                 {"start.x", m.start.x},
+                                 {"start.y", m.start.y},
+                                 {"start.z", m.start.z},
+                                 {"start_yaw", m.start_yaw}}) {
+    if (!std::isfinite(v)) throw bad(field, "a finite number", v);
+  }
+  if (!(m.altitude_min < m.altitude_max)) {
+    throw bad("altitude_max",
+              "more than altitude_min (" + scenario::formatNumber(m.altitude_min) + ")",
+              m.altitude_max);
+  }
+  if (!(m.max_speed > 0)) throw bad("max_speed", "m/s > 0", m.max_speed);
+  scenario::UavSpec u;
+  u.model = m.model;
+  u.altitude_min = m.altitude_min;
+  u.altitude_max = m.altitude_max;
+  u.max_speed = m.max_speed;
+  u.start = {0.0, m.start.x, m.start.y, m.start.z, m.start_yaw};
+  for (std::size_t i = 0; i < m.cameras.size(); ++i) {
+    const auto& cm = m.cameras[i];
+    const std::string f = "cameras[" + std::to_string(i) + "].";
+    if (cm.width == 0) throw bad(f + "width", "pixels > 0", cm.width);
+    if (cm.height == 0) throw bad(f + "height", "pixels > 0", cm.height);
+    if (!(cm.hfov_deg > 0 && cm.hfov_deg < 180))
+      throw bad(f + "hfov_deg", "degrees in (0, 180)", cm.hfov_deg);
+    if (!(cm.rate_hz > 0 && std::isfinite(cm.rate_hz)))
+      throw bad(f + "rate_hz", "Hz > 0", cm.rate_hz);
+    scenario::CameraSpec c;
+    c.name = cm.name;
+    c.mount_xyz = {cm.mount_xyz.x, cm.mount_xyz.y, cm.mount_xyz.z};
+    c.mount_rpy = {cm.mount_rpy_deg.x, cm.mount_rpy_deg.y, cm.mount_rpy_deg.z};
+    if (!c.mount_xyz.allFinite() || !c.mount_rpy.allFinite()) {
+      throw scenario::ConfigError("uav message: " + f + "mount: expected finite numbers");
+    }
+    c.width = static_cast<int>(cm.width);
+    c.height = static_cast<int>(cm.height);
+    c.hfov_deg = cm.hfov_deg;
+    c.rate_hz = cm.rate_hz;
+    c.modalities = cm.modalities;
+    u.cameras.push_back(std::move(c));
+  }
+  return u;
 }
 
 }  // namespace hameritt::ros_wrappers

@@ -1,11 +1,13 @@
 #include "hameritt/ros/simulator_ros.h"
 
 #include <ros/callback_queue.h>
+#include <ros/master.h>
 #include <rosgraph_msgs/Clock.h>
-#include <tf2_msgs/TFMessage.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
+#include <tf2_msgs/TFMessage.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "hameritt/CrashEvent.h"
@@ -77,6 +79,9 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param<std::string>("wait_for", wait_for, "");
   pnh.param("wait_timeout", wait_timeout_, wait_timeout_);
   wait_for_ = resolvedList(wait_for);
+  std::string wait_for_nodes;
+  pnh.param<std::string>("wait_for_nodes", wait_for_nodes, "");
+  wait_for_nodes_ = resolvedList(wait_for_nodes);
   steps_per_publish_ = ratio(settings.physics_rate_hz, publish_hz, "publish_rate_hz");
   steps_per_ground_truth_ = ratio(settings.physics_rate_hz, truth_hz, "ground_truth_rate_hz");
   gate_ = std::make_unique<LockstepGate>(nh, pnh, LockstepGate::Role::kCoordinator);
@@ -260,7 +265,7 @@ int SimulatorRos::subscribers(const std::string& topic) const {
 }
 
 void SimulatorRos::waitForSubscribers() {
-  if (wait_for_.empty()) return;
+  if (wait_for_.empty() && wait_for_nodes_.empty()) return;
   for (const auto& t : wait_for_) {
     if (subscribers(t) < 0) ROS_WARN("simulator: ~wait_for: %s is not a topic of this node; ignored", t.c_str());
   }
@@ -276,9 +281,20 @@ void SimulatorRos::waitForSubscribers() {
     for (const auto& t : wait_for_) {
       if (subscribers(t) == 0) missing += (missing.empty() ? "" : ", ") + t;
     }
+    if (!wait_for_nodes_.empty()) {
+      // Client nodes (the baselines or a user's own): known to the master once they have
+      // initialised ROS.
+      std::vector<std::string> nodes;
+      ros::master::getNodes(nodes);
+      for (const auto& n : wait_for_nodes_) {
+        if (std::find(nodes.begin(), nodes.end(), n) == nodes.end()) {
+          missing += (missing.empty() ? "" : ", ") + n;
+        }
+      }
+    }
     if (missing.empty()) return;
     if (ros::WallTime::now() > deadline) {
-      ROS_WARN("simulator: starting without subscribers on %s (~wait_timeout %.0f s)", missing.c_str(),
+      ROS_WARN("simulator: starting without %s (~wait_timeout %.0f s)", missing.c_str(),
                wait_timeout_);
       return;
     }

@@ -12,6 +12,7 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/sim_config_io.h"
 
 namespace hameritt::ros_wrappers {
 namespace {
@@ -42,6 +43,43 @@ TEST(MissionConversions, RoundTripKeepsEveryField) {
   EXPECT_TRUE(back.relations.back().eventually);
   EXPECT_EQ(back.relations.back().time, 12.5);
   EXPECT_EQ(back.relations.back().related_attributes.integer("storeys", -1), 2);
+}
+
+TEST(MissionConversions, UavSpecRoundTripAndBadMessages) {
+  const scenario::SimConfig cfg = scenario::loadSimConfig("scenarios/default/sim_config.json");
+  const hameritt::UavSpec msg = toMsg(cfg.uav, cfg.scenario_id);
+  EXPECT_EQ(msg.scenario_id, cfg.scenario_id);
+  ASSERT_EQ(msg.cameras.size(), 2u);
+  EXPECT_EQ(msg.cameras[1].frame_id, "uav/camera_down_optical");
+  EXPECT_EQ(msg.cameras[1].mount_rpy_deg.y, 90.0);
+  const scenario::UavSpec back = fromMsg(msg);
+  EXPECT_EQ(back.altitude_min, cfg.uav.altitude_min);
+  EXPECT_EQ(back.altitude_max, cfg.uav.altitude_max);
+  EXPECT_EQ(back.max_speed, cfg.uav.max_speed);
+  EXPECT_EQ(back.start.x, cfg.uav.start.x);
+  EXPECT_EQ(back.start.yaw, cfg.uav.start.yaw);
+  ASSERT_EQ(back.cameras.size(), cfg.uav.cameras.size());
+  for (std::size_t i = 0; i < back.cameras.size(); ++i) {
+    const auto& a = back.cameras[i];
+    const auto& b = cfg.uav.cameras[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.mount_xyz, b.mount_xyz);
+    EXPECT_EQ(a.mount_rpy, b.mount_rpy);
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    EXPECT_EQ(a.hfov_deg, b.hfov_deg);
+    EXPECT_EQ(a.rate_hz, b.rate_hz);
+    EXPECT_EQ(a.modalities, b.modalities);
+  }
+  hameritt::UavSpec bad = msg;
+  bad.altitude_max = bad.altitude_min;
+  EXPECT_THROW(fromMsg(bad), scenario::ConfigError);
+  bad = msg;
+  bad.cameras[0].hfov_deg = 0;
+  EXPECT_THROW(fromMsg(bad), scenario::ConfigError);
+  bad = msg;
+  bad.max_speed = std::nan("");
+  EXPECT_THROW(fromMsg(bad), scenario::ConfigError);
 }
 
 TEST(MissionConversions, BadMessagesAreConfigErrors) {

@@ -1,9 +1,10 @@
 #pragma once
 // The ADK node: the ROS API that client algorithms touch. It publishes the mission (never the
-// targets' positions), monitors the flown path against the keep-out zones and areas of
-// interest, gives perfect perception from the renderer's boxes in maneuver-only runs, scores
-// detection claims, and judges the mission's lifecycle and metrics (metrics.json). The logic is
-// the ROS-free hameritt_adk library; this class wires topics to it. See README "ADK".
+// targets' positions) and the UAV's envelope (/mission/uav), monitors the flown path against
+// the keep-out zones and areas of interest, gives perfect perception from the renderer's boxes
+// in maneuver-only runs, scores detection claims, and judges the mission's lifecycle and metrics
+// (metrics.json). The logic is the ROS-free hameritt_adk library; this class wires topics to it.
+// See docs/reference/client-contract.md.
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -77,6 +78,7 @@ class AdkRos {
   std::unique_ptr<scenario::World> world_;
   std::string mode_, output_dir_;
   bool perfect_perception_ = false;
+  bool found_by_sighting_ = false;
   int min_visible_pixels_ = 20;
   double status_period_ = 0.1;
   bool shutdown_on_end_ = true;
@@ -106,8 +108,8 @@ class AdkRos {
   bool write_failed_ = false;
   ros::WallTime finished_at_;
 
-  ros::Publisher mission_pub_, markers_pub_, constraints_pub_, events_pub_, perception_pub_,
-      scores_pub_, state_pub_, metrics_pub_;
+  ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
+      perception_pub_, scores_pub_, state_pub_, metrics_pub_;
   ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };

@@ -35,7 +35,9 @@ namespace hameritt::ros_wrappers {
 //   concurrently, each thread with its own renderer, published in order),
 //   ~record_image_rate (0: also publish camera images decimated to this rate for recording),
 //   ~wait_for (comma-separated topics of this node; the clock starts once each has a
-//   subscriber, or after ~wait_timeout wall seconds, 60), ~geofence_margin (50 m: the UAV is
+//   subscriber, or after ~wait_timeout wall seconds, 60), ~wait_for_nodes (comma-separated
+//   node names, e.g. the mission's clients: the clock also waits until the master knows each,
+//   within the same timeout), ~geofence_margin (50 m: the UAV is
 //   kept inside the neighborhood bounds grown by this and below altitude_max + this),
 //   ~lockstep (false: README "Lock-step missions"; the simulator coordinates the turns of
 //   ~lockstep_participants, comma-separated node names in turn order, every ~lockstep_period
@@ -79,6 +81,7 @@ class SimulatorRos {
   double real_time_factor_ = 0.0;
   double duration_ = 0.0;
   std::vector<std::string> wait_for_;
+  std::vector<std::string> wait_for_nodes_;
   double wait_timeout_ = 60.0;
   bool paused_ = false;
   bool crash_reported_ = false;

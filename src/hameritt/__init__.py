@@ -1,0 +1,1 @@
+"""hameritt for Python clients: hameritt.msg and hameritt.srv (generated), hameritt.lockstep."""
