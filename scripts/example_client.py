@@ -35,21 +35,23 @@ class ExampleClient:
     def __init__(self):
         self.gate = LockstepGate()  # every subscription, publisher and timer goes through it
         self.mission = self.uav = self.odom = None
-        self.mode, self.plan, self.claims = "", [], []
+        self.plan, self.claims = [], []
+        # The mode is also in /adk/state; the launch sets the ADK's parameter before we start.
+        self.mode = rospy.get_param("/adk/mode", "end_to_end")
         self.gate.subscribe("/mission", Mission, lambda m: setattr(self, "mission", m))
         self.gate.subscribe("/mission/uav", UavSpec, lambda m: setattr(self, "uav", m))
         self.gate.subscribe("/uav/odom", Odometry, lambda m: setattr(self, "odom", m), queue_size=1)
         self.gate.subscribe("/adk/state", MissionState, self.on_state)
         self.gate.subscribe("/planner/progress", FollowProgress, self.on_progress)
         self.gate.subscribe("/adk/perfect_perception", PerceptionReport, self.on_perfect)
-        self.gate.subscribe("/uav/camera/down/image_raw", Image, self.on_image, queue_size=1)
+        if self.mode != "maneuver_only":  # a camera no one subscribes to is not rendered
+            self.gate.subscribe("/uav/camera/down/image_raw", Image, self.on_image, queue_size=1)
         self.waypoints = self.gate.advertise("/planner/waypoints", Path, latch=True)
         self.detections = self.gate.advertise("/perception/detections", Detection, queue_size=20)
         self.gate.every(1.0, self.start_search)
 
     def on_state(self, s):
-        self.mode = s.mode
-        if s.state in ("succeeded", "timeout", "crashed", "aborted"):
+        if s.state in ("succeeded", "timeout", "crashed", "aborted") and not rospy.is_shutdown():
             rospy.loginfo("example_client: mission %s (%s); exiting", s.state, s.reason)
             rospy.signal_shutdown("mission over")
 
@@ -96,8 +98,7 @@ class ExampleClient:
             self.claim(e.entity_class, seen, e.position.x, e.position.y, report.header.stamp, 1.0)
 
     def on_image(self, img):
-        if self.mode == "maneuver_only" or None in (self.mission, self.uav, self.odom) or \
-                self.odom.pose.pose.position.z < 10:
+        if None in (self.mission, self.uav, self.odom) or self.odom.pose.pose.position.z < 10:
             return
         target = self.mission.objective.targets[0]
         lo, hi = COLOURS.get(target.color, COLOURS["white"])
