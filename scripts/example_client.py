@@ -21,9 +21,10 @@ from hameritt.lockstep import LockstepGate
 from hameritt.msg import (Detection, FollowProgress, KeyValue, Mission, MissionState,
                           PerceptionReport, PriorCell, UavSpec)
 
-# HSV ranges (OpenCV: H 0-179, S and V 0-255) of the colour names a mission uses.
-COLOURS = {"white": ((0, 0, 200), (179, 40, 255)), "black": ((0, 0, 0), (179, 255, 40)),
-           "red": ((0, 120, 80), (8, 255, 255)), "blue": ((100, 120, 60), (130, 255, 255))}
+# Hue ranges (OpenCV: H 0-179) of saturated colours. White, silver and grey (the brightest 2 %
+# of the unsaturated pixels) and black (the darkest 2 %) are told relative to the image: the
+# scene's light changes with the hour and the weather.
+HUES = {"red": (0, 8), "yellow": (20, 35), "green": (40, 85), "blue": (100, 130)}
 ATTRIBUTES = ["vehicle_class", "make", "model", "color"]
 
 
@@ -101,9 +102,16 @@ class ExampleClient:
         if None in (self.mission, self.uav, self.odom) or self.odom.pose.pose.position.z < 10:
             return
         target = self.mission.objective.targets[0]
-        lo, hi = COLOURS.get(target.color, COLOURS["white"])
         rgb = np.frombuffer(img.data, np.uint8).reshape(img.height, img.step // 3, 3)[:, :img.width]
-        mask = cv2.inRange(cv2.cvtColor(rgb, cv2.COLOR_RGB2HSV), lo, hi)
+        hsv = cv2.cvtColor(cv2.medianBlur(rgb, 5), cv2.COLOR_RGB2HSV)  # the median removes noise
+        v = hsv[:, :, 2]
+        if target.color in HUES:
+            mask = cv2.inRange(hsv, (HUES[target.color][0], 80, 40), (HUES[target.color][1], 255, 255))
+        elif target.color == "black":
+            mask = cv2.inRange(hsv, (0, 0, 0), (179, 80, int(np.percentile(v, 2))))
+        else:
+            mask = cv2.inRange(hsv, (0, 0, int(np.percentile(v, 98))), (179, 50, 255))
+        mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, np.ones((5, 5), np.uint8))
         cam = next(c for c in self.uav.cameras if c.name == "down")
         f = cam.width / 2 / math.tan(math.radians(cam.hfov_deg) / 2)
         p, q = self.odom.pose.pose.position, self.odom.pose.pose.orientation
