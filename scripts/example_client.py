@@ -3,9 +3,9 @@
 
 It reads the mission and the UAV's envelope, flies a simple search (the AOIs' prior cells, most
 probable first, skipping keep-out zones), finds the target (perfect perception in maneuver_only,
-a colour threshold on the down camera otherwise), claims it with its symbolic context (the AOI it
-lies in), and exits when the ADK says the mission is over. Run it beside
-`roslaunch hameritt mission.launch clients:=none client_nodes:=/example_client`.
+a colour threshold on the down camera otherwise), claims it with its symbolic context (the AOI
+it lies in, while that AOI's window is open), and exits when the ADK says the mission is over.
+Run it beside `roslaunch hameritt mission.launch clients:=none client_nodes:=/example_client`.
 """
 import math
 import re
@@ -129,12 +129,16 @@ class ExampleClient:
                 self.claim(target.entity_class, attrs, x, y, img.header.stamp, 0.5)
 
     def claim(self, cls, seen, x, y, stamp, confidence):
-        """Claims a match of the objective's description inside an AOI, once per 10 m."""
+        """Claims a match of the objective's description inside an AOI whose time window is open,
+        once per 10 m."""
         for t in self.mission.objective.targets if self.mission else []:
             if cls != t.entity_class or any(getattr(t, k) and seen.get(k) != getattr(t, k)
                                             for k in ATTRIBUTES):
                 continue
-            aoi = next((a.id for a in self.mission.areas_of_interest if inside(a.polygon, x, y)), "")
+            t_now, aois = stamp.to_sec(), self.mission.areas_of_interest
+            aoi = next((a.id for a in aois if inside(a.polygon, x, y) and  # its window open now
+                        (not a.window.has_net or a.window.net <= t_now) and
+                        (not a.window.has_nlt or t_now <= a.window.nlt)), "")
             if not aoi or any(math.hypot(x - cx, y - cy) < 10 for cx, cy in self.claims):
                 continue
             self.claims.append((x, y))
