@@ -11,7 +11,8 @@ deadline. A page fails when a block exits non-zero or the deadline passes; the f
 page, the block number, the block and the output's tail. The number of blocks that ran to their
 end must equal the number the page has, and every <!-- runnable --> marker must open a bash block.
 
-Also checked: every relative link and image of README.md and docs/**/*.md resolves to an existing
+Also checked: each tool of docs/reference/tools.md answers --help with a usage (exit 0) that
+names every --flag its section names; every relative link and image of README.md and docs/**/*.md resolves to an existing
 file (anchors are not checked); README.md has at most 250 lines and each page of docs/index.md,
 docs/tutorials, docs/howto, docs/reference and docs/explanation at most 400 (docs/RELIABILITY.md,
 like BENCHMARKS.md, is the measured record and has no limit).
@@ -19,7 +20,7 @@ like BENCHMARKS.md, is the measured record and has no limit).
 Negative controls, run first: a synthetic page whose second of three blocks fails must be
 reported failing at block 2 with block 3 not run; a block that outlives the deadline must be
 reported; a dangling marker must be reported; a page with a broken link and one over the line
-limit must be reported.
+limit must be reported; a documented flag a tool lacks, and a missing tool, must be reported.
 """
 import glob
 import os
@@ -218,6 +219,40 @@ def check_lengths(root, files):
     return over
 
 
+def check_tools(root, bin_dir):
+    """(tools checked, problems): each `## hameritt_*` section of docs/reference/tools.md names a
+    tool whose --help exits 0 with a usage, and every --flag the section names is in that help
+    (for hameritt_campaign, the help of each subcommand)."""
+    text = open(os.path.join(root, "docs", "reference", "tools.md")).read()
+    sections = re.split(r"^## ", text, flags=re.M)[1:]
+    checked, problems = 0, []
+    for sec in sections:
+        tool = sec.split("\n", 1)[0].strip()
+        if not tool.startswith("hameritt_"):
+            continue
+        checked += 1
+        exe = os.path.join(bin_dir, tool)
+        runs = [[exe, "--help"]]
+        if tool == "hameritt_campaign":
+            runs += [[exe, c, "--help"] for c in
+                     ("plan", "run", "run-shard", "submit", "status", "merge", "compare")]
+        helps = []
+        if not os.access(exe, os.X_OK):
+            problems.append("%s: no such tool in %s" % (tool, bin_dir))
+            continue
+        for cmd in runs:
+            r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               universal_newlines=True)
+            if r.returncode != 0 or "usage" not in r.stdout.lower():
+                problems.append("%s: exit %d, no usage: %s" % (" ".join(cmd[1:]), r.returncode,
+                                                             r.stdout[:200]))
+            helps.append(r.stdout)
+        for flag in sorted(set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", sec))):
+            if not any(re.search(re.escape(flag) + r"(?![\w-])", h) for h in helps):
+                problems.append("%s: docs name %s, its --help does not" % (tool, flag))
+    return checked, problems
+
+
 def doc_files(root):
     files = ["README.md"] if os.path.exists(os.path.join(root, "README.md")) else []
     files += sorted(os.path.relpath(p, root)
@@ -269,6 +304,17 @@ def negative_controls(tmp):
         fails.append("negative control: links %d %r, lengths %r" % (checked, broken, over))
     else:
         print("negative control: broken link and long page reported: %s; %s" % (broken[0], over[0]))
+    # A flag the docs name that the tool does not have, and a tool that does not exist.
+    root = os.path.join(tmp, "neg_tools")
+    os.makedirs(os.path.join(root, "docs", "reference"))
+    with open(os.path.join(root, "docs", "reference", "tools.md"), "w") as f:
+        f.write("# Tools\n\n## hameritt_map\n\n`--out`, `--no-such-flag`\n\n## hameritt_nope\n")
+    checked, problems = check_tools(root, BIN)
+    if checked != 2 or len(problems) != 2 or "--no-such-flag" not in problems[0] or (
+            "no such tool" not in problems[1]):
+        fails.append("negative control: tools check: %d %r" % (checked, problems))
+    else:
+        print("negative control: tools check reported: %s" % "; ".join(p[:60] for p in problems))
     return fails
 
 
@@ -289,6 +335,12 @@ def main():
     fails += ["broken link: %s" % b for b in broken]
     fails += ["too long: %s" % o for o in over]
     print("lengths: %d files over their limit" % len(over))
+    tools, problems = check_tools(SRC, BIN)
+    print("tools: %d tools' --help against docs/reference/tools.md, %d problems" % (tools,
+                                                                                  len(problems)))
+    if tools < 9:
+        fails.append("only %d tools found in docs/reference/tools.md" % tools)
+    fails += problems
 
     pages = sorted(glob.glob(os.path.join(SRC, "docs", "tutorials", "[0-9][0-9]-*.md")))
     if len(pages) < 6:
