@@ -11,16 +11,19 @@ deadline. A page fails when a block exits non-zero or the deadline passes; the f
 page, the block number, the block and the output's tail. The number of blocks that ran to their
 end must equal the number the page has, and every <!-- runnable --> marker must open a bash block.
 
-Also checked: each tool of docs/reference/tools.md answers --help with a usage (exit 0) that
-names every --flag its section names; every relative link and image of README.md and docs/**/*.md resolves to an existing
-file (anchors are not checked); README.md has at most 250 lines and each page of docs/index.md,
-docs/tutorials, docs/howto, docs/reference and docs/explanation at most 400 (docs/RELIABILITY.md,
-like BENCHMARKS.md, is the measured record and has no limit).
+Also checked: README.md keeps the two quick-start commands, a picture from docs/images/ and
+links to BENCHMARKS.md and docs/RELIABILITY.md; each tool of docs/reference/tools.md answers
+--help with a usage (exit 0) that names every --flag its section names; every relative link and
+image of README.md and docs/**/*.md resolves to an existing file (anchors are not checked);
+README.md has at most 250 lines and each page of docs/index.md, docs/tutorials, docs/howto,
+docs/reference and docs/explanation at most 400 (docs/RELIABILITY.md, like BENCHMARKS.md, is the
+measured record and has no limit).
 
 Negative controls, run first: a synthetic page whose second of three blocks fails must be
 reported failing at block 2 with block 3 not run; a block that outlives the deadline must be
-reported; a dangling marker must be reported; a page with a broken link and one over the line
-limit must be reported; a documented flag a tool lacks, and a missing tool, must be reported.
+reported and its processes stopped; marker errors must be reported; a broken link, a page over
+the line limit and a README without the quick start, picture or links must be reported; a
+documented flag a tool lacks, and a missing tool, must be reported.
 """
 import glob
 import os
@@ -253,6 +256,23 @@ def check_tools(root, bin_dir):
     return checked, problems
 
 
+def check_readme(root):
+    """What the front door must keep: the two quick-start commands, a picture from docs/images/,
+    and links to the measured record."""
+    text = open(os.path.join(root, "README.md")).read()
+    blocks = re.findall(r"^```bash\n(.*?)^```", text, re.S | re.M)
+    problems = []
+    for cmd in ("bash scripts/run_main.sh", "bash scripts/run_tests.sh"):
+        if not any(re.search(r"^" + re.escape(cmd) + r"(\s|$)", b, re.M) for b in blocks):
+            problems.append("README.md: no bash block with the quick-start command %r" % cmd)
+    if not re.search(r"!\[[^\]]*\]\(docs/images/[^)]+\.png\)", text):
+        problems.append("README.md: no picture from docs/images/")
+    for target in ("BENCHMARKS.md", "docs/RELIABILITY.md"):
+        if "](%s)" % target not in text:
+            problems.append("README.md: no link to %s" % target)
+    return problems
+
+
 def doc_files(root):
     files = ["README.md"] if os.path.exists(os.path.join(root, "README.md")) else []
     files += sorted(os.path.relpath(p, root)
@@ -300,6 +320,11 @@ def negative_controls(tmp):
         f.write("line\n" * (PAGE_MAX_LINES + 1))
     checked, broken, _ = check_links(root, doc_files(root))
     over = check_lengths(root, doc_files(root))
+    readme = check_readme(root)
+    if len(readme) != 5:
+        fails.append("negative control: README check found %r" % readme)
+    else:
+        print("negative control: README check reported %d problems" % len(readme))
     if checked != 2 or broken != ["README.md -> docs/missing.md"] or len(over) != 1:
         fails.append("negative control: links %d %r, lengths %r" % (checked, broken, over))
     else:
@@ -335,6 +360,9 @@ def main():
     fails += ["broken link: %s" % b for b in broken]
     fails += ["too long: %s" % o for o in over]
     print("lengths: %d files over their limit" % len(over))
+    readme = check_readme(SRC)
+    print("README: %d problems (quick start, picture, measured record)" % len(readme))
+    fails += readme
     tools, problems = check_tools(SRC, BIN)
     print("tools: %d tools' --help against docs/reference/tools.md, %d problems" % (tools,
                                                                                   len(problems)))
