@@ -12,7 +12,7 @@ reported a dropped message. Prints the real-time factor and per-topic counts.
       [--compression lz4|bz2] [--mode end_to_end] [--lockstep [--lockstep-period 0.02]]
       [--out DIR]
 
-With --lockstep the mission runs in lock-step (README "Lock-step missions"; the simulator stops
+With --lockstep the mission runs in lock-step (docs/explanation/lockstep.md; the simulator stops
 at --sim-seconds) and the real-time factor is the lock-step loop's.
 
 Also prints the bag's MB per sim second and its bytes per topic group (uncompressed), so that

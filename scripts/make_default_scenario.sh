@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the shipped scenario (scenarios/default) and the README pictures with the
+# Regenerates the shipped scenario (scenarios/default) and the maps in docs/images/ with the
 # project's own tools. Run after a change that alters generator output on purpose.
 source "$(dirname "$0")/common.sh"
 build >/dev/null

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Redraws the README "Rendering" pictures (docs/images/render_*.png) with hameritt_render from
-# the shipped scenario: the front camera of a UAV hovering 22 m above the street east of the
-# target car (car_706), looking west along it; clear, in snow, in fog and at dusk, plus the
-# depth, segmentation and boxes images of the clear view and the down camera over the target.
+# Redraws the renderer pictures (docs/images/render_*.png, shown in docs/explanation/renderer.md)
+# with hameritt_render from the shipped scenario: the front camera of a UAV hovering 22 m above
+# the street east of the target car (car_706), looking west along it; clear, in snow, in fog and
+# at dusk, plus the depth, segmentation and boxes images of the clear view and the down camera
+# over the target.
 # Camera noise is off so that the pictures compress well (and show the scene, not the sensor).
 source "$(dirname "$0")/common.sh"
 build >/dev/null

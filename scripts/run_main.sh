@@ -22,7 +22,7 @@ rm -rf "$OUT/mission"
 mkdir -p "$OUT/mission"
 # A private ROS master port, so that a running roscore is left alone.
 port=$((11400 + $$ % 500))
-# The COP and the TAK bridge ride along (README "Common Operational Picture and TAK bridge"):
+# The COP and the TAK bridge ride along (docs/tutorials/06-cop-tak.md):
 # CoT events go to a local listener on 127.0.0.1 only.
 tak_port=$((16000 + $$ % 2000))
 /usr/bin/python3 "$HAMERITT_ROOT/scripts/cot_listen.py" --port "$tak_port" >"$OUT/mission/cot.log" 2>&1 &

@@ -1,5 +1,5 @@
 // adk: mission API, constraint monitor, perfect perception, detection scoring and metrics
-// (see README "ADK").
+// (see docs/explanation/adk.md).
 #include <ros/ros.h>
 
 #include <csignal>

@@ -1,5 +1,5 @@
 // cop: the Common Operational Picture (track fusion of claims and perfect perception)
-// (see README "Common Operational Picture and TAK bridge").
+// (see docs/explanation/cop.md).
 #include <ros/ros.h>
 
 #include <memory>

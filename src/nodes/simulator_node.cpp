@@ -1,4 +1,4 @@
-// simulator: the physics of a scenario on sim time (see README "Simulator").
+// simulator: the physics of a scenario on sim time (see docs/explanation/simulator.md).
 #include <ros/ros.h>
 
 #include "hameritt/ros/simulator_ros.h"

@@ -1,5 +1,5 @@
 // tak_bridge: the COP, the UAV and the mission's zones as Cursor-on-Target events to TAK
-// (see README "Common Operational Picture and TAK bridge").
+// (see docs/explanation/cop.md).
 #include <ros/ros.h>
 
 #include <memory>

@@ -89,8 +89,13 @@ void summarize(const std::string& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* usage = "usage: hameritt_summary SCENARIO_DIR\n";
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::fputs(usage, stdout);
+    return 0;
+  }
   if (argc != 2) {
-    std::fprintf(stderr, "usage: hameritt_summary SCENARIO_DIR\n");
+    std::fputs(usage, stderr);
     return 2;
   }
   try {

@@ -22,6 +22,10 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw ConfigError(a + ": missing value");
         return argv[++i];
       };
+      if (a == "-h" || a == "--help") {
+        std::fputs("usage: hameritt_world [--world-config FILE] [--seed S] --out FILE\n", stdout);
+        return 0;
+      }
       if (a == "--world-config") cfg = next();
       else if (a == "--seed") seed = next();
       else if (a == "--out") out = next();

@@ -9,7 +9,7 @@ same sim time. `rosbag record` subscribes to every topic of the mission before i
 bags must hold, topic by topic, the same messages in the same order, byte for byte (compared
 with Python rosbag), and the ADK's metrics.json must be byte-identical. The only messages left
 out are the simulator's "t = 1 ns" clock ticks, published while it waits for its subscribers
-(their number depends on start-up timing; README "Lock-step missions").
+(their number depends on start-up timing; docs/explanation/lockstep.md).
 
 A participant that never joins (a simulator alone, told to wait for "/ghost", with a 3 s
 lockstep_timeout) must not hang the simulator: it logs the error and runs to its duration.

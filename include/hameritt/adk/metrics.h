@@ -155,7 +155,7 @@ class MetricsAccumulator {
   bool last_airborne_ = false;
 };
 
-// metrics.json: a fixed field order (README "ADK"), absent times as null.
+// metrics.json: a fixed field order (docs/reference/formats.md), absent times as null.
 std::string metricsJson(const MissionMetrics& m);
 // Writes metrics.json atomically (temporary file and rename); OutputError naming the path.
 void writeMetricsJson(const MissionMetrics& m, const std::string& path);

@@ -9,7 +9,8 @@
 
 namespace hameritt::planning {
 
-// Kinematic limits of the UAV (defaults: the simulator's controller limits, README).
+// Kinematic limits of the UAV (defaults: the simulator's controller limits,
+// docs/explanation/simulator.md).
 struct SpeedLimits {
   double max_speed = 12.0;    // horizontal, m/s
   double climb_rate = 3.0;    // m/s

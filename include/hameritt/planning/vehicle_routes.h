@@ -14,7 +14,7 @@
 
 namespace hameritt::planning {
 
-// How fast a car drives (README conventions: 2 m/s^2, 3 m/s^2 braking, 4.5 m/s corners).
+// How fast a car drives (docs/reference/conventions.md: 2 m/s^2, 3 m/s^2 braking, 4.5 m/s corners).
 // validate() throws scenario::ConfigError naming "route.speed.<field>".
 struct SpeedProfile {
   double cruise_speed = 10.0;

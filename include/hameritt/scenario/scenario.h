@@ -1,7 +1,7 @@
 #pragma once
 // The scenario data model: the mission description (what a client algorithm is told) and the
 // simulation configuration (what the simulator needs). Written as mission.json and
-// sim_config.json; see README "Scenario files".
+// sim_config.json; see docs/reference/formats.md.
 
 #include <cstdint>
 #include <optional>
