@@ -318,10 +318,13 @@ void AdkRos::endAtSimulationEnd(bool force) {
 }
 
 std::string AdkRos::recorderDiskShortage() const {
+  if (recorder_min_space_mb_ <= 0 || output_dir_.empty()) return "";
+  // The disk of the output directory (of its nearest existing parent, before it is made).
   struct statvfs st {};
-  if (recorder_min_space_mb_ <= 0 || output_dir_.empty() ||
-      ::statvfs(output_dir_.c_str(), &st) != 0) {
-    return "";
+  std::filesystem::path dir = std::filesystem::absolute(output_dir_);
+  while (::statvfs(dir.c_str(), &st) != 0) {
+    if (dir == dir.parent_path()) return "";
+    dir = dir.parent_path();
   }
   // As rosbag's recorder judges it (--min-space against the space available to it).
   const double free_mb = static_cast<double>(st.f_bavail) * st.f_frsize / (1024.0 * 1024.0);
