@@ -69,6 +69,8 @@ const char* toString(Outcome o) {
       return "crashed";
     case Outcome::kAborted:
       return "aborted";
+    case Outcome::kEnded:
+      return "ended";
   }
   return "?";
 }
@@ -334,6 +336,8 @@ const char* toString(MissionState s) {
       return "crashed";
     case MissionState::kAborted:
       return "aborted";
+    case MissionState::kEnded:
+      return "ended";
   }
   return "?";
 }
@@ -346,6 +350,8 @@ Outcome outcomeOf(MissionState s) {
       return Outcome::kTimeout;
     case MissionState::kCrashed:
       return Outcome::kCrashed;
+    case MissionState::kEnded:
+      return Outcome::kEnded;
     default:
       return Outcome::kAborted;
   }
@@ -397,6 +403,10 @@ bool MissionLifecycle::crash(double t, const std::string& reason) {
 
 bool MissionLifecycle::abort(double t, const std::string& reason) {
   return end(MissionState::kAborted, t, reason);
+}
+
+bool MissionLifecycle::simulationEnded(double t, const std::string& reason) {
+  return end(MissionState::kEnded, t, reason);
 }
 
 }  // namespace hameritt::adk

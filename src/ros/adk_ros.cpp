@@ -1,11 +1,13 @@
 #include "hameritt/ros/adk_ros.h"
 
 #include <ros/callback_queue.h>
+#include <sys/statvfs.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "hameritt/ConstraintEvent.h"
@@ -105,6 +107,12 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                       scenario::formatNumber(coverage_max_range_));
   }
 
+  pnh.param("recorder_min_space_mb", recorder_min_space_mb_, 0.0);
+  if (!(recorder_min_space_mb_ >= 0.0 && recorder_min_space_mb_ <= 1e9)) {
+    throw ConfigError("~recorder_min_space_mb: expected MB in [0, 1e9] (0 = no recorder), got " +
+                      scenario::formatNumber(recorder_min_space_mb_));
+  }
+
   mission_ = scenario::loadMission(mission_path);
   sim_config_ = scenario::loadSimConfig(sim_config_path);
   if (sim_config_.scenario_id != mission_.scenario_id) {
@@ -169,6 +177,8 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
         nh, topic, 20,
         [this, i](const hameritt::BoundingBoxArray::ConstPtr& m) { onBoxes(i, m); }));
   }
+  // Last: in lock-step a turn hands it over after the odometry of the same cycle.
+  sim_end_sub_ = gate_->subscribe(nh, "simulator/end", 1, &AdkRos::onSimulationEnd, this);
   // The state again every second (wall time; sim time in lock-step), until the mission ends.
   gate_->every(
       nh, 1.0,
@@ -285,6 +295,51 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   // A target found before the mission started running ends it as soon as it runs.
   checkObjective(t);
+  endAtSimulationEnd(false);
+}
+
+void AdkRos::onSimulationEnd(const hameritt::SimulationEnd::ConstPtr& msg) {
+  if (finished_ || sim_end_pending_) return;
+  sim_end_pending_ = true;
+  sim_end_t_ = msg->header.stamp.toSec();
+  sim_end_reason_ = msg->reason;
+  sim_end_seen_ = ros::WallTime::now();
+  ROS_INFO("adk: the simulator stopped at sim time %.3f s (%s): ending the mission", sim_end_t_,
+           sim_end_reason_.c_str());
+  endAtSimulationEnd(false);
+}
+
+void AdkRos::endAtSimulationEnd(bool force) {
+  if (!sim_end_pending_ || finished_) return;
+  // Free running, the last odometry may arrive just after the end message.
+  if (!force && have_odom_ && last_odom_t_ < sim_end_t_ - 1e-6) return;
+  sim_end_pending_ = false;
+  now_ = std::max(now_, sim_end_t_);
+  // A time limit reached at the same sim time is the mission's own end: it goes first.
+  if (!lifecycle_->update(sim_end_t_, have_odom_) || !lifecycle_->ended()) {
+    lifecycle_->simulationEnded(sim_end_t_, sim_end_reason_);
+  }
+  publishState();
+  finish();
+}
+
+std::string AdkRos::recorderDiskShortage() const {
+  if (recorder_min_space_mb_ <= 0 || output_dir_.empty()) return "";
+  // The disk of the output directory (of its nearest existing parent, before it is made).
+  struct statvfs st {};
+  std::filesystem::path dir = std::filesystem::absolute(output_dir_);
+  while (::statvfs(dir.c_str(), &st) != 0) {
+    if (dir == dir.parent_path()) return "";
+    dir = dir.parent_path();
+  }
+  // As rosbag's recorder judges it (--min-space against the space available to it).
+  const double free_mb = static_cast<double>(st.f_bavail) * st.f_frsize / (1024.0 * 1024.0);
+  if (free_mb >= recorder_min_space_mb_) return "";
+  char buf[512];
+  std::snprintf(buf, sizeof(buf),
+                "recorder stopped: less than %g MB free on the output disk (%.1f MB free in %s)",
+                recorder_min_space_mb_, free_mb, output_dir_.c_str());
+  return buf;
 }
 
 void AdkRos::onTruth(const hameritt::EntityStateArray::ConstPtr& msg) {
@@ -452,10 +507,17 @@ int AdkRos::spin() {
         finish();
       }
     }
+    if (sim_end_pending_ && (ros::WallTime::now() - sim_end_seen_).toSec() >= 1.0) {
+      endAtSimulationEnd(true);
+    }
     if (g_stop || !ros::ok()) {
       if (!finished_) {
-        lifecycle_->abort(now_, g_stop ? "interrupted (SIGINT/SIGTERM) before the end"
-                                       : "ROS shut down before the end");
+        std::string why =
+            g_stop ? "interrupted (SIGINT/SIGTERM) before the end" : "ROS shut down before the end";
+        // The launch ends when its required recorder stops, which it does for lack of space.
+        const std::string disk = recorderDiskShortage();
+        if (!disk.empty()) why = disk + "; " + why;
+        lifecycle_->abort(now_, why);
         finish();
       }
       break;

@@ -9,9 +9,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "hameritt/CrashEvent.h"
 #include "hameritt/EntityStateArray.h"
+#include "hameritt/SimulationEnd.h"
 #include "hameritt/build_paths.h"
 #include "hameritt/ros/conversions.h"
 #include "hameritt/ros/log_throttle.h"
@@ -167,6 +169,7 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   imu_pub_ = gate_->advertise<sensor_msgs::Imu>(nh, "uav/imu", 50);
   truth_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "ground_truth/entities", 10);
   crash_pub_ = gate_->advertise<hameritt::CrashEvent>(nh, "uav/crash", 1, true);
+  end_pub_ = gate_->advertise<hameritt::SimulationEnd>(pnh, "end", 1, true);
   if (gate_->enabled()) {
     // The tf broadcasters' topics (the same publications as theirs), for the connect phase.
     tf_watch_ = gate_->advertise<tf2_msgs::TFMessage>(nh, "/tf", 100);
@@ -331,6 +334,7 @@ void SimulatorRos::spin() {
   while (ros::ok()) {
     const bool running = !paused_ && sim_->time() < duration_;
     if (!running) {
+      if (!lockstep && sim_->time() >= duration_) publishEndOnce();
       if (lockstep && !ended && sim_->time() >= duration_) {
         ended = true;
         ROS_INFO("simulator: lock-step: stopped at the duration, sim %.3f s, cycle %llu, in wall "
@@ -352,6 +356,8 @@ void SimulatorRos::spin() {
       gate_->beforeCycle();
       advance(steps_per_cycle_);
       if (cameras_) cameras_->flush();
+      // In the last cycle's messages, so that the participants' last turn hands it over.
+      if (sim_->time() >= duration_) publishEndOnce();
       ros::Time stamp;
       stamp.fromSec(sim_->time());
       if (!gate_->afterCycle(++cycle, stamp)) break;
@@ -369,6 +375,19 @@ void SimulatorRos::spin() {
       if (ahead > 0) ros::WallDuration(ahead).sleep();
     }
   }
+}
+
+void SimulatorRos::publishEndOnce() {
+  if (end_published_) return;
+  end_published_ = true;
+  hameritt::SimulationEnd m;
+  m.header.stamp.fromSec(sim_->time());
+  m.duration = duration_;
+  char reason[96];
+  std::snprintf(reason, sizeof(reason), "simulation duration %g s reached", duration_);
+  m.reason = reason;
+  gate_->publish(end_pub_, m);
+  ROS_INFO("simulator: %s at sim %.3f s (~end)", m.reason.c_str(), sim_->time());
 }
 
 void SimulatorRos::applyVelocity() {
@@ -459,6 +478,7 @@ bool SimulatorRos::onReset(hameritt::ResetSimulation::Request&,
   velocity_mode_ = false;
   step_count_ = 0;
   crash_reported_ = false;
+  end_published_ = false;
   publishState(true);
   res.success = true;
   res.code = 0;

@@ -380,22 +380,80 @@ std::string worldJson(const World& world) {
   return w.take();
 }
 
+namespace {
+
+// Writes `content` to a new file `p` (write() until done, then fsync() when `sync`); throws
+// OutputError naming `shown` and the cause (ENOSPC: "No space left on device"). Removes nothing.
+void writeWhole(const std::string& p, std::string_view content, bool sync,
+                const std::string& shown) {
+  const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw OutputError(shown + ": cannot write: " + std::strerror(errno));
+  std::size_t done = 0;
+  while (done < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n == 0 ? EIO : errno;
+      ::close(fd);
+      throw OutputError(shown + ": write failed: " + std::strerror(err));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (sync && ::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw OutputError(shown + ": write failed: " + std::strerror(err));
+  }
+  if (::close(fd) != 0) throw OutputError(shown + ": write failed: " + std::strerror(errno));
+}
+
+// Flushes a directory's entries (a rename in it) to the disk; best effort.
+void syncDirectory(const std::string& dir) {
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
 void writeFileAtomic(const std::string& path, const std::string& content) {
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw OutputError(path + ": cannot write: " + std::strerror(errno));
-  const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed) {
-    const int err = errno;
+  try {
+    writeWhole(tmp, content, /*sync=*/true, path);
+  } catch (const OutputError&) {
     std::remove(tmp.c_str());
-    throw OutputError(path + ": write failed: " + std::strerror(err));
+    throw;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const int err = errno;
     std::remove(tmp.c_str());
     throw OutputError(path + ": cannot rename into place: " + std::strerror(err));
   }
+  syncDirectory(fs::path(path).parent_path().string());
+}
+
+void replaceDirectory(const std::string& tmp, const std::string& final_path) {
+  if (std::rename(tmp.c_str(), final_path.c_str()) == 0) return;
+  if (errno != EEXIST && errno != ENOTEMPTY) {
+    throw OutputError(final_path + ": cannot move into place: " + std::strerror(errno));
+  }
+  std::error_code ec;
+  // An older directory of the same name: swap the two in one step, then remove the old one.
+  if (::renameat2(AT_FDCWD, tmp.c_str(), AT_FDCWD, final_path.c_str(), RENAME_EXCHANGE) == 0) {
+    fs::remove_all(tmp, ec);
+    return;
+  }
+  if (errno != EINVAL && errno != ENOSYS) {
+    throw OutputError(final_path + ": cannot move into place: " + std::strerror(errno));
+  }
+  // A file system without the exchange: move the old one aside, then the new one in.
+  const std::string old = final_path + ".old-" + std::to_string(::getpid());
+  if (std::rename(final_path.c_str(), old.c_str()) != 0 ||
+      std::rename(tmp.c_str(), final_path.c_str()) != 0) {
+    throw OutputError(final_path + ": cannot move into place: " + std::strerror(errno));
+  }
+  fs::remove_all(old, ec);
 }
 
 std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
@@ -412,20 +470,7 @@ std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
   try {
     auto put = [&](const char* name, std::string_view content) {
       const std::string p = tmp + "/" + name;
-      const int fd = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-      if (fd < 0) throw OutputError(p + ": cannot write: " + std::strerror(errno));
-      std::size_t done = 0;
-      while (done < content.size()) {
-        const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-          const int err = errno;
-          ::close(fd);
-          throw OutputError(p + ": write failed: " + std::strerror(err));
-        }
-        done += static_cast<std::size_t>(n);
-      }
-      if (::close(fd) != 0) throw OutputError(p + ": write failed: " + std::strerror(errno));
+      writeWhole(p, content, /*sync=*/false, p);
     };
     // Both documents are formatted in per-thread writers whose buffers are reused from one
     // scenario to the next, and written from there (the same bytes as missionJson() and
@@ -435,15 +480,7 @@ std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
     put("mission.json", t_writer.finish());
     writeSimConfig(t_writer, s.sim);
     put("sim_config.json", t_writer.finish());
-    if (std::rename(tmp.c_str(), final_dir.c_str()) != 0) {
-      // An older scenario of the same id: move it aside, then replace it.
-      const std::string old = final_dir + ".old-" + std::to_string(::getpid());
-      if (std::rename(final_dir.c_str(), old.c_str()) != 0 ||
-          std::rename(tmp.c_str(), final_dir.c_str()) != 0) {
-        throw OutputError(final_dir + ": cannot move scenario into place: " + std::strerror(errno));
-      }
-      fs::remove_all(old, ec);
-    }
+    replaceDirectory(tmp, final_dir);
   } catch (...) {
     fs::remove_all(tmp, ec);
     throw;

@@ -12,6 +12,7 @@
 // Exit codes: 0 success, 2 bad flags or output directory, 3 unreadable bag, 4 output write
 // failure, 5 no frames to export, 1 internal error, 130 interrupted.
 
+#include <fcntl.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
 #include <rosbag/view.h>
@@ -46,6 +47,8 @@
 #include "hameritt/dataset/coco.h"
 #include "hameritt/dataset/frame.h"
 #include "hameritt/dataset/rle.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/scenario_io.h"
 
 namespace fs = std::filesystem;
 namespace dataset = hameritt::dataset;
@@ -242,8 +245,11 @@ void writeFile(const fs::path& path, const void* data, std::size_t size) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) throw ExitError(kExitWrite, path.string() + ": " + std::strerror(errno));
   const bool ok = std::fwrite(data, 1, size, f) == size;
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed) throw ExitError(kExitWrite, path.string() + ": write failed (disk full?)");
+  int err = ok ? 0 : errno;
+  if (std::fclose(f) != 0 && err == 0) err = errno;
+  if (!ok || err != 0) {
+    throw ExitError(kExitWrite, path.string() + ": write failed: " + std::strerror(err));
+  }
 }
 
 void writeFile(const fs::path& path, const std::string& text) {
@@ -948,19 +954,24 @@ int main(int argc, char** argv) {
       exporter.finish();
     }
     if (g_interrupted) throw ExitError(kExitInterrupted, "interrupted");
-    if (fs::exists(out_clean)) {
-      const fs::path old = out_clean.string() + ".old" + std::to_string(getpid());
-      fs::rename(out_clean, old);
-      fs::rename(tmp, out_clean);
-      fs::remove_all(old);
-    } else {
-      fs::rename(tmp, out_clean);
+    // Every file on the disk before the dataset takes its name (a crash leaves the old one or
+    // the new one whole); then the name, replacing an older dataset in one step.
+    const int dir = ::open(tmp.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    const bool synced = dir >= 0 && ::syncfs(dir) == 0;
+    const int sync_err = errno;
+    if (dir >= 0) ::close(dir);
+    if (!synced) {
+      throw ExitError(kExitWrite, tmp.string() + ": sync failed: " + std::strerror(sync_err));
     }
+    hameritt::scenario::replaceDirectory(tmp, out_clean);
     return 0;
   } catch (const ExitError& e) {
     std::fprintf(stderr, "hameritt_export: %s\n", e.what());
     code = e.code;
   } catch (const fs::filesystem_error& e) {
+    std::fprintf(stderr, "hameritt_export: %s\n", e.what());
+    code = kExitWrite;
+  } catch (const hameritt::scenario::OutputError& e) {
     std::fprintf(stderr, "hameritt_export: %s\n", e.what());
     code = kExitWrite;
   } catch (const std::exception& e) {

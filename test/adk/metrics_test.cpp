@@ -181,6 +181,15 @@ TEST(MissionLifecycle, Transitions) {
   s.update(1.0, true);
   EXPECT_TRUE(s.succeed(4.0, "found"));
   EXPECT_EQ(outcomeOf(s.state()), Outcome::kSuccess);
+  MissionLifecycle e(10.0);
+  e.update(1.0, true);
+  EXPECT_TRUE(e.simulationEnded(8.0, "simulation duration 8 s reached"));
+  EXPECT_EQ(outcomeOf(e.state()), Outcome::kEnded);
+  EXPECT_STREQ(toString(e.state()), "ended");
+  EXPECT_STREQ(toString(outcomeOf(e.state())), "ended");
+  EXPECT_EQ(e.endTime(), 8.0);
+  EXPECT_FALSE(e.update(10.0, true));  // ended stays ended: no timeout after it
+  EXPECT_EQ(e.state(), MissionState::kEnded);
   EXPECT_THROW(MissionLifecycle(0.0), InputError);
 }
 

@@ -11,6 +11,11 @@ with Python rosbag), and the ADK's metrics.json must be byte-identical. The only
 out are the simulator's "t = 1 ns" clock ticks, published while it waits for its subscribers
 (their number depends on start-up timing; docs/explanation/lockstep.md).
 
+Beyond the shipped scenario: one generated scenario of each class (hameritt_generate
+--scenario-seed, area_search, route_search and pursuit) flies twice in maneuver_only mode for
+3 sim s without a time limit (the simulator's duration ends it: outcome `ended` in both runs),
+with the same comparison.
+
 A participant that never joins (a simulator alone, told to wait for "/ghost", with a 3 s
 lockstep_timeout) must not hang the simulator: it logs the error and runs to its duration.
 
@@ -19,6 +24,7 @@ Negative control: a third end_to_end run with lock-step cycles of 0.04 s instead
 comparison is shown to see a change.
 """
 import hashlib
+import json
 import os
 import signal
 import subprocess
@@ -49,11 +55,17 @@ MUST = ["/clock", "/uav/odom", "/ground_truth/entities", "/mission", "/adk/state
         "/adk/constraints", "/uav/cmd_pose", "/planner/path", "/planner/progress",
         "/planner/waypoints", "/uav/camera/down/image_raw", "/uav/camera/front/boxes"]
 MODES = [("end_to_end", 6.0, []), ("maneuver_only", 5.0, ["/adk/perfect_perception"])]
+# Generated scenarios: class, scenario seed; flown for GENERATED_DURATION sim s.
+GENERATED = [("area_search", 11), ("route_search", 12), ("pursuit", 13)]
+GENERATED_DURATION = 3.0
+GENERATED_MUST = ["/clock", "/uav/odom", "/ground_truth/entities", "/mission", "/adk/state",
+                  "/adk/metrics", "/uav/camera/down/image_raw", "/uav/camera/front/boxes"]
 
 
-def run_mission(base, name, mode, limit, period=0.02):
+def run_mission(base, name, mode, limit, period=0.02, scenario=None, time_limit=True):
     """One mission into base/name/mission.bag; returns the wall seconds of the launch.
 
+    `limit` is the simulator's duration and, with `time_limit`, the mission's time limit.
     Every run writes to the same base/current (the metrics name their file), renamed after."""
     out = os.path.join(base, "current")
     os.makedirs(out)
@@ -70,14 +82,18 @@ def run_mission(base, name, mode, limit, period=0.02):
         started = time.time()
         launch = subprocess.Popen(
             ["roslaunch", "hameritt", "mission.launch", "lockstep:=true", "real_time_factor:=0",
-             "mode:=" + mode, "time_limit:=%g" % limit, "duration:=%g" % limit,
-             "lockstep_period:=%g" % period, "output_dir:=" + out],
+             "mode:=" + mode, "duration:=%g" % limit, "lockstep_period:=%g" % period,
+             "output_dir:=" + out] + (["time_limit:=%g" % limit] if time_limit else []) +
+            (["scenario:=" + scenario] if scenario else []),
             stdout=open(os.path.join(out, "launch.log"), "w"), stderr=subprocess.STDOUT, env=env)
-        # The ADK ends the mission at the limit, lingers a second and exits; the launch follows.
+        # The ADK ends the mission at the limit (or the simulator's end), lingers a second and
+        # exits; the launch follows.
         launch.wait(240)
         wall = time.time() - started
         launch = None
-        time.sleep(1.0)  # the recorder writes what it received
+        # The recorder writes what it received; under load it still receives for a while (a
+        # run on a machine at load 10 once lost the last 0.3 sim s of the 250 Hz topics after 1 s).
+        time.sleep(3.0)
     finally:
         if launch is not None:
             launch.send_signal(signal.SIGINT)
@@ -146,6 +162,43 @@ def ghost(out, fails):
         subprocess.run(["rosparam", "delete", "/lockstep_timeout"])
 
 
+def generated(out, fails):
+    """A generated scenario of each class, twice, compared as above."""
+    gen = os.path.join(out, "generated")
+    for cls, seed in GENERATED:
+        r = subprocess.run([os.path.join(os.environ["HAMERITT_BIN_DIR"], "hameritt_generate"),
+                            "--class", cls, "--scenario-seed", str(seed), "--out", gen],
+                           capture_output=True, text=True)
+        ids = r.stdout.split()  # the generated scenario's id
+        if r.returncode != 0 or len(ids) != 1:
+            fails.append("hameritt_generate --class %s: exit %d, %s (%s)"
+                         % (cls, r.returncode, ids, r.stderr.strip()))
+            continue
+        scenario = os.path.join(gen, ids[0])
+        runs = []
+        for run in (1, 2):
+            name = "%s_%d" % (cls, run)
+            wall = run_mission(out, name, "maneuver_only", GENERATED_DURATION, scenario=scenario,
+                               time_limit=False)
+            d = os.path.join(out, name)
+            msgs = messages(os.path.join(d, "mission.bag"))
+            metrics = open(os.path.join(d, "metrics.json"), "rb").read()
+            outcome = json.loads(metrics)["outcome"]
+            runs.append((msgs, metrics))
+            print("%s (%s) run %d: %d messages, %.1f sim s in %.1f wall s, outcome %s"
+                  % (cls, ids[0], run, sum(len(v) for v in msgs.values()), GENERATED_DURATION,
+                     wall, outcome))
+            if outcome != "ended":
+                fails.append("%s run %d: outcome %s, expected ended (the simulator's duration)"
+                             % (cls, run, outcome))
+            for topic in GENERATED_MUST:
+                if not msgs.get(topic):
+                    fails.append("%s run %d: nothing on %s" % (cls, run, topic))
+        compare(runs[0][0], runs[1][0], fails, cls)
+        if runs[0][1] != runs[1][1]:
+            fails.append("%s: metrics.json differs" % cls)
+
+
 def main():
     out = tempfile.mkdtemp(prefix="hameritt_lockstep.")
     core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
@@ -186,6 +239,7 @@ def main():
                           % (topic, "identical" if same else "different"))
                     if same:
                         fails.append("cycles of 0.04 s: %s is the same as with 0.02 s" % topic)
+        generated(out, fails)
         ghost(out, fails)
     finally:
         core.send_signal(signal.SIGINT)
@@ -195,8 +249,8 @@ def main():
     if fails:
         print("FAIL (runs kept in %s):\n  " % out + "\n  ".join(fails))
         return 1
-    print("PASS: each mode's two lock-step missions recorded the same %d topics, byte for byte, "
-          "and the same metrics.json" % len(TOPICS))
+    print("PASS: each mode's and each generated class's two lock-step missions recorded the same "
+          "%d topics, byte for byte, and the same metrics.json" % len(TOPICS))
     return 0
 
 

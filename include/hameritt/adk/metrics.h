@@ -48,8 +48,9 @@ struct EnergyModel {
   bool airborne(const geometry::Vec3& p, const geometry::Vec3& v) const;
 };
 
-enum class Outcome { kSuccess, kTimeout, kCrashed, kAborted };
-// "success", "timeout", "crashed", "aborted".
+enum class Outcome { kSuccess, kTimeout, kCrashed, kAborted, kEnded };
+// "success", "timeout", "crashed", "aborted", "ended" (the simulator stopped at its duration
+// before the time limit).
 const char* toString(Outcome o);
 
 // How the objective is judged.
@@ -161,14 +162,14 @@ std::string metricsJson(const MissionMetrics& m);
 void writeMetricsJson(const MissionMetrics& m, const std::string& path);
 
 // The states of a mission run, and the transitions the ADK node drives.
-enum class MissionState { kWaiting, kRunning, kSucceeded, kTimeout, kCrashed, kAborted };
-// "waiting", "running", "succeeded", "timeout", "crashed", "aborted".
+enum class MissionState { kWaiting, kRunning, kSucceeded, kTimeout, kCrashed, kAborted, kEnded };
+// "waiting", "running", "succeeded", "timeout", "crashed", "aborted", "ended".
 const char* toString(MissionState s);
 Outcome outcomeOf(MissionState s);
 
 // waiting -> running at the first sim time > 0 with odometry; running -> succeeded (objective
-// met), timeout (time limit reached), crashed; any state before an end -> aborted. An ended
-// mission stays ended.
+// met), timeout (time limit reached), crashed; any state before an end -> aborted, or ended (the
+// simulation stopped at its duration). An ended mission stays ended.
 class MissionLifecycle {
  public:
   // time_limit in seconds of mission time (> 0, finite; InputError otherwise).
@@ -179,6 +180,8 @@ class MissionLifecycle {
   bool succeed(double t, const std::string& reason);
   bool crash(double t, const std::string& reason);
   bool abort(double t, const std::string& reason);
+  // The simulator stopped at its duration at sim time t (before the time limit).
+  bool simulationEnded(double t, const std::string& reason);
 
   MissionState state() const { return state_; }
   bool ended() const;

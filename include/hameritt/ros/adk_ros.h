@@ -19,6 +19,7 @@
 #include "hameritt/CrashEvent.h"
 #include "hameritt/Detection.h"
 #include "hameritt/EntityStateArray.h"
+#include "hameritt/SimulationEnd.h"
 #include "hameritt/adk/clock_watchdog.h"
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/adk/coverage.h"
@@ -37,7 +38,9 @@ namespace hameritt::ros_wrappers {
 //   ~status_rate_hz (10, sim time), ~shutdown_on_end (true), ~end_linger (1.0 wall s),
 //   ~time_limit (mission.time_limit), ~car_gate (6), ~pedestrian_gate (3),
 //   ~found_by_sighting (default: mode == maneuver_only), ~track_fraction (0.5),
-//   ~coverage_cell_size (2), ~coverage_max_range (150).
+//   ~coverage_cell_size (2), ~coverage_max_range (150),
+//   ~recorder_min_space_mb (0 = no recorder; else the recorder's --min-space in MB: a mission
+//   cut short while ~output_dir's disk has less free names the recorder's stop as the cause).
 // Topics are relative to the node's namespace (/mission, /adk/... in the root namespace).
 class AdkRos {
  public:
@@ -60,6 +63,12 @@ class AdkRos {
   void onCrash(const hameritt::CrashEvent::ConstPtr& msg);
   void onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
+  // The simulator stopped at its duration: the mission ends (outcome ended) once the odometry
+  // up to that time has been handled (at once in lock-step; free running, within a wall second).
+  void onSimulationEnd(const hameritt::SimulationEnd::ConstPtr& msg);
+  void endAtSimulationEnd(bool force);
+  // "" or "recorder stopped: less than N MB free on the output disk (...)".
+  std::string recorderDiskShortage() const;
 
   // Scenario entities at time t (ground truth history when there is one, else their
   // sim_config trajectories) and parked world cars.
@@ -84,6 +93,7 @@ class AdkRos {
   bool shutdown_on_end_ = true;
   double end_linger_ = 1.0;
   double coverage_max_range_ = 150.0;
+  double recorder_min_space_mb_ = 0.0;
   std::vector<adk::CameraIntrinsics> intrinsics_;
   std::map<std::string, std::size_t> scenario_index_;  // scenario entity id -> sim_config index
   std::vector<adk::EntityTruth> world_cars_;
@@ -106,11 +116,17 @@ class AdkRos {
   std::vector<double> next_footprint_t_;
   bool finished_ = false;
   bool write_failed_ = false;
+  // The simulator's end, waiting for the odometry up to its time.
+  bool sim_end_pending_ = false;
+  double sim_end_t_ = 0.0;
+  std::string sim_end_reason_;
+  ros::WallTime sim_end_seen_;
   ros::WallTime finished_at_;
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
       perception_pub_, scores_pub_, state_pub_, metrics_pub_;
-  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_;
+  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_,
+      sim_end_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };
 

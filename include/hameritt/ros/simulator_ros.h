@@ -64,6 +64,8 @@ class SimulatorRos {
   bool onStep(hameritt::StepSimulation::Request& req, hameritt::StepSimulation::Response& res);
   bool onPause(hameritt::SetPaused::Request& req, hameritt::SetPaused::Response& res);
   bool onReset(hameritt::ResetSimulation::Request& req, hameritt::ResetSimulation::Response& res);
+  // Publishes ~end once the sim time has reached the duration.
+  void publishEndOnce();
 
   // Declared first: the subscriptions and publishers below go through it.
   std::unique_ptr<LockstepGate> gate_;
@@ -89,7 +91,10 @@ class SimulatorRos {
   int steps_per_ground_truth_ = 1;
   long long step_count_ = 0;
 
-  ros::Publisher clock_pub_, odom_pub_, imu_pub_, truth_pub_, crash_pub_, tf_watch_, tf_static_watch_;
+  ros::Publisher clock_pub_, odom_pub_, imu_pub_, truth_pub_, crash_pub_, tf_watch_,
+      tf_static_watch_, end_pub_;
+  // ~end (latched) announced for the duration reached (again after a reset).
+  bool end_published_ = false;
   ros::Subscriber vel_sub_, pose_sub_;
   ros::ServiceServer step_srv_, pause_srv_, reset_srv_;
   tf2_ros::TransformBroadcaster tf_;

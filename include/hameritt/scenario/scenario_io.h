@@ -25,6 +25,11 @@ std::string hex64(std::uint64_t v);
 // that readers never see a partial file. Throws OutputError naming the path.
 void writeFileAtomic(const std::string& path, const std::string& content);
 
+// Moves the finished directory `tmp` to `final_path` (same file system): a rename or, where
+// `final_path` exists, an atomic exchange (renameat2 RENAME_EXCHANGE) and the removal of the
+// old one, so that `final_path` names a complete directory at every instant. Throws OutputError.
+void replaceDirectory(const std::string& tmp, const std::string& final_path);
+
 // Writes DIR/<scenario_id>/{mission.json, sim_config.json} through a temporary directory that
 // is renamed into place (replacing an older scenario of the same id). Returns the directory.
 std::string writeScenarioDir(const std::string& dir, const Scenario& s);

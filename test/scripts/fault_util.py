@@ -1,0 +1,76 @@
+"""Shared pieces of the write-fault, full-disk and duration-end tests: a tally of checks, the
+metrics.json schema (python3-jsonschema) and an ADK that writes its metrics without a mission."""
+import json
+import os
+import signal
+import subprocess
+import time
+
+from jsonschema import Draft7Validator
+
+SRC = os.environ["HAMERITT_SOURCE_DIR"]
+BIN = os.environ["HAMERITT_BIN_DIR"]
+SCENARIO = os.path.join(SRC, "scenarios", "default")
+
+
+class Checks:
+    """Counts checks; prints and keeps each failure."""
+
+    def __init__(self):
+        self.passed = 0
+        self.fails = []
+
+    def __call__(self, cond, what):
+        if cond:
+            self.passed += 1
+        else:
+            self.fails.append(what)
+            print("FAIL:", what)
+        return cond
+
+    def summary(self, kept):
+        print("%d passed, %d failed" % (self.passed, len(self.fails)))
+        if self.fails:
+            print("FAIL (outputs kept in %s):\n  %s" % (kept, "\n  ".join(self.fails)))
+        return 1 if self.fails else 0
+
+
+def metrics_validator():
+    with open(os.path.join(SRC, "config", "schema", "metrics.schema.json")) as f:
+        return Draft7Validator(json.load(f))
+
+
+def metrics_state(path, validator):
+    """("absent" | "complete" | "half (why)", the document when complete)."""
+    if not os.path.exists(path):
+        return "absent", None
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+    except ValueError as e:
+        return "half (%s)" % e, None
+    errors = [e.message for e in validator.iter_errors(doc)]
+    return ("half (schema: %s)" % errors[0], None) if errors else ("complete", doc)
+
+
+def run_adk(out, log, name, params=(), env=None):
+    """The adk node on the default scenario (a master must run) until it is up, then SIGINT:
+    it ends the mission `aborted` and writes OUT/metrics.json at once. Returns its exit code
+    (negative: the signal that killed it)."""
+    p = subprocess.Popen(
+        [os.path.join(BIN, "adk"), "__name:=" + name, "_mission:=%s/mission.json" % SCENARIO,
+         "_sim_config:=%s/sim_config.json" % SCENARIO, "_output_dir:=" + out,
+         "_clock_timeout:=0"] + list(params),
+        stdout=open(log, "w"), stderr=subprocess.STDOUT,
+        env=dict(env or os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1"))
+    deadline = time.time() + 60
+    while time.time() < deadline and p.poll() is None:
+        if "metrics to" in open(log).read():
+            break
+        time.sleep(0.05)
+    p.send_signal(signal.SIGINT)
+    try:
+        return p.wait(60)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        return p.wait()
