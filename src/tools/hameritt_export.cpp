@@ -22,14 +22,11 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <deque>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -39,12 +36,12 @@
 #include <regex>
 #include <set>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "hameritt/BoundingBoxArray.h"
 #include "hameritt/Mission.h"
 #include "hameritt/dataset/coco.h"
+#include "hameritt/dataset/encode_pool.h"
 #include "hameritt/dataset/frame.h"
 #include "hameritt/dataset/rle.h"
 #include "hameritt/scenario/error.h"
@@ -331,81 +328,17 @@ cv::Mat decode(const ImageInput& in, const std::string& what, std::string* encod
   return img;
 }
 
-// ------------------------------------------------------------------------- encoding pool
-
-// Runs jobs on N threads with at most `capacity` queued; the first error stops everything.
-class EncodePool {
- public:
-  EncodePool(int threads, std::size_t capacity) : capacity_(capacity) {
-    for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { run(); });
+// Ends an export whose encoding pool failed: an ExitError keeps its code, any other error is the
+// bag's (a frame that does not decode).
+[[noreturn]] void rethrowPoolFailure() {
+  try {
+    throw;
+  } catch (const ExitError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw ExitError(kExitBag, e.what());
   }
-  ~EncodePool() { finish(); }
-
-  // Queues a job (waits while the queue is full); false once an error happened.
-  bool submit(std::function<void()> job) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    space_.wait(lock, [this] { return queue_.size() < capacity_ || !error_.empty(); });
-    if (!error_.empty()) return false;
-    queue_.push_back(std::move(job));
-    work_.notify_one();
-    return true;
-  }
-  // Waits for every queued job; returns the first error ("" if none).
-  std::string finish() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    work_.notify_all();
-    for (auto& t : workers_) {
-      if (t.joinable()) t.join();
-    }
-    return error_;
-  }
-  int errorCode() const { return error_code_; }
-
- private:
-  void run() {
-    while (true) {
-      std::function<void()> job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        work_.wait(lock, [this] { return !queue_.empty() || stop_; });
-        if (queue_.empty()) return;
-        job = std::move(queue_.front());
-        queue_.pop_front();
-      }
-      space_.notify_one();
-      try {
-        if (error_flag_.load() || g_interrupted) continue;
-        job();
-      } catch (const ExitError& e) {
-        fail(e.what(), e.code);
-      } catch (const std::exception& e) {
-        fail(e.what(), kExitBag);
-      }
-    }
-  }
-  void fail(const std::string& msg, int code) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (error_.empty()) {
-      error_ = msg;
-      error_code_ = code;
-    }
-    error_flag_ = true;
-    space_.notify_all();
-  }
-
-  std::size_t capacity_;
-  std::vector<std::thread> workers_;
-  std::deque<std::function<void()>> queue_;
-  std::mutex mutex_;
-  std::condition_variable work_, space_;
-  bool stop_ = false;
-  std::string error_;
-  int error_code_ = 0;
-  std::atomic<bool> error_flag_{false};
-};
+}
 
 // ------------------------------------------------------------------------- export
 
@@ -451,7 +384,7 @@ class Exporter {
   std::vector<CameraTopics> cameras_;  // of the current bag
   std::vector<std::int64_t> camera_counter_;
   std::vector<std::unique_ptr<dataset::FrameRecord>> frames_;
-  std::unique_ptr<EncodePool> pool_;
+  std::unique_ptr<dataset::EncodePool> pool_;
   std::mutex frames_mutex_;
   int skipped_boxes_ = 0;
   std::atomic<int> skipped_annotations_{0};
@@ -674,7 +607,9 @@ void Exporter::exportBag(std::size_t bag_index, const std::string& path) {
 }
 
 void Exporter::dispatch(FrameSet&& set, const std::string& bag) {
-  if (!pool_) pool_ = std::make_unique<EncodePool>(o_.jobs, static_cast<std::size_t>(2 * o_.jobs));
+  if (!pool_) {
+    pool_ = std::make_unique<dataset::EncodePool>(o_.jobs, static_cast<std::size_t>(2 * o_.jobs));
+  }
   auto rec = std::make_unique<dataset::FrameRecord>();
   rec->image_id = static_cast<std::int64_t>(frames_.size()) + 1;
   rec->camera = cameras_[set.camera].name;
@@ -700,8 +635,16 @@ void Exporter::dispatch(FrameSet&& set, const std::string& bag) {
   dataset::FrameRecord* r = rec.get();
   frames_.push_back(std::move(rec));
   auto shared = std::make_shared<FrameSet>(std::move(set));
-  if (!pool_->submit([this, shared, r, bag] { encode(*shared, *r, bag); })) {
-    throw ExitError(pool_->errorCode(), pool_->finish());
+  const bool queued = pool_->submit([this, shared, r, bag] {
+    if (!g_interrupted) encode(*shared, *r, bag);
+  });
+  if (!queued) {
+    try {
+      pool_->finish();
+    } catch (...) {
+      rethrowPoolFailure();
+    }
+    throw ExitError(1, "internal error: the encoding pool refused a frame without a failure");
   }
 }
 
@@ -779,9 +722,13 @@ void Exporter::encode(FrameSet& set, dataset::FrameRecord& rec, const std::strin
 
 void Exporter::finish() {
   if (pool_) {
-    const std::string err = pool_->finish();
+    try {
+      pool_->finish();
+    } catch (...) {
+      if (g_interrupted) throw ExitError(kExitInterrupted, "interrupted");
+      rethrowPoolFailure();
+    }
     if (g_interrupted) throw ExitError(kExitInterrupted, "interrupted");
-    if (!err.empty()) throw ExitError(pool_->errorCode(), err);
   }
   if (frames_.empty()) {
     throw ExitError(kExitEmpty,

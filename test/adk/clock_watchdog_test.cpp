@@ -30,7 +30,7 @@ TEST(ClockWatchdog, ZeroTimeoutNeverStallsAndBadTimeoutsThrow) {
   off.clock(1.0, 0.0);
   EXPECT_EQ(off.stalled(1e9), "");
   EXPECT_THROW(ClockWatchdog(-1.0), InputError);
-  EXPECT_THROW(ClockWatchdog(std::numeric_limits<double>::infinity()), InputError);
+  EXPECT_THROW(ClockWatchdog{std::numeric_limits<double>::infinity()}, InputError);
 }
 
 TEST(ClockWatchdog, ReportsALateStart) {

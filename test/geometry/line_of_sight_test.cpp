@@ -67,8 +67,8 @@ std::vector<int> bruteCandidates(const OccluderIndex& index, const Aabb2& area) 
 TEST(OccluderIndexTest, InvalidConstructionAndBoxes) {
   EXPECT_THROW(OccluderIndex(0.0), GeometryError);
   EXPECT_THROW(OccluderIndex(-5.0), GeometryError);
-  EXPECT_THROW(OccluderIndex(std::numeric_limits<double>::quiet_NaN()), GeometryError);
-  EXPECT_THROW(OccluderIndex(std::numeric_limits<double>::infinity()), GeometryError);
+  EXPECT_THROW(OccluderIndex{std::numeric_limits<double>::quiet_NaN()}, GeometryError);
+  EXPECT_THROW(OccluderIndex{std::numeric_limits<double>::infinity()}, GeometryError);
 
   OccluderIndex index(10.0);
   const double nan = std::numeric_limits<double>::quiet_NaN();

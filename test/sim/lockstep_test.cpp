@@ -128,6 +128,66 @@ TEST(LockstepInbox, TakeIsCanonicalWhateverTheArrivalOrder) {
   }
 }
 
+// Messages arrive on ROS callback threads: one thread per publisher, while the participant polls
+// missing() and pending() for its turn. The turn starts once nothing is missing, and take()
+// hands out the same order as a single-threaded inbox. Also run under ThreadSanitizer
+// (test/scripts/test_sanitizers_tsan.sh).
+TEST(LockstepInbox, ReceivesFromManyThreadsWhileTheTurnWaits) {
+  const std::vector<std::string> order = {"/sim", "/detector", "/adk"};
+  const std::vector<std::string> publishers = {"/adk", "/sim", "/detector", "/zeta", "/alpha"};
+  constexpr int kPerStream = 200;
+  std::vector<StreamCount> totals;
+  for (int sub = 0; sub < 3; ++sub) {
+    for (const auto& p : publishers) totals.push_back({"/t" + std::to_string(sub), p, kPerStream});
+  }
+  auto tagOf = [](const std::string& p, int sub, int seq) {
+    return p + "/t" + std::to_string(sub) + "#" + std::to_string(seq);
+  };
+  // The reference: every message from one thread.
+  std::vector<std::string> reference;
+  {
+    LockstepInbox in;
+    for (int s = 0; s < 3; ++s) in.addSubscription("/t" + std::to_string(s));
+    for (const auto& p : publishers) {
+      for (int seq = 0; seq < kPerStream; ++seq) {
+        for (int sub = 0; sub < 3; ++sub) {
+          const std::string tag = tagOf(p, sub, seq);
+          in.receive(static_cast<std::size_t>(sub), p,
+                     [&reference, tag] { reference.push_back(tag); });
+        }
+      }
+    }
+    for (auto& f : in.take(order)) f();
+  }
+  ASSERT_EQ(reference.size(), 3u * publishers.size() * kPerStream);
+
+  LockstepInbox in;
+  for (int s = 0; s < 3; ++s) in.addSubscription("/t" + std::to_string(s));
+  std::vector<std::string> got;
+  std::vector<std::thread> threads;
+  for (const auto& p : publishers) {
+    threads.emplace_back([&in, &got, &tagOf, p] {
+      for (int seq = 0; seq < kPerStream; ++seq) {
+        for (int sub = 0; sub < 3; ++sub) {
+          const std::string tag = tagOf(p, sub, seq);
+          in.receive(static_cast<std::size_t>(sub), p, [&got, tag] { got.push_back(tag); });
+        }
+      }
+    });
+  }
+  std::size_t polls = 0;
+  while (!in.missing(totals).empty()) {
+    EXPECT_LE(in.pending(), reference.size());
+    ++polls;
+    std::this_thread::yield();
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(in.pending(), reference.size());
+  for (auto& f : in.take(order)) f();
+  EXPECT_EQ(in.pending(), 0u);
+  EXPECT_EQ(got, reference) << "after " << polls << " polls";
+}
+
 TEST(PeriodicSchedule, DueOncePerPeriodAtTheFirstTurnAtOrAfterEachMultiple) {
   PeriodicSchedule p(0.1);
   std::vector<double> fired;

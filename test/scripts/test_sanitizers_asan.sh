@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# The gtest programs under AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer:
+# builds them in build/asan (clang-14, -O1, only the libraries they link) and runs each through
+# the judge of scripts/sanitizers_common.sh (any report fails), two at a time. Negative control
+# first: test/sanitizers/control.cpp, compiled the same way, must be reported and fail the judge
+# for each fault (heap overflow, use after free, signed overflow, a leak from our code), and pass
+# without one. docs/RELIABILITY.md "Sanitizers" has the cost.
+set -euo pipefail
+source "$(dirname "$0")/../../scripts/sanitizers_common.sh"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+
+sanitizer_configure asan
+# Every gtest program of the build (so that a new one is never left out) but test_ros_conversions:
+# its five tests of the ROS message conversions would need the whole instrumented ROS layer and
+# the generated messages (sixteen ROS sources, the heaviest to compile) and do not fit the test
+# command's budget; scripts/run_sanitizers.sh runs it by hand. HAMERITT_ASAN_PROGRAMS names
+# another list.
+if [[ -n "${HAMERITT_ASAN_PROGRAMS:-}" ]]; then
+  read -r -a programs <<<"$HAMERITT_ASAN_PROGRAMS"
+else
+  mapfile -t programs < <(sanitizer_gtests asan | grep -vx test_ros_conversions)
+  # The list comes from the build; it must hold at least the ten programs known today.
+  ((${#programs[@]} >= 10)) || { echo "FAIL: fewer than 10 gtest programs: ${programs[*]}"; exit 1; }
+fi
+echo "gtest programs: ${#programs[@]} (${programs[*]})"
+sanitizer_build asan sanitizer_control "${programs[@]}" >"$work/build.log" 2>&1 ||
+  { tail -40 "$work/build.log"; exit 1; }
+sanitizer_source_devel asan
+bin="$(sanitizer_build_dir asan)/devel/lib/hameritt"
+
+failed=0
+sanitizer_control_check asan heap-buffer-overflow "ERROR: AddressSanitizer: heap-buffer-overflow" || failed=1
+sanitizer_control_check asan use-after-free "ERROR: AddressSanitizer: heap-use-after-free" || failed=1
+sanitizer_control_check asan signed-integer-overflow "runtime error: signed integer overflow" || failed=1
+# A leak from our code fails even though Mesa's leaks are let through.
+sanitizer_control_check asan leak "ERROR: LeakSanitizer: detected memory leaks" || failed=1
+sanitizer_run "$work/control_none.log" "$bin/sanitizer_control" none ||
+  { echo "FAIL: the negative control without a fault failed the judge"; failed=1; }
+
+# The gtest programs, the slowest (the renderer's) first, HAMERITT_JOBS (default: the number of
+# cores) at a time.
+order=()
+for p in "${programs[@]}"; do
+  if [[ "$p" == test_render ]]; then order=("$p" "${order[@]}"); else order+=("$p"); fi
+done
+jobs="${HAMERITT_JOBS:-$(nproc)}"
+for p in "${order[@]}"; do
+  while (($(jobs -rp | wc -l) >= jobs)); do wait -n || true; done
+  (
+    rc=0
+    sanitizer_run "$work/$p.log" "$bin/$p" >"$work/$p.verdict" || rc=$?
+    echo "$rc" >"$work/$p.rc"
+  ) &
+done
+wait
+tests=0
+for p in "${programs[@]}"; do
+  cat "$work/$p.verdict"
+  if [[ "$(cat "$work/$p.rc")" != 0 ]]; then
+    failed=1
+    tail -60 "$work/$p.log"
+    continue
+  fi
+  n="$(sanitizer_gtest_count "$work/$p.log")"
+  if [[ -z "$n" ]] || ((n < 1)); then
+    echo "FAIL $p: no test ran"; failed=1; continue
+  fi
+  tests=$((tests + n))
+done
+echo "asan+ubsan: ${#programs[@]} gtest programs, $tests tests, failed: $failed"
+exit "$failed"
