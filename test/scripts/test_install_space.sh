@@ -6,8 +6,9 @@
 # (hameritt_validate, hameritt_generate, hameritt_summary, hameritt_map, hameritt_world,
 # hameritt_campaign, cot_listen.py) work on the installed scenario and config, and a short
 # `roslaunch hameritt mission.launch` ends with metrics.json written. strace is the judge of
-# "alone": no program opens or executes a file of the checkout or of the workspace outside its
-# install space (negative control: a run told to read the checkout's config is caught).
+# "alone": no tool opens, stats or executes a file of the checkout or of the workspace outside
+# its install space (negative control: a run told to read the checkout's config is caught); the
+# mission executes the installed nodes, and roslaunch hands them files of the install space.
 #
 # ccache: the workspace's build space is $SRC/build-workspace and the workspace builds with
 # Ninja, which runs the compiler there; its devel space is build-workspace/devel and the generated
