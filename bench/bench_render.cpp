@@ -8,7 +8,6 @@
 //
 // Usage: bench_render [frame_sets] [--backend auto|surfaceless|device]
 
-#include "hameritt/build_paths.h"
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "hameritt/render/renderer.h"
+#include "hameritt/scenario/share_dir.h"
 #include "hameritt/scenario/sim_config_io.h"
 
 namespace render = hameritt::render;
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  const std::string file = std::string(HAMERITT_SOURCE_DIR) + "/scenarios/default/sim_config.json";
+  const std::string file = scenario::shareDir() + "/scenarios/default/sim_config.json";
   const scenario::SimConfig cfg = scenario::loadSimConfig(file);
   const scenario::World world = scenario::generateCheckedWorld(cfg, file);
   if (!cfg.uav.perception_path || cfg.uav.perception_path->trajectory.empty()) {

@@ -6,7 +6,6 @@
 //
 // Usage: bench_sim [seconds_per_case]
 
-#include "hameritt/build_paths.h"
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "hameritt/scenario/generator.h"
+#include "hameritt/scenario/share_dir.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/world.h"
 #include "hameritt/sim/quadrotor.h"
@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
   {
     const scenario::World world = scenario::generateWorld(
         scenario::loadWorldParams(scenario::defaultConfigDir() + "/world.json"));
-    const std::string dir = std::string(HAMERITT_SOURCE_DIR) + "/scenarios/default";
+    const std::string dir = scenario::shareDir() + "/scenarios/default";
     const scenario::SimConfig c = scenario::loadSimConfig(dir + "/sim_config.json");
     Simulator sim(world, c, params, settings);
     const Result r = run(sim, wall);

@@ -40,6 +40,9 @@ HAMERITT_PACKAGES=(
   clang-14 libclang-rt-14-dev libfuzzer-14-dev python3-shapely
   # Repeated builds (the sanitizer and workspace builds, a second clone) reuse objects.
   ccache
+  # Package checks: catkin_lint; the workspace build (Ninja); strace judges that the install
+  # space runs alone.
+  catkin-lint ninja-build strace
 )
 
 install_deps() {

@@ -1,4 +1,3 @@
-#include "hameritt/build_paths.h"
 #include "hameritt/render/renderer.h"
 
 #include <algorithm>
@@ -15,6 +14,7 @@
 #include "environment_model.h"
 #include "gl.h"
 #include "hameritt/scenario/error.h"
+#include "hameritt/scenario/share_dir.h"
 #include "mesh.h"
 #include "scene.h"
 #include "shaders.h"
@@ -1358,6 +1358,6 @@ SceneTriangles Renderer::sceneTriangles(const RenderRequest& request) const {
   return impl_->scene.triangles(request.time, &lod);
 }
 
-std::string defaultModelsDir() { return std::string(HAMERITT_SOURCE_DIR) + "/models"; }
+std::string defaultModelsDir() { return scenario::shareDir() + "/models"; }
 
 }  // namespace hameritt::render

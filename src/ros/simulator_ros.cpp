@@ -14,7 +14,6 @@
 #include "hameritt/CrashEvent.h"
 #include "hameritt/EntityStateArray.h"
 #include "hameritt/SimulationEnd.h"
-#include "hameritt/build_paths.h"
 #include "hameritt/ros/conversions.h"
 #include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
@@ -63,7 +62,7 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (!pnh.getParam("sim_config", sim_config)) {
     throw scenario::ConfigError("~sim_config: required parameter (path of a sim_config.json)");
   }
-  pnh.param<std::string>("urdf", urdf, std::string(HAMERITT_SOURCE_DIR) + "/models/sentinel.urdf");
+  pnh.param<std::string>("urdf", urdf, sim::defaultQuadrotorUrdf());
   sim::SimSettings settings;
   pnh.param("physics_rate_hz", settings.physics_rate_hz, settings.physics_rate_hz);
   pnh.param("real_time_factor", real_time_factor_, 0.0);

@@ -1,4 +1,3 @@
-#include "hameritt/build_paths.h"
 #include "hameritt/scenario/params_table.h"
 
 #include <cmath>
@@ -9,6 +8,7 @@
 #include <sstream>
 
 #include "hameritt/scenario/error.h"
+#include "hameritt/scenario/share_dir.h"
 
 namespace hameritt::scenario {
 
@@ -339,7 +339,7 @@ GeneratorConfig loadGeneratorConfig(const std::string& path) {
 
 std::string defaultConfigDir() {
   if (const char* env = std::getenv("HAMERITT_CONFIG_DIR")) return env;
-  return std::string(HAMERITT_SOURCE_DIR) + "/config";
+  return shareDir() + "/config";
 }
 
 }  // namespace hameritt::scenario

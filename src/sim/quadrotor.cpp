@@ -1,4 +1,3 @@
-#include "hameritt/build_paths.h"
 #include "hameritt/sim/quadrotor.h"
 
 #include <tinyxml2.h>
@@ -15,6 +14,7 @@
 #include <sstream>
 
 #include "hameritt/scenario/error.h"
+#include "hameritt/scenario/share_dir.h"
 
 namespace hameritt::sim {
 
@@ -231,9 +231,7 @@ QuadrotorParams loadQuadrotorUrdf(const std::string& path) {
   return p;
 }
 
-std::string defaultQuadrotorUrdf() {
-  return std::string(HAMERITT_SOURCE_DIR) + "/models/sentinel.urdf";
-}
+std::string defaultQuadrotorUrdf() { return scenario::shareDir() + "/models/sentinel.urdf"; }
 
 // ------------------------------------------------------------------------------------ Mixer
 

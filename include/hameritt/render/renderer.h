@@ -189,7 +189,7 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// Default models directory: <package>/models (from the source tree the library was built in).
+// Default models directory: the package's models/ (scenario::shareDir()).
 std::string defaultModelsDir();
 
 }  // namespace hameritt::render

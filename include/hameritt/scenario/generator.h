@@ -76,7 +76,8 @@ struct GeneratorConfig {
 WorldParams loadWorldParams(const std::string& path);
 // Reads config/generator.json, strictly likewise.
 GeneratorConfig loadGeneratorConfig(const std::string& path);
-// The shipped configuration directory (the package's config/).
+// The shipped configuration directory: $HAMERITT_CONFIG_DIR, else the package's config/
+// (shareDir() in hameritt/scenario/share_dir.h).
 std::string defaultConfigDir();
 
 // "<class>-<16 hex digits of the seed>", e.g. "area_search-00000000000004d2".

@@ -67,7 +67,7 @@ struct QuadrotorParams {
 // Throws scenario::ConfigError naming the file and the offending element.
 QuadrotorParams loadQuadrotorUrdf(const std::string& path);
 
-// The shipped model: <package>/models/sentinel.urdf.
+// The shipped model: models/sentinel.urdf in the package's data (scenario::shareDir()).
 std::string defaultQuadrotorUrdf();
 
 // Control allocation for a planar rotor layout: [T, tau_x, tau_y, tau_z] = A * f with rotor
