@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "hameritt/scenario/bounded_json.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/sim_config_io.h"
 
@@ -20,13 +21,10 @@ nlohmann::ordered_json publicSimConfigJson(const nlohmann::ordered_json& sim_con
 }
 
 scenario::SimConfig loadPublicSimConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw scenario::ConfigError(path + ": cannot open file");
-  std::stringstream buf;
-  buf << in.rdbuf();
+  const std::string text = scenario::readBoundedJsonFile(path);
   nlohmann::ordered_json j;
   try {
-    j = nlohmann::ordered_json::parse(buf.str());
+    j = nlohmann::ordered_json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw scenario::ConfigError(path + ": not valid JSON: " + e.what());
   }

@@ -4,6 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "hameritt/render/renderer.h"
+#include "hameritt/scenario/bounded_json.h"
+#include "hameritt/scenario/error.h"
 
 namespace hameritt::render {
 
@@ -11,6 +13,11 @@ std::vector<LodManifestEntry> parseLodManifest(const std::string& text, const st
                                                const std::string& dir,
                                                const std::set<std::string>& class_meshes) {
   nlohmann::json doc;
+  try {
+    scenario::checkJsonText(text, path);
+  } catch (const scenario::ConfigError& e) {
+    throw RenderError(e.what());
+  }
   try {
     doc = nlohmann::json::parse(text);
   } catch (const std::exception& e) {

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "hameritt/scenario/bounded_json.h"
+#include "hameritt/scenario/error.h"
 #include "hameritt/scenario/trajectory.h"
 
 namespace hameritt::render {
@@ -203,16 +205,19 @@ void Scene::loadLods(const std::string& dir,
                      const std::unordered_map<std::string, int>& file_model) {
   lods_.assign(models_.size(), {});
   const std::string path = dir + "lod.json";
-  std::ifstream in(path);
-  if (!in) return;  // no coarse meshes: every instance is drawn in full
-  std::stringstream text;
-  text << in.rdbuf();
+  if (!std::ifstream(path)) return;  // no coarse meshes: every instance is drawn in full
+  std::string text;
+  try {
+    text = scenario::readBoundedFile(path);
+  } catch (const scenario::ConfigError& e) {
+    throw RenderError(e.what());
+  }
   std::set<std::string> class_meshes;
   for (const auto& [file, m] : file_model) {
     const std::string name = file.substr(0, file.size() - 4);  // without ".obj"
     if (name != "sentinel") class_meshes.insert(name);
   }
-  for (const LodManifestEntry& e : parseLodManifest(text.str(), path, dir, class_meshes)) {
+  for (const LodManifestEntry& e : parseLodManifest(text, path, dir, class_meshes)) {
     const int fine = file_model.at(e.mesh + ".obj");
     std::vector<LodLevel> levels;
     for (const LodFileLevel& lf : e.levels) {

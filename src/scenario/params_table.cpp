@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "hameritt/scenario/bounded_json.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/share_dir.h"
 
@@ -314,6 +315,7 @@ void GeneratorConfig::validate() const {
 }
 
 json parseJsonString(const std::string& text, const std::string& file) {
+  checkJsonText(text, file);
   try {
     return json::parse(text);
   } catch (const json::parse_error& e) {
@@ -322,11 +324,7 @@ json parseJsonString(const std::string& text, const std::string& file) {
 }
 
 json readJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parseJsonString(text.str(), path);
+  return parseJsonString(readBoundedFile(path), path);
 }
 
 WorldParams loadWorldParams(const std::string& path) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <utility>
 
+#include "hameritt/scenario/bounded_json.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/scenario.h"
 
@@ -37,8 +38,10 @@ inline std::string idx(const std::string& path, std::size_t i) {
   return path + "[" + std::to_string(i) + "]";
 }
 
-// Parses a whole document text, keeping key order (ConfigError on syntax errors, with `file`).
+// Parses a whole document text, keeping key order (ConfigError on syntax errors and beyond the
+// size and depth limits of bounded_json.h, with `file`).
 inline json parseText(const std::string& text, const std::string& file) {
+  checkJsonText(text, file);
   try {
     return json::parse(text);
   } catch (const json::parse_error& e) {
@@ -47,14 +50,7 @@ inline json parseText(const std::string& text, const std::string& file) {
 }
 
 // Parses a whole file, keeping key order (ConfigError on I/O or syntax errors, with the file).
-inline json parseFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(path + ": cannot read file");
-  return parseText(text.str(), path);
-}
+inline json parseFile(const std::string& path) { return parseText(readBoundedFile(path), path); }
 
 // A JSON object being read strictly.
 class Object {

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "hameritt/geometry/polygon.h"
+#include "hameritt/scenario/bounded_json.h"
 #include "hameritt/scenario/params_table.h"
 #include "hameritt/scenario/scenario_io.h"
 
@@ -1036,6 +1037,12 @@ std::vector<ValidationIssue> validateDocument(const json& doc, const std::string
 
 bool parseJsonText(const std::string& text, const std::string& file, json* out,
                    ValidationIssue* issue) {
+  try {
+    checkJsonText(text, file);
+  } catch (const ConfigError& e) {
+    *issue = {file, "", "limit", std::string(e.what()).substr(file.size() + 2)};
+    return false;
+  }
   // Tracks the JSON Pointer of the value being parsed, to report duplicate keys.
   struct Frame {
     bool array = false;
@@ -1107,14 +1114,17 @@ bool parseJsonText(const std::string& text, const std::string& file, json* out,
 }
 
 std::vector<ValidationIssue> validateFile(const std::string& path, const std::string& schema_dir) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {{path, "", "io", "cannot open file"}};
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return {{path, "", "io", "read failed"}};
+  std::string text;
+  try {
+    text = readBoundedFile(path);
+  } catch (const ConfigError& e) {
+    // "PATH: cannot open file", "PATH: N bytes, more than the limit ...".
+    const std::string what = std::string(e.what()).substr(path.size() + 2);
+    return {{path, "", what.rfind("cannot", 0) == 0 ? "io" : "limit", what}};
+  }
   json doc;
   ValidationIssue issue;
-  if (!parseJsonText(ss.str(), path, &doc, &issue)) return {issue};
+  if (!parseJsonText(text, path, &doc, &issue)) return {issue};
   return validateDocument(doc, path, schema_dir);
 }
 

@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import socket
@@ -49,6 +50,50 @@ RUN_DEPENDENT_SUMMARY_FIELDS = ("bag_bytes",)
 
 class CampaignError(Exception):
     """Bad input: a config field, an argument or a campaign directory; exit code 2."""
+
+
+# The limits every JSON reader of the project holds (include/hameritt/scenario/bounded_json.h):
+# a larger file is refused before it is read, deeper nesting before it is parsed.
+MAX_JSON_BYTES = 64 << 20
+MAX_JSON_DEPTH = 64
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"', re.S)
+_JSON_BRACKET = re.compile(r"[\[\]{}]")
+
+
+def check_json_depth(text, path, max_depth=MAX_JSON_DEPTH):
+    """CampaignError naming the file and the limit when arrays and objects nest deeper."""
+    depth = 0
+    for m in _JSON_BRACKET.finditer(_JSON_STRING.sub('""', text)):
+        if m.group() in "[{":
+            depth += 1
+            if depth > max_depth:
+                raise CampaignError("%s: JSON nested deeper than the limit of %d levels"
+                                    % (path, max_depth))
+        elif depth > 0:
+            depth -= 1
+
+
+def load_json(path, hint="", max_bytes=MAX_JSON_BYTES):
+    """The parsed JSON file `path` within the size and depth limits; CampaignError (exit 2)
+    naming the file, and the limit or the reason, otherwise."""
+    try:
+        with open(path, "rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > max_bytes:
+                raise CampaignError("%s: %d bytes, more than the limit of %d bytes (%d MiB) for a "
+                                    "JSON document" % (path, size, max_bytes, max_bytes >> 20))
+            data = f.read(max_bytes + 1)
+    except OSError as e:
+        raise CampaignError("%s: cannot read%s: %s" % (path, hint, e.strerror))
+    if len(data) > max_bytes:
+        raise CampaignError("%s: more than the limit of %d bytes (%d MiB) for a JSON document"
+                            % (path, max_bytes, max_bytes >> 20))
+    try:
+        text = data.decode("utf-8")
+        check_json_depth(text, path)
+        return json.loads(text)
+    except ValueError as e:  # UnicodeDecodeError and JSONDecodeError
+        raise CampaignError("%s: not valid JSON: %s" % (path, e))
 
 
 # ---------------------------------------------------------------------------- config
@@ -243,14 +288,7 @@ def dump_json(obj):
 
 def load_plan(cdir):
     path = os.path.join(cdir, "plan.json")
-    try:
-        with open(path) as f:
-            plan = json.load(f)
-    except OSError as e:
-        raise CampaignError("%s: cannot read (run 'hameritt_campaign plan' first): %s"
-                            % (path, e.strerror))
-    except ValueError as e:
-        raise CampaignError("%s: not valid JSON: %s" % (path, e))
+    plan = load_json(path, " (run 'hameritt_campaign plan' first)")
     if not isinstance(plan, dict) or plan.get("schema") != SCHEMA_PLAN:
         raise CampaignError("%s: field 'schema': expected %s" % (path, SCHEMA_PLAN))
     return plan
@@ -373,8 +411,7 @@ def run_generate_unit(cfg, unit, work, log):
     r = subprocess.run(cmd, stdout=log, stderr=log)
     if r.returncode != 0:
         raise RuntimeError("hameritt_generate exited %d" % r.returncode)
-    with open(os.path.join(work, "scenarios", "manifest.json")) as f:
-        man = json.load(f)
+    man = load_json(os.path.join(work, "scenarios", "manifest.json"))
     return {"scenarios": [{"index": s["index"], "id": s["id"], "class": s["class"],
                            "seed": s["seed"]} for s in man["scenarios"]]}
 
@@ -439,14 +476,12 @@ def run_mission_unit(cfg, unit, work, log, task_id, slot):
     r = subprocess.run(cmd, stdout=log, stderr=log)
     if r.returncode != 0:
         raise RuntimeError("hameritt_generate exited %d" % r.returncode)
-    with open(os.path.join(gen, "manifest.json")) as f:
-        sid = json.load(f)["scenarios"][0]["id"]
+    sid = load_json(os.path.join(gen, "manifest.json"))["scenarios"][0]["id"]
     os.rename(os.path.join(gen, sid), scen_dir)
     shutil.rmtree(gen)
     sim_cfg_path = os.path.join(scen_dir, "sim_config.json")
     if m["cameras"] != "all":
-        with open(sim_cfg_path) as f:
-            sc = filter_cameras(json.load(f), m["cameras"])
+        sc = filter_cameras(load_json(sim_cfg_path), m["cameras"])
         sim_cfg_path = os.path.join(work, "sim_config_cameras.json")
         write_atomic(sim_cfg_path, json.dumps(sc, indent=2) + "\n")
     out = os.path.join(work, "output")
@@ -484,8 +519,7 @@ def run_mission_unit(cfg, unit, work, log, task_id, slot):
         raise RuntimeError("the mission wrote no metrics.json")
     if m["record"] and not os.path.exists(os.path.join(out, "mission.bag")):
         raise RuntimeError("record is on but there is no mission.bag")
-    with open(metrics_path) as f:
-        metrics = json.load(f)
+    metrics = load_json(metrics_path)
     return {"scenario_id": sid, "port": port, "metrics": metrics}
 
 
@@ -612,8 +646,7 @@ def slurm_jobs(cdir):
     path = os.path.join(cdir, "slurm", "jobs.json")
     if not os.path.exists(path):
         return []
-    with open(path) as f:
-        return json.load(f)
+    return load_json(path)
 
 
 def queued_tasks(job_ids):
@@ -833,8 +866,7 @@ def merge(cdir):
     scenarios, missions, world, shards, hosts, jobs, wall = [], [], None, set(), set(), set(), 0.0
     for u in sorted(plan["units"], key=lambda u: u["id"]):
         udir = os.path.join(cdir, "units", u["id"])
-        with open(os.path.join(udir, "unit.json")) as f:
-            rec = json.load(f)
+        rec = load_json(os.path.join(udir, "unit.json"))
         if rec["unit"] != u:
             raise CampaignError("%s/unit.json: the unit differs from plan.json's" % udir)
         shards.add(rec["shard"])
@@ -948,11 +980,7 @@ def compare_manifests(a, b, nondeterministic=RUN_DEPENDENT_MISSION_FIELDS):
 def cmd_compare(args):
     ms = []
     for p in (args.a, args.b):
-        try:
-            with open(p) as f:
-                ms.append(json.load(f))
-        except (OSError, ValueError) as e:
-            raise CampaignError("%s: cannot read a manifest: %s" % (p, e))
+        ms.append(load_json(p, " a manifest"))
     nd = list(RUN_DEPENDENT_MISSION_FIELDS) + [x for x in args.nondeterministic.split(",") if x]
     diffs = compare_manifests(ms[0], ms[1], nd)
     for d in diffs:

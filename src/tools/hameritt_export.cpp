@@ -44,6 +44,7 @@
 #include "hameritt/dataset/encode_pool.h"
 #include "hameritt/dataset/frame.h"
 #include "hameritt/dataset/rle.h"
+#include "hameritt/scenario/bounded_json.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/scenario_io.h"
 
@@ -83,6 +84,9 @@ constexpr int kExitBag = 3;
 constexpr int kExitWrite = 4;
 constexpr int kExitEmpty = 5;
 constexpr int kExitInterrupted = 130;
+// --preview reads the COCO annotation files of an export: larger than scenario documents (one
+// RLE mask per instance), so a limit of its own; nesting within kMaxJsonDepth.
+constexpr std::uintmax_t kMaxAnnotationBytes = std::uintmax_t{1} << 30;  // 1 GiB
 
 // An error that ends the run with an exit code.
 struct ExitError : std::runtime_error {
@@ -782,8 +786,7 @@ int preview(Options o) {
   std::sort(files.begin(), files.end());
   auto load = [](const fs::path& file) {
     try {
-      std::ifstream in(file);
-      return nlohmann::json::parse(in);
+      return nlohmann::json::parse(hameritt::scenario::readBoundedJsonFile(file.string(), kMaxAnnotationBytes));
     } catch (const std::exception& e) {
       throw ExitError(kExitFlags, file.string() + ": " + e.what());
     }

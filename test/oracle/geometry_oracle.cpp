@@ -10,8 +10,15 @@
 // violation_duration: total time of adk::violationIntervals() for the keep-out zone made of the
 // polygon, the altitude band [zmin, zmax] and the window [net, nlt]. With m < 3 the two
 // polygon-polygon answers are 0.
+//
+// Negative control: with HAMERITT_ORACLE_WRONG=boundary_outside the driver answers as a wrong
+// library would that treats the ring as outside: a point within the library's own boundary
+// tolerance of the ring is not contained, and a segment that only touches the ring (no length
+// inside) does not intersect. The oracle must fail on these answers.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -19,6 +26,7 @@
 
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/geometry/polygon.h"
+#include "hameritt/geometry/segment.h"
 
 namespace {
 
@@ -46,10 +54,25 @@ std::optional<double> bound(double v) {
   return std::isnan(v) ? std::nullopt : std::optional<double>(v);
 }
 
+// Distance from p to the ring of `v`.
+double ringDistance(const std::vector<Vec2>& v, const Vec2& p) {
+  double d = INFINITY;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    d = std::min(d, hameritt::geometry::pointSegmentDistance(p, v[i], v[(i + 1) % v.size()]));
+  }
+  return d;
+}
+
 }  // namespace
 
 int main() {
   std::ios::sync_with_stdio(false);
+  const char* wrong_env = std::getenv("HAMERITT_ORACLE_WRONG");
+  const std::string wrong = wrong_env ? wrong_env : "";
+  if (!wrong.empty() && wrong != "boundary_outside") {
+    std::fprintf(stderr, "geometry_oracle: HAMERITT_ORACLE_WRONG: expected boundary_outside\n");
+    return 2;
+  }
   std::string line;
   std::size_t count = 0;
   while (std::getline(std::cin, line)) {
@@ -80,10 +103,20 @@ int main() {
       violation += i.length();
     }
     const bool has_other = other.size() >= 3;
-    std::printf("%.17g %d %.17g %d %.17g %zu %d %.17g %d %.17g\n", poly.area(),
-                poly.contains(q) ? 1 : 0, poly.distance(q), poly.intersectsSegment(a2, b2) ? 1 : 0,
-                inside, pieces.size(), has_other && poly.intersects(other) ? 1 : 0,
-                has_other ? poly.distance(other) : 0.0, poly.isSimple() ? 1 : 0, violation);
+    bool contains = poly.contains(q);
+    bool hits = poly.intersectsSegment(a2, b2);
+    if (wrong == "boundary_outside") {
+      double m = std::max(std::fabs(q.x()), std::fabs(q.y()));
+      for (const Vec2& v : poly.vertices()) m = std::max({m, std::fabs(v.x()), std::fabs(v.y())});
+      const double band = hameritt::geometry::kEpsilon * std::max(1.0, m);
+      contains = contains && ringDistance(poly.vertices(), q) > band;
+      hits = a2 == b2 ? poly.contains(a2) && ringDistance(poly.vertices(), a2) > band
+                      : hits && inside > 0.0;
+    }
+    std::printf("%.17g %d %.17g %d %.17g %zu %d %.17g %d %.17g\n", poly.area(), contains ? 1 : 0,
+                poly.distance(q), hits ? 1 : 0, inside, pieces.size(),
+                has_other && poly.intersects(other) ? 1 : 0, has_other ? poly.distance(other) : 0.0,
+                poly.isSimple() ? 1 : 0, violation);
     ++count;
   }
   std::fprintf(stderr, "geometry_oracle: %zu cases\n", count);

@@ -11,6 +11,7 @@
 #include <rosgraph_msgs/Log.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -40,9 +41,15 @@ const double kInf = std::numeric_limits<double>::infinity();
 // Every message of every node on /rosout.
 struct Rosout {
   explicit Rosout(ros::NodeHandle& nh) : log(nh, "/rosout", 100000) {}
-  // ERROR lines of `node` containing every one of `parts`, after a wall second for delivery.
+  // ERROR lines of `node` containing every one of `parts`, once there is one (or after 10 wall
+  // seconds without): the condition, not a fixed sleep, ends the wait.
   int errors(const std::string& node, const std::vector<std::string>& parts) {
-    spinUntil([] { return false; }, 0.5);
+    spinUntil([&] { return count(node, parts) > 0; }, 10);
+    return count(node, parts);
+  }
+  // The same, now.
+  int count(const std::string& node, const std::vector<std::string>& parts) {
+    ros::spinOnce();
     int n = 0;
     for (const auto& m : log.all) {
       if (m.name != node || m.level != rosgraph_msgs::Log::ERROR) continue;
@@ -134,9 +141,6 @@ struct Graph {
     }
     pub.publish(m);
   }
-  void settle() {
-    spinUntil([] { return false; }, 0.3);
-  }
 
   ros::NodeHandle nh;
   Rosout rosout;
@@ -152,6 +156,26 @@ struct Graph {
 Graph* g = nullptr;
 hameritt::testing::SimClient* sim = nullptr;
 int cases = 0;  // hostile messages and requests sent
+
+// Odometry samples the test must have seen at least (asserted at the end). The simulator
+// publishes one every physics_rate_hz / publish_rate_hz steps and queues at most kOdomQueue per
+// subscriber (src/ros/simulator_ros.cpp): a call of 5000 steps publishes 2500 at once and the
+// oldest are dropped when the queue is full, but the newest kOdomQueue of each call are always
+// delivered (SimClient::step waits for the call's last one).
+constexpr unsigned kOdomQueue = 50;
+double guaranteed_samples = 0;
+
+// Advances `steps` physics steps and counts the samples that must arrive.
+void fly(unsigned steps) {
+  static const double steps_per_sample = [] {
+    double physics_hz = 0, publish_hz = 0;
+    EXPECT_TRUE(ros::param::get("/simulator/physics_rate_hz", physics_hz));
+    EXPECT_TRUE(ros::param::get("/simulator/publish_rate_hz", publish_hz));
+    return physics_hz / publish_hz;
+  }();
+  sim->step(steps);
+  guaranteed_samples += std::min<double>(kOdomQueue, std::floor(steps / steps_per_sample));
+}
 
 geometry_msgs::Twist twist(double x, double y, double z, double w) {
   geometry_msgs::Twist t;
@@ -183,7 +207,7 @@ nav_msgs::Path pathOf(const std::vector<hameritt::geometry::Vec3>& pts,
 TEST(HostileInputs, SimulatorSetpoints) {
   sim->connect();
   sim->setPose(sim->odom.pose.pose.position.x, sim->odom.pose.pose.position.y, 30, 0);
-  sim->step(7500);  // 15 s: take off
+  fly(7500);  // 15 s: take off
   const auto start = sim->odom.pose.pose.position;
   ASSERT_GT(start.z, 20.0);
 
@@ -208,41 +232,39 @@ TEST(HostileInputs, SimulatorSetpoints) {
   g->send(g->cmd_pose, pose(start.x + 500, start.y, start.z, "earth"));
   g->send(g->cmd_pose, pose(start.x + 500, start.y, start.z, "uav/base_link"));
   cases += 2;
-  g->settle();
-  sim->step(1000);
-  // Nothing was taken: the UAV still holds its pose setpoint.
-  const auto& held = sim->odom.pose.pose.position;
-  EXPECT_NEAR(held.x, start.x, 0.5);
-  EXPECT_NEAR(held.y, start.y, 0.5);
-  EXPECT_NEAR(held.z, start.z, 0.5);
+  // The simulator took them (its error lines say so) before it steps on.
   EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_vel", "expected a finite", "ignored"}), 1)
       << g->rosout.dump("/simulator");
   EXPECT_EQ(
       g->rosout.errors("/simulator", {"/uav/cmd_pose", "pose.position.", "expected a finite"}), 1);
   EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_pose", "header.frame_id", "'map'"}), 1);
+  fly(1000);
+  // Nothing was taken: the UAV still holds its pose setpoint.
+  const auto& held = sim->odom.pose.pose.position;
+  EXPECT_NEAR(held.x, start.x, 0.5);
+  EXPECT_NEAR(held.y, start.y, 0.5);
+  EXPECT_NEAR(held.z, start.z, 0.5);
 
   // Absurd finite velocity: clamped to the controller's limits; the geofence stops the UAV at
   // the bounds, the ceiling too.
   g->send(g->cmd_vel, twist(1e9, 1e9, 1e9, 1e9));
   ++cases;
-  g->settle();
-  for (int i = 0; i < 30; ++i) sim->step(5000);  // 150 s at 12 m/s and 3 m/s climb
+  EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_vel", "clamped", "linear.x/y to 12"}), 1);
+  for (int i = 0; i < 30; ++i) fly(5000);  // 150 s at 12 m/s and 3 m/s climb
   EXPECT_EQ(g->badSample(), "");
   const auto& corner = sim->odom.pose.pose.position;
   EXPECT_GT(corner.x, g->fence.max.x() - 60) << "the flight did not reach the fence";
   EXPECT_GT(corner.z, g->fence.max.z() - 40);
-  EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_vel", "clamped", "linear.x/y to 12"}), 1);
 
   // Absurd pose: clamped onto the fence; a NaN orientation flies with yaw 0.
   auto far = pose(-1e12, -1e12, 1e6);
   far.pose.orientation.w = kNan;
   g->send(g->cmd_pose, far);
   ++cases;
-  g->settle();
-  for (int i = 0; i < 6; ++i) sim->step(5000);
-  EXPECT_EQ(g->badSample(), "");
   EXPECT_EQ(g->rosout.errors("/simulator", {"/uav/cmd_pose", "clamped", "to the geofence's"}), 1)
       << g->rosout.dump("/simulator");
+  for (int i = 0; i < 6; ++i) fly(5000);
+  EXPECT_EQ(g->badSample(), "");
 
   // Lock-step requests out of range.
   hameritt::StepSimulation too_many;
@@ -254,7 +276,7 @@ TEST(HostileInputs, SimulatorSetpoints) {
 
   // A valid command afterwards still works: back to the start.
   sim->setPose(start.x, start.y, 40, 0);
-  for (int i = 0; i < 14; ++i) sim->step(5000);
+  for (int i = 0; i < 14; ++i) fly(5000);
   const auto& back = sim->odom.pose.pose.position;
   EXPECT_NEAR(back.x, start.x, 2.0);
   EXPECT_NEAR(back.y, start.y, 2.0);
@@ -267,14 +289,14 @@ TEST(HostileInputs, PlannerRequestsAndWaypoints) {
   ASSERT_TRUE(ros::service::waitForService("/planner/plan_path", ros::Duration(30)));
   const auto here = sim->odom.pose.pose.position;
   auto request = [&](const geometry_msgs::Point& start, const std::vector<geometry_msgs::Point>& w,
-                     double t0) {
+                     double t0, bool hostile = true) {
     hameritt::PlanPath srv;
     srv.request.start = start;
     srv.request.waypoints = w;
     srv.request.start_time = t0;
     srv.request.seed = 3;
     EXPECT_TRUE(ros::service::call("/planner/plan_path", srv));
-    ++cases;
+    cases += hostile;
     return srv.response;
   };
   geometry_msgs::Point s = here, goal = here;
@@ -303,7 +325,7 @@ TEST(HostileInputs, PlannerRequestsAndWaypoints) {
   r = request(s, {absurd}, 0);
   EXPECT_FALSE(r.success);
   EXPECT_EQ(r.code, 1) << r.message;  // outside the world: no path, not a crash
-  r = request(s, {goal}, 0);
+  r = request(s, {goal}, 0, false);   // a valid request: not a hostile one
   EXPECT_TRUE(r.success) << r.message;
 
   // The follower's topic: refused whole, nothing flown.
@@ -314,16 +336,18 @@ TEST(HostileInputs, PlannerRequestsAndWaypoints) {
   g->send(g->waypoints, pathOf(std::vector<V>(20000, h + V(10, 0, 0))));
   g->send(g->waypoints, pathOf({h + V(40, 0, 0)}, "earth"));
   cases += 4;
-  g->settle();
-  EXPECT_EQ(g->rosout.errors("/planner", {"/planner/waypoints", "poses[", "expected a finite"}) +
-                g->rosout.errors("/planner", {"/planner/waypoints", "at most 1000"}) +
-                g->rosout.errors("/planner", {"/planner/waypoints", "header.frame_id"}),
-            1)
-      << "one throttled line for the hostile lists: " << g->rosout.dump("/planner");
+  const auto refused = [] {
+    return g->rosout.count("/planner", {"/planner/waypoints", "poses[", "expected a finite"}) +
+           g->rosout.count("/planner", {"/planner/waypoints", "at most 1000"}) +
+           g->rosout.count("/planner", {"/planner/waypoints", "header.frame_id"});
+  };
+  spinUntil([&] { return refused() > 0; }, 10);
+  EXPECT_EQ(refused(), 1) << "one throttled line for the hostile lists: "
+                          << g->rosout.dump("/planner");
   for (const auto& p : g->progress.all) EXPECT_NE(p.state, "following") << p.message;
-  // An empty list stops the follower (documented), a valid one is flown.
+  // An empty list stops the follower (documented, so not a hostile message), a valid one is
+  // flown.
   g->send(g->waypoints, pathOf({}));
-  ++cases;
   EXPECT_TRUE(spinUntil(
       [] {
         return !g->progress.all.empty() && g->progress.last().message == "empty waypoint list";
@@ -385,7 +409,6 @@ TEST(HostileInputs, AdkAndClients) {
   g->send(g->mission, m);
   g->send(g->mission, m);
   cases += 4;
-  g->settle();
   EXPECT_EQ(g->rosout.errors("/adk", {"/uav/odom", "expected finite"}), 1)
       << g->rosout.dump("/adk");
   EXPECT_EQ(g->rosout.errors("/adk", {"/uav/odom", "header.stamp", "older than the last"}), 1);
@@ -401,7 +424,7 @@ TEST(HostileInputs, AdkAndClients) {
   }
 
   // Everyone alive; the ADK still scores a valid claim and publishes its state.
-  sim->step(500);
+  fly(500);
   const std::size_t before = g->states.all.size();
   d.position.x = sim->odom.pose.pose.position.x;
   d.position.y = sim->odom.pose.pose.position.y;
@@ -416,9 +439,24 @@ TEST(HostileInputs, AdkAndClients) {
     EXPECT_TRUE(alive(node)) << node;
   }
   EXPECT_EQ(g->badSample(), "");
+
+  // The tally of the three tests above: 4 fields x 3 non-finite velocities, 3 axes x 3
+  // non-finite poses, 2 foreign frames, an absurd velocity, an absurd pose and an absurd step
+  // (simulator); 6 bad plan requests and 4 bad waypoint lists (planner); 3 odometry, 2
+  // detections, a ground truth, a box list and 2 missions (ADK and clients).
+  EXPECT_EQ(cases, (4 * 3 + 3 * 3 + 2 + 3) + (6 + 4) + (3 + 2 + 4));
+  // badSample() checked the simulator's odometry: at least the samples fly() counted, derived
+  // from the publish rate and the steps of each call.
+  std::size_t samples = 0;
+  for (const auto& o : g->flight.all) samples += o.child_frame_id != "hostile";
+  double rate = 0;
+  ASSERT_TRUE(ros::param::get("/simulator/publish_rate_hz", rate));
+  EXPECT_GE(static_cast<double>(samples), guaranteed_samples);
+  EXPECT_GT(guaranteed_samples, 0.0);
   std::printf(
-      "hostile_inputs: %d hostile messages and requests sent, %zu odometry samples checked\n",
-      cases, g->flight.all.size());
+      "hostile_inputs: %d hostile messages and requests sent, %zu odometry samples checked "
+      "(%.0f guaranteed by the calls; %.0f Hz x %.3f sim s = %.0f published)\n",
+      cases, samples, guaranteed_samples, rate, sim->last_time, rate * sim->last_time);
 }
 
 }  // namespace

@@ -222,13 +222,28 @@ def check_coco(ds, frames, mission, expect_keys=None):
     return images, anns, n_checked
 
 
-def check_yolo(yolo, images, anns):
+def coco_categories(ds):
+    """{category id: name} of a COCO export: its own class list, read from its files."""
+    cats = {}
+    ann_dir = os.path.join(ds, "annotations")
+    for name in sorted(os.listdir(ann_dir)):
+        cats.update({c["id"]: c["name"] for c in json.load(open(os.path.join(ann_dir, name)))["categories"]})
+    return cats
+
+
+def check_yolo(yolo, images, anns, cat_name):
+    """The YOLO labels against the COCO annotations of the same export; cat_name maps the COCO
+    category ids to names (the dataset's own class list, not ids written into this test)."""
     data = yaml.safe_load(open(os.path.join(yolo, "data.yaml")))
     names = data["names"]
+    if isinstance(names, dict):  # {index: name} form of data.yaml
+        names = [names[k] for k in sorted(names)]
+    used = {cat_name.get(a["category_id"]) for a in anns}
+    check(used and None not in used and used <= set(names),
+          "YOLO names %s do not cover the annotated COCO classes %s" % (names, used))
     coco = {}
     for a in anns:
         coco.setdefault(a["image_id"], []).append(a)
-    cat_name = {8: "car", 9: "pedestrian"}
     n = 0
     for iid, im in images.items():
         stem = os.path.splitext(os.path.basename(im["file_name"]))[0]
@@ -340,7 +355,7 @@ def run_all(tmp):
     # YOLO cross-checked against the COCO boxes (same flags -> same image ids and names).
     yolo = os.path.join(tmp, "yolo")
     export(bag, yolo, "--format", "yolo", "--split", "train=0.7,val=0.3", "--seed", "3")
-    print("YOLO: %d labels cross-checked" % check_yolo(yolo, images, anns))
+    print("YOLO: %d labels cross-checked" % check_yolo(yolo, images, anns, coco_categories(coco)))
     check(not os.path.exists(os.path.join(yolo, "annotations")), "YOLO wrote COCO annotations")
 
     # --every and --cameras.

@@ -5,36 +5,51 @@ Generates CASES (default 100,000) seeded cases, random and adversarial (touching
 collinear overlaps, vertices on edges, segments through vertices, tiny zones, huge
 coordinates, degenerate segments, self-touching rings), answers them all with one run of
 $HAMERITT_BIN_DIR/geometry_oracle (our C++: geometry::Polygon, adk::segmentInsidePolygon,
-adk::violationIntervals), and compares every answer with an independent computation on
-python3-shapely:
+adk::violationIntervals), and compares every answer with an independent computation:
 
-  area                  Polygon.area                      |diff| <= TOL * L^2
-  contains(q)           Polygon.intersects(Point)         equal, or q within TOL of the ring
+  area                  Polygon.area                      |diff| <= 4 TOL x size
+  contains(q)           exact, or Polygon.intersects(Point)   see "yes/no" below
   distance(q)           Polygon.distance(Point)           |diff| <= TOL
-  intersectsSegment     Polygon.intersects(LineString)    equal, or the segment within TOL
-  inside length         intersection(LineString).length   |diff| <= TOL
-  intersects(other)     Polygon.intersects(Polygon)       equal, or the polygons within TOL
-  distance(other)       Polygon.distance(Polygon)         |diff| <= TOL
+  intersectsSegment     exact, or Polygon.intersects(LineString)
+  inside length         intersection(LineString).length   |diff| <= 4 TOL
+  intersects(other)     exact, or Polygon.intersects(Polygon)
+  distance(other)       Polygon.distance(Polygon)         |diff| <= 4 TOL
   isSimple              is_valid, >= 3 distinct vertices, no repeated consecutive vertex
   violation duration    Shapely pieces of the 2-D segment, clipped to the altitude band
                         and the time window in Python  |diff| <= TOL_T
 
-TOL = 1e-9 * max(1, L) where L is the largest coordinate magnitude of the case: our code
-works in doubles with 1e-9 tolerances (geometry::kEpsilon, the KOZ parameter tolerance), so a
-point within TOL of an edge may be called on it. TOL_T = 1e-9 * max(1, |tb|) + (tb - ta) *
-TOL / |ab| (an edge moved by TOL moves an entry time by that much). Booleans get no tolerance
-beyond "the two shapes are within TOL of each other"; isSimple none beyond "the ring is within
-TOL of a non-simple one". Where a segment runs along an edge (collinear within rounding) the
-inside length is ill-conditioned (GEOS itself may answer 0): a length or duration that misses
-the direct comparison must lie between the answers for the polygon shrunk and grown by 4 TOL,
-or, counted and printed, by WIDE = 16 TOL (near-tangent segments).
+Yes/no answers: where the point (segment, other ring) lies within 2 BAND of the ring, BAND =
+1e-9 x max(1, |coordinate|) being the library's declared boundary band (geometry::kEpsilon),
+the boundary is decided exactly in rational arithmetic (fractions.Fraction: a double is a
+rational): on the ring (touching it) the answer must be yes, with no tolerance. Query points
+and segment ends are built on the ring exactly (vertices on a dyadic grid, points at k/256 of
+an edge). Within the band but not meeting the ring exactly, and not overlapping it by
+Shapely, the case is set aside from that comparison and counted ("excluded"). Everywhere else
+Shapely's answer must be matched exactly.
 
-Prints the counts per case family and per check; exits 1 on any disagreement beyond the
-tolerance (the first ones are listed with the case line, to reproduce by hand:
-  echo 'LINE' | $HAMERITT_BIN_DIR/geometry_oracle).
+Tolerances on numbers are relative to the zone's own size (the diagonal of its bounding box):
+TOL = 1e-9 x size + 1e-12 x |coordinate| (the second term: the inputs' own rounding, some
+4,500 units in the last place). Durations: TOL_T = 1e-12 x max(1, |tb|) + (tb - ta) x 4 TOL /
+max(|ab|, size). Where a segment runs along an edge within the band the inside length is
+ill-conditioned: a length or duration that misses the direct comparison must lie between the
+answers for the polygon shrunk and grown by one BAND, or, counted apart, by four.
+
+The counts of excluded and widened cases are bounded (MAX_EXCLUDED, MAX_WIDENED,
+MAX_WIDENED_4, as fractions of all cases), and the exact boundary classes must be frequent
+(at least 30 % of cases on the ring and touching, 10 % of polygon pairs touching).
+
+Negative control, in the same run: the first CONTROL_CASES cases are answered again by the
+driver with HAMERITT_ORACLE_WRONG=boundary_outside (a library that calls the ring outside);
+the comparison must report disagreements in the exact boundary checks of contains and
+intersectsSegment, else the test fails.
+
+Prints the counts per case family, per check and per boundary class; exits 1 on any
+disagreement beyond the tolerance or any bound exceeded (the first disagreements are listed
+with the case line, to reproduce by hand: echo 'LINE' | $HAMERITT_BIN_DIR/geometry_oracle).
 """
 
 import math
+from fractions import Fraction
 import os
 import random
 import subprocess
@@ -48,11 +63,20 @@ except ImportError:  # Debian: apt-get install python3-shapely
 
 CASES = int(os.environ.get("HAMERITT_ORACLE_CASES", "100000"))
 SEED = int(os.environ.get("HAMERITT_ORACLE_SEED", "1"))
+# Tolerance on lengths, relative to the zone's size, and the floor from the rounding of the
+# coordinates (relative to their magnitude; about 4,500 units in the last place).
 REL = 1e-9
-# Near-tangent segments: a point within TOL of an edge counts as inside, so where a segment runs
-# almost along an edge an interval end may move along it by several TOL (seen: 11 TOL on a
-# micrometre sliver zone). Answers within the polygon grown/shrunk by WIDE TOL pass, counted.
-WIDE = 16
+REL_COORD = 1e-12
+# The library's boundary band, geometry::kEpsilon * max(1, |coordinate|) (src/geometry/polygon.cpp).
+BAND = 1e-9
+# Upper bounds, as fractions of all cases, on the cases set aside (within the band of the ring
+# and not meeting it exactly) and on the lengths and durations accepted only with the polygon
+# grown/shrunk by the band (x1) or by four bands (x4).
+MAX_EXCLUDED = 0.015
+MAX_WIDENED = 0.01
+MAX_WIDENED_4 = 0.003
+# Cases run through the negative control (the wrong library).
+CONTROL_CASES = 5000
 NAN = float("nan")
 
 rng = random.Random(SEED)
@@ -68,8 +92,11 @@ def star(cx, cy, r, n, jitter=0.6):
             angles[i] = angles[i - 1] + 1e-3
     if angles[-1] - angles[0] > 2 * math.pi - 1e-3:
         return rect(cx - r, cy - r, cx + r, cy + r)
-    return [(cx + r * (1 - jitter * rng.random()) * math.cos(a),
-             cy + r * (1 - jitter * rng.random()) * math.sin(a)) for a in angles]
+    # Vertices on a dyadic grid 2^-40 of the coordinates' magnitude: a point at t = k/256 along
+    # an edge is then a double exactly (so exactly on the ring), and the ring stays irregular.
+    q = 2.0 ** (math.floor(math.log2(max(abs(cx), abs(cy)) + r)) - 40)
+    return [(round((cx + r * (1 - jitter * rng.random()) * math.cos(a)) / q) * q,
+             round((cy + r * (1 - jitter * rng.random()) * math.sin(a)) / q) * q) for a in angles]
 
 
 def rect(x0, y0, x1, y1):
@@ -80,7 +107,7 @@ def on_edge(poly, t=None):
     """A point on the polygon's ring (vertex when t is 0)."""
     i = rng.randrange(len(poly))
     (x0, y0), (x1, y1) = poly[i], poly[(i + 1) % len(poly)]
-    t = rng.choice([0.0, 0.5, 0.25, rng.random()]) if t is None else t
+    t = rng.choice([0.0, 0.5, 0.25, rng.randrange(1, 256) / 256]) if t is None else t
     return (x0 + t * (x1 - x0), y0 + t * (y1 - y0))
 
 
@@ -104,7 +131,7 @@ def segment_for(poly):
     if kind == 2:  # collinear with an edge, overlapping it partly
         i = rng.randrange(len(poly))
         (x0, y0), (x1, y1) = poly[i], poly[(i + 1) % len(poly)]
-        s, t = rng.choice([(-0.5, 0.5), (0.25, 1.5), (-1, 2), (0.2, 0.7), (1.0, 2.0)])
+        s, t = rng.choice([(-0.5, 0.5), (0.25, 1.5), (-1, 2), (0.1875, 0.6875), (1.0, 2.0)])
         return (x0 + s * (x1 - x0), y0 + s * (y1 - y0)), (x0 + t * (x1 - x0), y0 + t * (y1 - y0))
     if kind == 3:  # from outside to a point on the ring (touching)
         return random_point(poly, 3.0), on_edge(poly)
@@ -296,24 +323,93 @@ def oracle_simple(ring):
     return p.is_valid and p.area > 0
 
 
+# ---------------------------------------------------------------- exact boundary predicates
+# Doubles are rationals: Fraction(x) is x exactly, so these decide "on the ring" and "touches
+# the ring" without rounding.
+def orient(a, b, c):
+    """Sign of the cross product (b - a) x (c - a), exactly: in doubles where the result is
+    farther from 0 than their rounding error (Shewchuk's orient2d bound, 3.3e-16 of the terms'
+    magnitudes, taken as 1e-15), else in rationals."""
+    left = (b[0] - a[0]) * (c[1] - a[1])
+    right = (b[1] - a[1]) * (c[0] - a[0])
+    err = 1e-15 * (abs(left) + abs(right))
+    if left - right > err:
+        return 1
+    if right - left > err:
+        return -1
+    ax, ay, bx, by, cx, cy = (Fraction(v) for v in (*a, *b, *c))
+    v = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    return (v > 0) - (v < 0)
+
+
+def within_box(p, a, b):
+    return min(a[0], b[0]) <= p[0] <= max(a[0], b[0]) and min(a[1], b[1]) <= p[1] <= max(a[1], b[1])
+
+
+def on_segment_exact(p, a, b):
+    return within_box(p, a, b) and orient(a, b, p) == 0
+
+
+def segments_meet_exact(p1, p2, q1, q2):
+    """The closed segments p1-p2 and q1-q2 share a point (exactly)."""
+    if p1 == p2:
+        return on_segment_exact(p1, q1, q2)
+    if q1 == q2:
+        return on_segment_exact(q1, p1, p2)
+    d1, d2 = orient(q1, q2, p1), orient(q1, q2, p2)
+    d3, d4 = orient(p1, p2, q1), orient(p1, p2, q2)
+    if d1 * d2 < 0 and d3 * d4 < 0:
+        return True
+    return ((d1 == 0 and within_box(p1, q1, q2)) or (d2 == 0 and within_box(p2, q1, q2))
+            or (d3 == 0 and within_box(q1, p1, p2)) or (d4 == 0 and within_box(q2, p1, p2)))
+
+
+def edges(ring):
+    return [(ring[i], ring[(i + 1) % len(ring)]) for i in range(len(ring))]
+
+
+def on_ring_exact(ring, p):
+    return any(on_segment_exact(p, a, b) for a, b in edges(ring))
+
+
+def touches_ring_exact(ring, a, b):
+    return any(segments_meet_exact(a, b, c, d) for c, d in edges(ring))
+
+
+def rings_meet_exact(r1, r2):
+    return any(segments_meet_exact(a, b, c, d) for a, b in edges(r1) for c, d in edges(r2))
+
+
 # ---------------------------------------------------------------- run and compare
-def main():
+def run_driver(text, wrong=None):
     binary = os.path.join(os.environ.get("HAMERITT_BIN_DIR", ""), "geometry_oracle")
-    cases = [make_case() for _ in range(CASES)]
-    text = "\n".join(case_line(c) for c in cases) + "\n"
-    proc = subprocess.run([binary], input=text, capture_output=True, text=True, check=False)
+    env = dict(os.environ)
+    env.pop("HAMERITT_ORACLE_WRONG", None)
+    if wrong:
+        env["HAMERITT_ORACLE_WRONG"] = wrong
+    proc = subprocess.run([binary], input=text, capture_output=True, text=True, check=False,
+                          env=env)
     if proc.returncode != 0:
-        print("geometry_oracle failed:", proc.stderr[-2000:])
-        return 1
-    answers = proc.stdout.splitlines()
-    if len(answers) != len(cases):
-        print(f"geometry_oracle answered {len(answers)} of {len(cases)} cases")
-        return 1
-    lines = text.splitlines()
+        raise RuntimeError("geometry_oracle failed: " + proc.stderr[-2000:])
+    return proc.stdout.splitlines()
+
+
+def compare(cases, lines, answers):
+    """Compares every answer; returns (checks, bad, tally) where checks maps a check name to
+    [compared, disagreements] and tally counts the boundary classes and widened tolerances."""
     checks = {}
     bad = []
-    wide = [0, 0]  # answers accepted with the polygon grown/shrunk by 4 TOL, by WIDE TOL
-    families = {}
+    tally = {k: 0 for k in ("on ring (exact)", "near ring, excluded", "segment touching (exact)",
+                            "polygons touching (exact)",
+                            "near-touching, excluded", "isSimple near-degenerate",
+                            "widened x1 band", "widened x4 band")}
+
+    by_family = {}
+
+    def count(name, i):
+        tally[name] += 1
+        fam = by_family.setdefault(name, {})
+        fam[cases[i]["family"]] = fam.get(cases[i]["family"], 0) + 1
 
     def check(name, ok, i, detail):
         n = checks.setdefault(name, [0, 0])
@@ -323,80 +419,159 @@ def main():
             if len(bad) < 20:
                 bad.append(f"{name} ({cases[i]['family']}): {detail}\n  case: {lines[i]}")
 
+    def yes_no(name, ours, oracle, near, exact_meet, i):
+        """A yes/no answer: exact where the shapes meet (on the ring: yes), Shapely's where they
+        are farther apart than the library's band or Shapely says they overlap (then they
+        meet away from the ring, robustly); within the band and not meeting: excluded."""
+        if near and exact_meet():
+            count({"contains": "on ring (exact)", "intersectsSegment": "segment touching (exact)"}.get(
+                name, "polygons touching (exact)"), i)
+            check(name + " [boundary, exact]", ours, i, f"ours {ours}, exact: on the boundary")
+        elif near and not oracle:
+            count("near ring, excluded" if name == "contains" else "near-touching, excluded", i)
+        else:
+            check(name, ours == oracle, i, f"ours {ours}, oracle {oracle}")
+
     for i, (c, ans) in enumerate(zip(cases, answers)):
-        families[c["family"]] = families.get(c["family"], 0) + 1
         f = ans.split()
         area, contains, dist_q = float(f[0]), f[1] == "1", float(f[2])
         seg_hit, inside_len = f[3] == "1", float(f[4])
         poly_hit, poly_dist, simple, viol = f[6] == "1", float(f[7]), f[8] == "1", float(f[9])
-        coords = [abs(x) for p in c["poly"] + c["other"] + [c["a"][:2], c["b"][:2], c["q"]] for x in p]
-        scale = max(1.0, max(coords))
-        tol = REL * scale
-        expect_simple = oracle_simple(c["poly"])
-        check("isSimple", simple == expect_simple or near_degenerate(c["poly"], tol), i,
-              f"ours {simple}, oracle {expect_simple}")
+        ring = c["poly"]
+        xs, ys = [p[0] for p in ring], [p[1] for p in ring]
+        # The zone's own size, and the magnitude of the coordinates of the case.
+        size = math.hypot(max(xs) - min(xs), max(ys) - min(ys))
+        mag = max(1.0, max(abs(x) for p in ring + c["other"] + [c["a"][:2], c["b"][:2], c["q"]]
+                           for x in p))
+        # Lengths: relative to the zone's size, plus a floor of REL_COORD * |coordinate| (a few
+        # thousand units in the last place: the inputs themselves are rounded to doubles).
+        tol = REL * size + REL_COORD * mag
+        # The library's declared boundary band (geometry::kEpsilon * max(1, |coordinate|)): a
+        # point closer to the ring than this may be called on it.
+        band = BAND * mag
+        expect_simple = oracle_simple(ring)
+        if simple != expect_simple and near_degenerate(ring, band):
+            count("isSimple near-degenerate", i)
+        else:
+            check("isSimple", simple == expect_simple, i, f"ours {simple}, oracle {expect_simple}")
         if not (expect_simple and simple):
             continue  # Shapely's other answers are undefined for invalid polygons
-        P = Polygon(c["poly"])
+        P = Polygon(ring)
         a2, b2 = c["a"][:2], c["b"][:2]
         q = Point(c["q"])
         seg = shape2(a2, b2)
-        check("area", abs(area - P.area) <= REL * scale * scale, i, f"ours {area!r}, oracle {P.area!r}")
-        exp = P.intersects(q)
-        check("contains", contains == exp or P.exterior.distance(q) <= tol, i,
-              f"ours {contains}, oracle {exp}, ring distance {P.exterior.distance(q)!r}")
+        check("area", abs(area - P.area) <= 4 * tol * size, i, f"ours {area!r}, oracle {P.area!r}")
+        yes_no("contains", contains, P.intersects(q), P.exterior.distance(q) <= 2 * band,
+               lambda: on_ring_exact(ring, c["q"]), i)
         exp_d = P.distance(q)
-        check("distance(point)", abs(dist_q - exp_d) <= tol, i, f"ours {dist_q!r}, oracle {exp_d!r}")
-        exp = P.intersects(seg)
-        check("intersectsSegment", seg_hit == exp or P.exterior.distance(seg) <= tol, i,
-              f"ours {seg_hit}, oracle {exp}, ring distance {P.exterior.distance(seg)!r}")
+        if dist_q == 0 and 0 < exp_d <= 2 * band:
+            count("near ring, excluded", i)  # called on the ring (within the band): distance 0
+        else:
+            check("distance(point)", abs(dist_q - exp_d) <= tol, i,
+                  f"ours {dist_q!r}, oracle {exp_d!r}")
+        yes_no("intersectsSegment", seg_hit, P.intersects(seg),
+               P.exterior.distance(seg) <= 2 * band, lambda: touches_ring_exact(ring, a2, b2), i)
         exp_len = P.intersection(seg).length if a2 != b2 else 0.0
-        ok = abs(inside_len - exp_len) <= tol * 4
+        ok = abs(inside_len - exp_len) <= 4 * tol
         if not ok and a2 != b2:
-            # Along an edge within rounding the length is ill-conditioned: ours must lie between
-            # the answers for the polygon shrunk and grown by 4 TOL.
-            for k in (4, WIDE):
-                lo = P.buffer(-k * tol).intersection(seg).length
-                hi = P.buffer(k * tol).intersection(seg).length
-                ok = between(inside_len, lo, hi, k * tol)
+            # Along an edge within the band the length is ill-conditioned: ours must lie between
+            # the answers for the polygon shrunk and grown by the band (counted, bounded).
+            for k in (1, 4):
+                lo = P.buffer(-k * band).intersection(seg).length
+                hi = P.buffer(k * band).intersection(seg).length
+                ok = between(inside_len, lo, hi, 4 * tol)
                 if ok:
-                    wide[k == WIDE] += 1
+                    count(f"widened x{k} band", i)
                     break
         check("inside length", ok, i, f"ours {inside_len!r}, oracle {exp_len!r}")
         if oracle_simple(c["other"]):
             O = Polygon(c["other"])
-            exp = P.intersects(O)
-            check("intersects(polygon)", poly_hit == exp or P.exterior.distance(O.exterior) <= tol, i,
-                  f"ours {poly_hit}, oracle {exp}")
+            yes_no("intersects(polygon)", poly_hit, P.intersects(O),
+                   P.exterior.distance(O.exterior) <= 2 * band,
+                   lambda: rings_meet_exact(ring, c["other"]), i)
             exp_d = P.distance(O)
-            check("distance(polygon)", abs(poly_dist - exp_d) <= tol, i,
-                  f"ours {poly_dist!r}, oracle {exp_d!r}")
+            if poly_dist == 0 and 0 < exp_d <= 2 * band:
+                count("near-touching, excluded", i)  # called touching (within the band)
+            else:
+                check("distance(polygon)", abs(poly_dist - exp_d) <= 4 * tol, i,
+                      f"ours {poly_dist!r}, oracle {exp_d!r}")
         exp_v = violation_duration(P, c)
         ab = math.dist(a2, b2)
+        # Times: rounding of the times themselves, plus a length tolerance moved along the
+        # segment (an interval end moves by (tb - ta) * tol / |ab|).
+        slack_t = REL_COORD * max(1.0, abs(c["tb"])) + (c["tb"] - c["ta"]) * 4 * tol / max(ab, size)
         if ab == 0:
-            ok = abs(viol - exp_v) <= REL * max(1.0, c["tb"]) or P.exterior.distance(Point(a2)) <= tol
+            ok = abs(viol - exp_v) <= slack_t or P.exterior.distance(Point(a2)) <= 2 * band
         else:
-            ok = abs(viol - exp_v) <= REL * max(1.0, c["tb"]) + (c["tb"] - c["ta"]) * 4 * tol / ab
-        if not ok:
-            slack = REL * max(1.0, c["tb"]) + (c["tb"] - c["ta"]) * 4 * tol / max(ab, tol)
-            for k in (4, WIDE):
-                ok = between(viol, violation_duration(P.buffer(-k * tol), c),
-                             violation_duration(P.buffer(k * tol), c), k / 4 * slack)
+            ok = abs(viol - exp_v) <= slack_t
+        if not ok and ab > 0:
+            for k in (1, 4):
+                ok = between(viol, violation_duration(P.buffer(-k * band), c),
+                             violation_duration(P.buffer(k * band), c), slack_t)
                 if ok:
-                    wide[k == WIDE] += 1
+                    count(f"widened x{k} band", i)
                     break
         check("violation duration", ok, i, f"ours {viol!r}, oracle {exp_v!r}")
+    return checks, bad, tally, by_family
+
+
+def main():
+    cases = [make_case() for _ in range(CASES)]
+    lines = [case_line(c) for c in cases]
+    text = "\n".join(lines) + "\n"
+    try:
+        answers = run_driver(text)
+    except RuntimeError as e:
+        print(e)
+        return 1
+    if len(answers) != len(cases):
+        print(f"geometry_oracle answered {len(answers)} of {len(cases)} cases")
+        return 1
+    families = {}
+    for c in cases:
+        families[c["family"]] = families.get(c["family"], 0) + 1
+    checks, bad, tally, by_family = compare(cases, lines, answers)
 
     total = sum(n for n, _ in checks.values())
     failed = sum(k for _, k in checks.values())
     print(f"geometry oracle: {len(cases)} cases (seed {SEED}): "
           + ", ".join(f"{k} {v}" for k, v in sorted(families.items())))
-    print(f"  lengths and durations accepted only with the polygon grown/shrunk by 4 TOL: "
-          f"{wide[0]}, by {WIDE} TOL (near-tangent segments): {wide[1]}")
     for name, (n, k) in checks.items():
         print(f"  {name}: {n} compared, {k} disagreements beyond tolerance")
+    for name, v in tally.items():
+        fams = ", ".join(f"{f} {n}" for f, n in sorted(by_family.get(name, {}).items()))
+        print(f"  {name}: {v}" + (f" ({fams})" if fams else ""))
     for b in bad:
         print("DISAGREE", b)
+
+    # Bounds on what the comparison set aside or widened, and a floor on the exact boundary
+    # cases (without them the yes/no checks would not test the boundary at all).
+    limits = []
+    n = len(cases)
+    for name, lo, hi in (("on ring (exact)", 0.3, 1.0), ("segment touching (exact)", 0.3, 1.0),
+                         ("polygons touching (exact)", 0.1, 1.0),
+                         ("near ring, excluded", 0.0, MAX_EXCLUDED),
+                         ("near-touching, excluded", 0.0, MAX_EXCLUDED),
+                         ("isSimple near-degenerate", 0.0, MAX_EXCLUDED),
+                         ("widened x1 band", 0.0, MAX_WIDENED),
+                         ("widened x4 band", 0.0, MAX_WIDENED_4)):
+        if not lo * n <= tally[name] <= hi * n:
+            limits.append(f"{name}: {tally[name]} of {n} cases, expected {lo:g} to {hi:g} of them")
+    for m in limits:
+        print("OUT OF BOUNDS", m)
+
+    # Negative control: the same comparison must fail on a library that calls the ring outside.
+    k = min(len(cases), CONTROL_CASES)
+    wrong = run_driver("\n".join(lines[:k]) + "\n", "boundary_outside")
+    wchecks = compare(cases[:k], lines[:k], wrong)[0]
+    caught = {name: v[1] for name, v in wchecks.items() if v[1]}
+    print(f"  negative control (boundary_outside, {k} cases): disagreements {caught}")
+    control_ok = (caught.get("contains [boundary, exact]", 0) > 0
+                  and caught.get("intersectsSegment [boundary, exact]", 0) > 0)
+    if not control_ok:
+        print("NEGATIVE CONTROL FAILED: the oracle did not catch boundary = outside")
+    failed += len(limits) + (not control_ok)
+    total += len(limits) + 1
     print(f"{total - failed} passed, {failed} failed")
     return 1 if failed else 0
 

@@ -18,8 +18,9 @@ namespace hameritt::scenario {
 // One problem found in a document. `path` is a JSON Pointer (RFC 6901) into the document, ""
 // for the document itself; `rule` names the failed check: a schema keyword ("type",
 // "required", "additionalProperties", "enum", ...) or a semantic rule ("polygon_simple",
-// "unique_id", "time_window", "prior_sum", ...), "json" for malformed JSON, "schema_kind" for
-// an unknown or missing "schema" field, "schema" for an unusable schema file.
+// "unique_id", "time_window", "prior_sum", ...), "json" for malformed JSON, "limit" for a
+// document beyond the size or nesting limit (bounded_json.h), "schema_kind" for an unknown or
+// missing "schema" field, "schema" for an unusable schema file.
 struct ValidationIssue {
   std::string file;
   std::string path;
@@ -92,12 +93,14 @@ std::vector<ValidationIssue> validateDocument(const nlohmann::json& doc, const s
                                               const std::string& schema_dir);
 
 // Parses a JSON text strictly (duplicate object keys are errors). On failure returns false and
-// sets `issue` (rule "json", message with line and column where known).
+// sets `issue` (rule "json", message with line and column where known; rule "limit" beyond
+// the size or nesting limit of bounded_json.h).
 bool parseJsonText(const std::string& text, const std::string& file, nlohmann::json* out,
                    ValidationIssue* issue);
 
 // Reads, parses and validates a file: an unreadable file is one issue with rule "io",
-// malformed JSON one issue with rule "json"; otherwise validateDocument().
+// malformed JSON one issue with rule "json", a file beyond the limits one with rule "limit";
+// otherwise validateDocument().
 std::vector<ValidationIssue> validateFile(const std::string& path, const std::string& schema_dir);
 
 // "FILE: PATH: RULE: MESSAGE" (PATH "/" ... or "(root)" for the document itself).
