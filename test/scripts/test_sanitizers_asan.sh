@@ -24,7 +24,7 @@ else
   ((${#programs[@]} >= 10)) || { echo "FAIL: fewer than 10 gtest programs: ${programs[*]}"; exit 1; }
 fi
 echo "gtest programs: ${#programs[@]} (${programs[*]})"
-sanitizer_build asan sanitizer_control "${programs[@]}" >"$work/build.log" 2>&1 ||
+sanitizer_build asan test_sanitizer_control "${programs[@]}" >"$work/build.log" 2>&1 ||
   { tail -40 "$work/build.log"; exit 1; }
 sanitizer_source_devel asan
 bin="$(sanitizer_build_dir asan)/devel/lib/hameritt"
