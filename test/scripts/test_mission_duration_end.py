@@ -23,6 +23,8 @@ import subprocess
 import sys
 import tempfile
 
+import rosgraph
+from graph_util import wait_for
 from fault_util import Checks, metrics_validator
 
 PORT = 25000 + os.getpid() % 2000
@@ -90,6 +92,8 @@ def main():
     core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     try:
+        # roslaunch starts a master of its own unless one answers: wait for ours first.
+        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         got = run(tmp, "lockstep", "true")
         run(tmp, "free_running", "false")
         if got:

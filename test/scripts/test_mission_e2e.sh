@@ -92,7 +92,7 @@ roscore -p "$port" >"$out/roscore.log" 2>&1 &
 core=$!
 trap 'kill $core 2>/dev/null; wait $core 2>/dev/null; rm -rf "$out"' EXIT
 /usr/bin/python3 - "$out" <<'PY'
-import json, os, subprocess, sys, time
+import json, os, signal, subprocess, sys, time
 import rosgraph, rospy, yaml
 out = sys.argv[1]
 counts = json.load(open(os.path.join(out, "counts.json")))
@@ -116,13 +116,19 @@ def counter(t):
         received[t] += 1
     return cb
 subs = [rospy.Subscriber(t, rospy.AnyMsg, counter(t), queue_size=1000, buff_size=1 << 26) for t in topics]
-rc = subprocess.call(["rosbag", "play", "-q", "-r", "10", "--wait-for-subscribers",
-                      os.path.join(out, "mission.bag"), "--topics"] + topics, timeout=120)
-deadline = time.time() + 10
-while time.time() < deadline and any(received[t] < counts[t] for t in topics):
+# --keep-alive: rosbag play stays up after the bag's end until every image has arrived (a player
+# that exits at once drops what its outgoing queues still hold when a loaded subscriber lags).
+play = subprocess.Popen(["rosbag", "play", "-q", "-r", "10", "--wait-for-subscribers",
+                         "--keep-alive", os.path.join(out, "mission.bag"), "--topics"] + topics)
+deadline = time.time() + 120
+while (time.time() < deadline and play.poll() is None
+       and any(received[t] < counts[t] for t in topics)):
     time.sleep(0.1)
-if rc != 0:
-    fails.append("rosbag play exited %d" % rc)
+if play.poll() is not None:
+    fails.append("rosbag play exited %d before every image arrived" % play.returncode)
+else:
+    play.send_signal(signal.SIGINT)
+    play.wait(30)
 for t in topics:
     if received[t] != counts[t]:
         fails.append("rosbag play: %s delivered %d of %d" % (t, received[t], counts[t]))

@@ -29,6 +29,8 @@ import subprocess
 import sys
 import tempfile
 
+import rosgraph
+from graph_util import wait_for
 from fault_util import BIN, SRC, Checks, metrics_state, metrics_validator, run_adk
 
 PORT = 23000 + os.getpid() % 2000
@@ -232,6 +234,8 @@ def main():
     core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     try:
+        # roslaunch starts a master of its own unless one answers: wait for ours first.
+        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         generate_on_full_disk(small)
         export_on_full_disk(small, TMP)
         recorder_reason(small)
