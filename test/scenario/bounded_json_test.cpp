@@ -21,22 +21,16 @@
 #include "hameritt/scenario/params_table.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/validation.h"
+#include "test_util.h"
 
 namespace hameritt::scenario {
 namespace {
 
+using testing::messageOf;
+
 namespace fs = std::filesystem;
 
 std::string nested(std::size_t depth) { return std::string(depth, '[') + std::string(depth, ']'); }
-
-std::string messageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 long maxRssKb() {
   rusage u{};

@@ -16,9 +16,12 @@
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/validation.h"
+#include "test_util.h"
 
 namespace hameritt::scenario {
 namespace {
+
+using testing::messageOf;
 
 std::string regression(const std::string& target, const std::string& name) {
   std::ifstream in(defaultConfigDir() + "/../test/fuzz/regressions/" + target + "/" + name);
@@ -26,15 +29,6 @@ std::string regression(const std::string& target, const std::string& name) {
   s << in.rdbuf();
   EXPECT_FALSE(s.str().empty()) << target << "/" << name;
   return s.str();
-}
-
-std::string messageOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 std::vector<ValidationIssue> validateText(const std::string& text) {

@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 #include <string>
 
+#include "hameritt/scenario/error.h"
 #include "hameritt/scenario/generator.h"
 #include "hameritt/scenario/world.h"
 
@@ -21,6 +23,16 @@ inline const GeneratorConfig& shippedConfig() {
 inline const World& shippedWorld() {
   static const World w = generateWorld(loadWorldParams(defaultConfigDir() + "/world.json"));
   return w;
+}
+
+// What f throws as a ConfigError, or "(no error)".
+inline std::string messageOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 // The whole file as bytes ("" if it cannot be read).
