@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The gtest programs under AddressSanitizer (with LeakSanitizer) and UndefinedBehaviorSanitizer:
-# builds them in build/asan (clang-14, -O1, only the libraries they link) and runs each through
+# builds them in build/asan (g++, -O1, only the libraries they link) and runs each through
 # the judge of scripts/sanitizers_common.sh (any report fails), two at a time. Negative control
 # first: test/sanitizers/control.cpp, compiled the same way, must be reported and fail the judge
 # for each fault (heap overflow, use after free, signed overflow, a leak from our code), and pass
