@@ -1187,7 +1187,8 @@ class ScenarioBuilder {
   void addTraffic() {
     const int cars = static_cast<int>(rng_.uniformInt(cfg_.traffic_count_min, cfg_.traffic_count_max));
     for (int i = 0; i < cars; ++i) {
-      std::vector<int> nodes = randomWalk(randomNode(), static_cast<int>(rng_.uniformInt(2, 5)));
+      const int hops = static_cast<int>(rng_.uniformInt(2, 5));  // "Draw order" at the top
+      std::vector<int> nodes = randomWalk(randomNode(), hops);
       if (nodes.size() < 2) continue;
       DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
       const std::vector<Vec2> path = nodePositions(nodes);
