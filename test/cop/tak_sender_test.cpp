@@ -82,12 +82,19 @@ TEST(TakEndpoint, ParsesUnicastMulticastAndTcpUrls) {
   EXPECT_EQ(t.protocol, TakEndpoint::Protocol::kTcp);
   EXPECT_EQ(t.host, "10.1.2.3");
   EXPECT_FALSE(t.multicast);
+  const TakEndpoint s = parseTakUrl("ssl://tak.example.org:8089");  // TLS: a DNS name too
+  EXPECT_EQ(s.protocol, TakEndpoint::Protocol::kSsl);
+  EXPECT_EQ(s.url(), "ssl://tak.example.org:8089");
+  EXPECT_TRUE(s.stream());
+  EXPECT_EQ(parseTakUrl("ssl://10.0.0.5:8089").host, "10.0.0.5");
 }
 
 TEST(TakEndpoint, RejectsMalformedUrlsNamingThem) {
-  for (const char* bad : {"http://1.2.3.4:5", "udp://1.2.3.4", "udp://1.2.3.4:0",
-                          "udp://1.2.3.4:70000", "udp://host.example:5", "tcp://", "tcp",
-                          "tcp://239.2.3.1:6969", "udp:/1.2.3.4:5", "udp://1.2.3.4:5x", ""}) {
+  for (const char* bad :
+       {"http://1.2.3.4:5", "udp://1.2.3.4", "udp://1.2.3.4:0", "udp://1.2.3.4:70000",
+        "udp://host.example:5", "tcp://", "tcp", "tcp://239.2.3.1:6969", "udp:/1.2.3.4:5",
+        "udp://1.2.3.4:5x", "", "ssl://", "ssl://tak_server:8089", "ssl://tak.example.org",
+        "ssl://239.2.3.1:8089", "tcp://tak.example.org:8087"}) {
     try {
       parseTakUrl(bad);
       ADD_FAILURE() << bad;
