@@ -1,6 +1,7 @@
 #!/bin/bash
 # Makes the certificates of the TAK TLS tests into DIR with the openssl tool, as a TAK Server's
-# certificate tools lay them out: a CA, a server certificate for 127.0.0.1 and localhost, a
+# certificate tools lay them out: a CA, a server certificate for 127.0.0.1 and localhost (and an
+# expired one), a
 # client certificate (PEM, an encrypted PEM key and a PKCS#12 with a password), the trust store
 # (PEM and PKCS#12), and for the negative cases a second CA with its own server and client
 # certificates that the first CA does not know.
@@ -33,6 +34,10 @@ leaf server ca "$server_ext"
 leaf client ca "$client_ext"
 leaf other-server other-ca "$server_ext"
 leaf other-client other-ca "$client_ext"
+# The server's key with a certificate that expired a day ago (-days -1: notAfter before now).
+cp server.key expired-server.key
+openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days -1 \
+  -extfile server.ext -out expired-server.pem 2>/dev/null
 # The client's key encrypted, and its PKCS#12 (certificate, key and CA) with a password.
 openssl pkey -in client.key -aes256 -passout pass:atakatak -out client-encrypted.key
 openssl pkcs12 -export -in client.pem -inkey client.key -certfile ca.pem -name client \

@@ -12,7 +12,7 @@ bridge's sender) sends events to it:
     (CoTParser.from_proto) decodes to the uid, type, point, callsign, track and remarks sent;
   * UDP mesh in Version 1 (0xbf 0x01 0xbf): the same judge;
   * refused, each reason printed once while the sender keeps retrying, nothing sent: an
-    untrusted server certificate, no client certificate and an unknown client certificate (the
+    untrusted server certificate, an expired one, no client certificate and an unknown client certificate (the
     server refuses), a name mismatch, a wrong pin, a wrong PKCS#12 password, a server that closes
     the handshake; a plaintext listener never sees CoT (no fallback to plaintext).
 Negative controls: the arrival check reports a missing event, node-cot rejects a damaged payload.
@@ -167,9 +167,10 @@ class Listener:
         self.sock.close()
 
 
-def run_check(binary, url, *args, seconds=4.0, env=None):
+def run_check(binary, url, *args, seconds=30.0, env=None):
+    """hameritt_tak_check's run and its summary line; it ends as soon as every event is sent."""
     cmd = [binary, url, "--events", str(EVENTS), "--seconds", str(seconds),
-           "--reconnect-initial-s", "0.3", "--connect-timeout-s", "2"] + list(args)
+           "--reconnect-initial-s", "0.3", "--connect-timeout-s", "10"] + list(args)
     e = dict(os.environ)
     e.update(env or {})
     p = subprocess.run(cmd, capture_output=True, text=True, env=e, timeout=60)
@@ -282,7 +283,7 @@ def check_decoded(name, decoded):
 
 
 def refused(name, binary, pki, url, listener, args, reason, env=None, server_reason=None):
-    p, s = run_check(binary, url, *args, seconds=1.5, env=env)
+    p, s = run_check(binary, url, *args, seconds=1.0, env=env)
     errors = [ln for ln in p.stderr.splitlines() if ln.startswith("tak_check: error:")]
     check(name + ": exit 1", p.returncode == 1, "%d %s %s" % (p.returncode, p.stdout, p.stderr))
     check(name + ": the reason printed once", len(errors) == 1 and reason in errors[0],
@@ -386,6 +387,11 @@ def main():
         refused("untrusted server", binary, pki, "ssl://127.0.0.1:%d" % srv.port, srv, pem,
                 "server certificate rejected: unable to get local issuer certificate", env=pw,
                 server_reason="UNKNOWN_CA")
+        srv.close()
+        srv = Listener(pki, cert="expired-server")
+        refused("expired server certificate", binary, pki, "ssl://127.0.0.1:%d" % srv.port, srv, pem,
+                "server certificate rejected: certificate has expired", env=pw,
+                server_reason="CERTIFICATE_EXPIRED")
         srv.close()
         srv = Listener(pki)
         refused("no client certificate", binary, pki, "ssl://127.0.0.1:%d" % srv.port, srv,
