@@ -9,6 +9,7 @@
 // Usage: bench_cop [entities] [reports]
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <openssl/err.h>
 #include <openssl/evp.h>
@@ -16,7 +17,6 @@
 #include <openssl/ssl.h>
 #include <openssl/x509v3.h>
 #include <sys/socket.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -53,7 +53,8 @@ Cert makeCert(const std::string& cn, const Cert* issuer, bool ca, const std::str
   c.key = EVP_EC_gen("P-256");
   c.cert = X509_new();
   X509_set_version(c.cert, 2);
-  ASN1_INTEGER_set(X509_get_serialNumber(c.cert), static_cast<long>(std::hash<std::string>()(cn) & 0x7fffffff));
+  ASN1_INTEGER_set(X509_get_serialNumber(c.cert),
+                   static_cast<long>(std::hash<std::string>()(cn) & 0x7fffffff));
   X509_gmtime_adj(X509_getm_notBefore(c.cert), -60);
   X509_gmtime_adj(X509_getm_notAfter(c.cert), 86400);
   X509_set_pubkey(c.cert, c.key);
@@ -63,7 +64,8 @@ Cert makeCert(const std::string& cn, const Cert* issuer, bool ca, const std::str
   X509_set_issuer_name(c.cert, issuer ? X509_get_subject_name(issuer->cert) : name);
   X509V3_CTX v3;
   X509V3_set_ctx(&v3, issuer ? issuer->cert : c.cert, c.cert, nullptr, nullptr, 0);
-  for (const char* ext : {ca ? "basicConstraints=critical,CA:TRUE" : "subjectAltName=IP:127.0.0.1"}) {
+  for (const char* ext :
+       {ca ? "basicConstraints=critical,CA:TRUE" : "subjectAltName=IP:127.0.0.1"}) {
     const std::string kv = ext;
     const size_t eq = kv.find('=');
     X509_EXTENSION* e =

@@ -385,8 +385,9 @@ bool TakSender::transmit(const Payload& p) {
     return false;
   }
   // What the server sends (pings, other clients' events) is read and dropped: a closed
-  // connection shows up here before the event is written into it.
-  if (!drainInput(nullptr)) return false;
+  // connection shows up here before the event is written into it, and the event waits for the
+  // next connection.
+  if (!drainInput(nullptr)) return unsent_ = true, false;
   if (protobuf_ && !p.proto.empty()) return writeAll(frameStream(p.proto));
   return writeAll(p.xml);
 }
@@ -421,11 +422,20 @@ void TakSender::run() {
     Payload payload = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();
+    unsent_ = false;
     const bool ok = transmit(payload);
     if (!ok && tcp) closeSocket();  // reconnect (after the current back-off) on the next event
     lock.lock();
+    if (!ok && tcp) {  // the next connect waits the back-off: a server that closes at once
+      stats_.next_backoff_s = backoff;  // is not hammered
+      next_attempt =
+          Clock::now() + std::chrono::microseconds(static_cast<long long>(backoff * 1e6));
+      backoff = std::min(backoff * 2.0, config_.reconnect_max_s);
+    }
     if (ok) {
       stats_.sent++;
+    } else if (unsent_ && queue_.size() < config_.queue_capacity) {
+      queue_.push_front(std::move(payload));  // nothing of it was written
     } else {
       stats_.send_errors++;
     }

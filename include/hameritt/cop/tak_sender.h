@@ -123,6 +123,7 @@ class TakSender {
   bool protobuf_ = false;  // the stream speaks TAK Protocol Version 1 (negotiated)
   std::string logged_;     // the reason logged last
   std::string inbound_;    // what the server sent, while negotiating
+  bool unsent_ = false;    // the last transmit failed before writing anything
   std::thread thread_;
 };
 
