@@ -183,6 +183,39 @@ TEST(TakSender, UnreachableTcpServerBacksOffThenConnects) {
   EXPECT_TRUE(waitFor([&] { return sender.stats().connects == 1; }, 60.0));
 }
 
+// A server that closed the connection: the sender notices before it writes the next event,
+// which then goes out on a new connection (not lost, not counted as an error).
+TEST(TakSender, EventAfterTheServerClosedGoesOnTheNextConnection) {
+  LoopbackSocket server(SOCK_STREAM);
+  ASSERT_EQ(::listen(server.fd, 2), 0);
+  TakSenderConfig c;
+  c.reconnect_initial_s = 0.05;
+  TakSender sender(parseTakUrl("tcp://127.0.0.1:" + std::to_string(server.port)), c);
+  sender.send("<event uid=\"a\"/>");
+  pollfd p{server.fd, POLLIN, 0};
+  ASSERT_GT(::poll(&p, 1, 60000), 0);
+  int conn = ::accept(server.fd, nullptr, nullptr);
+  ASSERT_GE(conn, 0);
+  EXPECT_EQ(server.receive(conn, 60000), "<event uid=\"a\"/>");
+  ASSERT_TRUE(waitFor([&] { return sender.stats().sent == 1; }, 60.0));
+  ::close(conn);  // the server hangs up
+  // On loopback the FIN is in the sender's socket when close() returns; the pause is only a
+  // margin for that (no time is asserted).
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  sender.send("<event uid=\"b\"/>");
+  ASSERT_GT(::poll(&p, 1, 60000), 0);
+  conn = ::accept(server.fd, nullptr, nullptr);
+  ASSERT_GE(conn, 0);
+  EXPECT_EQ(server.receive(conn, 60000), "<event uid=\"b\"/>");
+  ::close(conn);
+  ASSERT_TRUE(waitFor([&] { return sender.stats().sent == 2; }, 60.0));
+  const TakSenderStats s = sender.stats();
+  EXPECT_EQ(s.connects, 2u);
+  EXPECT_EQ(s.send_errors, 0u);
+  EXPECT_EQ(s.dropped, 0u);
+  EXPECT_EQ(s.connect_attempts, 2u);
+}
+
 // The destructor wakes the thread from its back-off: with a one-hour back-off, a destructor that
 // waited it out would hold the test past ctest's timeout.
 TEST(TakSender, StopsWhileBackingOff) {
