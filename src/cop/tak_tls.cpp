@@ -57,13 +57,20 @@ std::string subjectOf(X509* cert) {
   return buf;
 }
 
-// PKCS#12 files from older tools use RC2/3DES: OpenSSL 3 reads them with its legacy provider.
-void loadLegacyProvider() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    OSSL_PROVIDER_try_load(nullptr, "legacy", 1);
-    ERR_clear_error();
-  });
+// PKCS#12 files from older tools encrypt with RC2 or 3DES: OpenSSL 3 reads them with its legacy
+// provider, loaded on the first such file and unloaded at exit.
+bool loadLegacyProvider() {
+  struct Legacy {
+    OSSL_PROVIDER* provider = OSSL_PROVIDER_try_load(nullptr, "legacy", 1);
+    ~Legacy() {
+      if (provider) OSSL_PROVIDER_unload(provider);
+    }
+  };
+  static std::mutex mutex;
+  std::lock_guard<std::mutex> lock(mutex);
+  static const Legacy legacy;
+  ERR_clear_error();
+  return legacy.provider != nullptr;
 }
 
 struct P12Contents {
@@ -80,7 +87,6 @@ struct P12Contents {
 void readP12(const std::string& what, const std::string& path, const std::string& password,
              P12Contents& out) {
   const std::string data = readFile(what, path);
-  loadLegacyProvider();
   ERR_clear_error();
   const unsigned char* p = reinterpret_cast<const unsigned char*>(data.data());
   std::unique_ptr<PKCS12, decltype(&PKCS12_free)> p12(
@@ -92,8 +98,12 @@ void readP12(const std::string& what, const std::string& path, const std::string
     throw TlsConfigError(what + " '" + path + "': wrong password (the PKCS#12 integrity check " +
                          "fails with the password given)");
   }
-  if (!PKCS12_parse(p12.get(), password.c_str(), &out.key, &out.cert, &out.ca))
-    throw TlsConfigError(what + " '" + path + "': cannot be decrypted (" + opensslErrors() + ")");
+  if (!PKCS12_parse(p12.get(), password.c_str(), &out.key, &out.cert, &out.ca)) {
+    const std::string why = opensslErrors();
+    if (!loadLegacyProvider() ||
+        !PKCS12_parse(p12.get(), password.c_str(), &out.key, &out.cert, &out.ca))
+      throw TlsConfigError(what + " '" + path + "': cannot be decrypted (" + why + ")");
+  }
 }
 
 int passwordCallback(char* buf, int size, int, void* user) {

@@ -64,6 +64,9 @@ TEST_F(TakTls, GoodPemAndPkcs12SetsLoad) {
   EXPECT_EQ(loadError(p12()), "");
   TakTlsContext context(p12());
   EXPECT_CONTAINS(context.clientSubject(), "CN=client");
+  TakTlsConfig legacy = p12();  // RC2/3DES, as older certificate tools write them
+  legacy.client_p12 = f("client-legacy.p12");
+  EXPECT_EQ(loadError(legacy), "");
   TakTlsConfig none;  // no client certificate, system CAs: loads (the server decides)
   EXPECT_EQ(loadError(none), "");
 }

@@ -42,6 +42,9 @@ openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 
 openssl pkey -in client.key -aes256 -passout pass:atakatak -out client-encrypted.key
 openssl pkcs12 -export -in client.pem -inkey client.key -certfile ca.pem -name client \
   -passout pass:atakatak -out client.p12
+# The same with the RC2/3DES encryption of older certificate tools (OpenSSL's legacy provider).
+openssl pkcs12 -export -legacy -in client.pem -inkey client.key -certfile ca.pem -name client \
+  -passout pass:atakatak -out client-legacy.p12
 # The trust store as a PKCS#12 of the CA certificate alone.
 openssl pkcs12 -export -nokeys -in ca.pem -passout pass:trustpass -out truststore-root.p12
 # SHA-256 fingerprints (hex, colons) for the pin.
