@@ -136,7 +136,16 @@ Px4Server::~Px4Server() {
 
 bool Px4Server::connected() const { return client_fd_ >= 0; }
 
-bool Px4Server::readyToStep() const { return !lockstep_ || pending_actuators_ > 0; }
+bool Px4Server::readyToStep() const {
+  if (lockstep_) return pending_actuators_ > 0;
+  if (client_fd_ < 0) return true;
+  // A client that has not locked step yet (an autopilot booting) is served in real time, so
+  // that no backlog of sensor messages builds up in its socket: every sensor message still in
+  // flight when the lock-step starts would stay a step of latency for the whole flight.
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - connected_at_).count();
+  return sim_time_ - connect_sim_time_ <= wall;
+}
 
 void Px4Server::logOnce(const std::string& kind, LogLevel level, const std::string& message) {
   if (logged_[kind]) return;
@@ -180,6 +189,7 @@ void Px4Server::accept() {
     lockstep_ = false;
     pending_actuators_ = 0;
     connected_at_ = std::chrono::steady_clock::now();
+    connect_sim_time_ = sim_time_;
     last_actuator_wall_ = last_bytes_wall_ = connected_at_;
     next_heartbeat_ = next_gps_ = next_state_ = sim_time_;
     state_interval_us_ = -1;

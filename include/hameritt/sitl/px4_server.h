@@ -73,8 +73,9 @@ class Px4Server {
   // Accepts, reads and writes without blocking longer than `wait_s` wall seconds; drops a
   // stalled, silent or overflowing client.
   void service(double wait_s);
-  // True when the next sensor period may be simulated: free-wheeling (no lock-step client),
-  // or an actuator message answered the last HIL_SENSOR.
+  // True when the next sensor period may be simulated: without a client (free-wheeling); with
+  // a client before its first actuator message, at real time since it connected; in lock-step,
+  // once an actuator message answered the last HIL_SENSOR.
   bool readyToStep() const;
   // Physics steps per sensor period.
   int stepsPerExchange() const { return steps_per_exchange_; }
@@ -120,6 +121,7 @@ class Px4Server {
   Eigen::Vector4d controls_{0, 0, 0, 0};
   double last_actuator_sim_time_ = -1e9;
   double sim_time_ = 0;
+  double connect_sim_time_ = 0;
   std::chrono::steady_clock::time_point connected_at_, last_actuator_wall_, last_bytes_wall_;
   std::int64_t state_interval_us_ = -1;  // HIL_STATE_QUATERNION off until asked for
   double next_gps_ = 0, next_state_ = 0, next_heartbeat_ = 0;
