@@ -110,7 +110,8 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   if (autopilot_ != "internal" && gate_->enabled()) {
     throw scenario::ConfigError(
-        "~autopilot " + autopilot_ + " with /lockstep true: not supported (the autopilot's own "
+        "~autopilot " + autopilot_ +
+        " with /lockstep true: not supported (the autopilot's own "
         "lock-step paces the simulation by its actuator messages, the mission's lock-step by the "
         "nodes' turns; run one of them: lockstep:=false with an autopilot)");
   }
@@ -232,25 +233,27 @@ void SimulatorRos::loadAutopilot(ros::NodeHandle& pnh, double physics_rate_hz) {
   pnh.param("sitl_gps_velocity", n.gps_velocity, n.gps_velocity);
   std::vector<double> bias;
   if (pnh.getParam("sitl_accel_bias", bias)) {
-    if (bias.size() != 3) throw scenario::ConfigError("~sitl_accel_bias: expected 3 numbers (FRD m/s^2)");
+    if (bias.size() != 3)
+      throw scenario::ConfigError("~sitl_accel_bias: expected 3 numbers (FRD m/s^2)");
     n.accel_bias = sim::Vec3(bias[0], bias[1], bias[2]);
   }
   if (pnh.getParam("sitl_gyro_bias", bias)) {
-    if (bias.size() != 3) throw scenario::ConfigError("~sitl_gyro_bias: expected 3 numbers (FRD rad/s)");
+    if (bias.size() != 3)
+      throw scenario::ConfigError("~sitl_gyro_bias: expected 3 numbers (FRD rad/s)");
     n.gyro_bias = sim::Vec3(bias[0], bias[1], bias[2]);
   }
   pnh.param("sitl_baro_bias", n.baro_bias, n.baro_bias);
   sc.validate();
-  px4_ = std::make_unique<sitl::Px4Server>(
-      pc, sc, sim_->params(), physics_rate_hz,
-      [](sitl::Px4Server::LogLevel level, const std::string& m) {
-        if (level == sitl::Px4Server::LogLevel::kError)
-          ROS_ERROR("simulator: %s", m.c_str());
-        else if (level == sitl::Px4Server::LogLevel::kWarn)
-          ROS_WARN("simulator: %s", m.c_str());
-        else
-          ROS_INFO("simulator: %s", m.c_str());
-      });
+  px4_ =
+      std::make_unique<sitl::Px4Server>(pc, sc, sim_->params(), physics_rate_hz,
+                                        [](sitl::Px4Server::LogLevel level, const std::string& m) {
+                                          if (level == sitl::Px4Server::LogLevel::kError)
+                                            ROS_ERROR("simulator: %s", m.c_str());
+                                          else if (level == sitl::Px4Server::LogLevel::kWarn)
+                                            ROS_WARN("simulator: %s", m.c_str());
+                                          else
+                                            ROS_INFO("simulator: %s", m.c_str());
+                                        });
   autopilot_counters_pub_ = pnh.advertise<std_msgs::String>("autopilot_counters", 1, true);
 }
 

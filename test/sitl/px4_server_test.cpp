@@ -126,8 +126,10 @@ TEST(Px4Server, FreeWheelsThenLocksStepToActuatorMessages) {
   ASSERT_TRUE(rig.server.connected());
   // Before the first actuator message: free-wheeling, at real time for a connected client.
   for (int i = 0; i < 5;) {
-    if (rig.exchange()) ++i;
-    else rig.server.service(0.002);
+    if (rig.exchange())
+      ++i;
+    else
+      rig.server.service(0.002);
   }
   auto frames = client.receive();
   EXPECT_EQ(count(frames, ml::kHilSensor), 5);
