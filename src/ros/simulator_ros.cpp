@@ -105,8 +105,9 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
 
   pnh.param<std::string>("autopilot", autopilot_, autopilot_);
-  if (autopilot_ != "internal" && autopilot_ != "px4") {
-    throw scenario::ConfigError("~autopilot: expected internal or px4, got '" + autopilot_ + "'");
+  if (autopilot_ != "internal" && autopilot_ != "px4" && autopilot_ != "ardupilot") {
+    throw scenario::ConfigError("~autopilot: expected internal, px4 or ardupilot, got '" +
+                                autopilot_ + "'");
   }
   if (autopilot_ != "internal" && gate_->enabled()) {
     throw scenario::ConfigError(
@@ -133,7 +134,7 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                         config_.uav.altitude_max + fence_margin);
   fence.brake_distance = std::min(20.0, fence_margin);
   guard_ = std::make_unique<sim::SetpointGuard>(fence, sim_->params());
-  if (autopilot_ == "px4") loadAutopilot(pnh, settings.physics_rate_hz);
+  if (autopilot_ != "internal") loadAutopilot(pnh, settings.physics_rate_hz);
   bool cameras = true;
   pnh.param("cameras", cameras, true);
   if (cameras && !config_.uav.cameras.empty()) {
@@ -244,16 +245,31 @@ void SimulatorRos::loadAutopilot(ros::NodeHandle& pnh, double physics_rate_hz) {
   }
   pnh.param("sitl_baro_bias", n.baro_bias, n.baro_bias);
   sc.validate();
-  px4_ =
-      std::make_unique<sitl::Px4Server>(pc, sc, sim_->params(), physics_rate_hz,
-                                        [](sitl::Px4Server::LogLevel level, const std::string& m) {
-                                          if (level == sitl::Px4Server::LogLevel::kError)
-                                            ROS_ERROR("simulator: %s", m.c_str());
-                                          else if (level == sitl::Px4Server::LogLevel::kWarn)
-                                            ROS_WARN("simulator: %s", m.c_str());
-                                          else
-                                            ROS_INFO("simulator: %s", m.c_str());
-                                        });
+  auto log = [](sitl::Px4Server::LogLevel level, const std::string& m) {
+    if (level == sitl::Px4Server::LogLevel::kError)
+      ROS_ERROR("simulator: %s", m.c_str());
+    else if (level == sitl::Px4Server::LogLevel::kWarn)
+      ROS_WARN("simulator: %s", m.c_str());
+    else
+      ROS_INFO("simulator: %s", m.c_str());
+  };
+  if (autopilot_ == "px4") {
+    px4_ = std::make_unique<sitl::Px4Server>(pc, sc, sim_->params(), physics_rate_hz, log);
+  } else {
+    sitl::ArduPilotConfig ac;
+    pnh.param("ardupilot_port", ac.port, ac.port);
+    ac.instance = pc.instance;
+    ac.bind_address = pc.bind_address;
+    ac.sensor_rate_hz = pc.sensor_rate_hz;
+    ac.stall_timeout_s = pc.stall_timeout_s;
+    ac.layout = pc.layout;
+    ac.max_rotor_speed = pc.max_rotor_speed;
+    ardupilot_ = std::make_unique<sitl::ArduPilotServer>(
+        ac, sc, sim_->params(), physics_rate_hz,
+        [log](sitl::ArduPilotServer::LogLevel level, const std::string& m) {
+          log(static_cast<sitl::Px4Server::LogLevel>(level), m);
+        });
+  }
   autopilot_counters_pub_ = pnh.advertise<std_msgs::String>("autopilot_counters", 1, true);
 }
 
@@ -262,8 +278,19 @@ bool SimulatorRos::exchangeWithAutopilot() {
   if ((now - counters_published_).toSec() >= 0.5) {
     counters_published_ = now;
     std_msgs::String m;
-    m.data = sitl::toJson(px4_->counters());
+    m.data = px4_ ? sitl::toJson(px4_->counters()) : sitl::toJson(ardupilot_->counters());
     autopilot_counters_pub_.publish(m);
+  }
+  if (ardupilot_) {
+    ardupilot_->service(0.0);
+    if (!ardupilot_->readyToStep()) {
+      ardupilot_->service(0.002);
+      if (!ardupilot_->readyToStep()) return false;
+    }
+    ardupilot_->applyMotors(*sim_);
+    advance(ardupilot_->stepsPerExchange());
+    ardupilot_->sendState(sim_->uav());
+    return true;
   }
   px4_->service(0.0);
   if (!px4_->readyToStep()) {
@@ -449,7 +476,7 @@ void SimulatorRos::spin() {
       ros::Time stamp;
       stamp.fromSec(sim_->time());
       if (!gate_->afterCycle(++cycle, stamp)) break;
-    } else if (px4_) {
+    } else if (px4_ || ardupilot_) {
       if (!exchangeWithAutopilot()) {
         ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0));
         continue;
@@ -490,7 +517,7 @@ void SimulatorRos::applyVelocity() {
 }
 
 void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
-  if (px4_) {
+  if (px4_ || ardupilot_) {
     HAMERITT_INFO_THROTTLE(30.0, "simulator: %s ignored: the %s autopilot flies the UAV",
                            vel_sub_.getTopic().c_str(), autopilot_.c_str());
     return;
@@ -514,7 +541,7 @@ void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
 }
 
 void SimulatorRos::onPose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
-  if (px4_) {
+  if (px4_ || ardupilot_) {
     HAMERITT_INFO_THROTTLE(30.0, "simulator: %s ignored: the %s autopilot flies the UAV",
                            pose_sub_.getTopic().c_str(), autopilot_.c_str());
     return;

@@ -125,8 +125,9 @@ class Autopilot:
                  inertia=(0.00544, 0.00544, 0.0100), mag_ned=(0.21, -0.01, 0.42),
                  origin_alt=40.0, altitude=10.0, hold_s=34.0, idle_s=1.0, stall_at_s=None,
                  stall_wall_s=2.0, before_arm=None, log=print):
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=30)
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        if port is not None:
+            self.sock = socket.create_connection(("127.0.0.1", port), timeout=30)
+            self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.decoder = mj.Decoder()
         self.sent = bytearray()  # every byte this client sent (for the judge's replay)
         self.seq = 0

@@ -20,6 +20,7 @@
 #include "hameritt/scenario/world.h"
 #include "hameritt/sim/setpoint_guard.h"
 #include "hameritt/sim/simulator.h"
+#include "hameritt/sitl/ardupilot_server.h"
 #include "hameritt/sitl/px4_server.h"
 
 namespace hameritt::ros_wrappers {
@@ -44,7 +45,9 @@ namespace hameritt::ros_wrappers {
 //   ~lockstep_participants, comma-separated node names in turn order, every ~lockstep_period
 //   s of sim time, 0.02, a multiple of the publish period; ~lockstep_timeout wall s, 120),
 //   ~autopilot (internal: the built-in controller flies the ADK's setpoints; px4: PX4 SITL
-//   flies the UAV through the simulator API on TCP ~px4_port (4560) + ~instance (0); the
+//   flies the UAV through the simulator API on TCP ~px4_port (4560) + ~instance (0);
+//   ardupilot: ArduPilot SITL through its JSON interface on UDP ~ardupilot_port (9002) +
+//   10 x ~instance; the
 //   ~sitl_* parameters in docs/reference/nodes.md).
 class SimulatorRos {
  public:
@@ -86,6 +89,7 @@ class SimulatorRos {
   // internal | px4; the server when an external autopilot flies the UAV.
   std::string autopilot_ = "internal";
   std::unique_ptr<sitl::Px4Server> px4_;
+  std::unique_ptr<sitl::ArduPilotServer> ardupilot_;
   ros::Publisher autopilot_counters_pub_;
   ros::WallTime counters_published_;
   // The last accepted velocity command (valid while velocity_mode_).
