@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "hameritt/CrashEvent.h"
 #include "hameritt/EntityStateArray.h"
@@ -54,6 +55,16 @@ std::vector<std::string> resolvedList(const std::string& list) {
     a = b + 1;
   }
   return out;
+}
+
+// The map frame's geodetic origin (~origin_latitude/longitude/altitude; the defaults are the
+// shipped scenarios' origin).
+cop::Geodetic loadOrigin(ros::NodeHandle& pnh) {
+  cop::Geodetic o;
+  pnh.param("origin_latitude", o.latitude, 42.4851);
+  pnh.param("origin_longitude", o.longitude, -71.1873);
+  pnh.param("origin_altitude", o.altitude, 40.0);
+  return o;
 }
 
 }  // namespace
@@ -134,7 +145,23 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                         config_.uav.altitude_max + fence_margin);
   fence.brake_distance = std::min(20.0, fence_margin);
   guard_ = std::make_unique<sim::SetpointGuard>(fence, sim_->params());
-  if (autopilot_ != "internal") loadAutopilot(pnh, settings.physics_rate_hz);
+  if (autopilot_ != "internal") {
+    loadAutopilot(pnh, settings.physics_rate_hz);
+  } else {
+    // Ground-station telemetry while the built-in controller flies (off: none).
+    std::string gcs;
+    pnh.param<std::string>("gcs_udp", gcs, "127.0.0.1:14550");
+    if (gcs != "off") {
+      sitl::GcsConfig gc;
+      const std::size_t colon = gcs.rfind(':');
+      gc.address = gcs.substr(0, colon);
+      gc.port = colon == std::string::npos ? 0 : std::atoi(gcs.c_str() + colon + 1);
+      pnh.param("gcs_rate_hz", gc.rate_hz, gc.rate_hz);
+      gc.origin = loadOrigin(pnh);
+      gcs_ = std::make_unique<sitl::GcsTelemetry>(gc);
+      ROS_INFO("simulator: MAVLink telemetry for ground stations to UDP %s", gcs.c_str());
+    }
+  }
   bool cameras = true;
   pnh.param("cameras", cameras, true);
   if (cameras && !config_.uav.cameras.empty()) {
@@ -218,9 +245,7 @@ void SimulatorRos::loadAutopilot(ros::NodeHandle& pnh, double physics_rate_hz) {
   pc.layout = layout.empty() ? sim::quadXLayout(sim_->params())
                              : sim::parseRotorLayout(layout, "~rotor_layout");
   sitl::SensorConfig sc;
-  pnh.param("origin_latitude", sc.origin.latitude, 42.4851);
-  pnh.param("origin_longitude", sc.origin.longitude, -71.1873);
-  pnh.param("origin_altitude", sc.origin.altitude, 40.0);
+  sc.origin = loadOrigin(pnh);
   int seed = static_cast<int>(config_.seed & 0x7FFFFFFF);
   pnh.param("sitl_seed", seed, seed);
   sc.seed = static_cast<std::uint64_t>(seed);
@@ -343,6 +368,7 @@ void SimulatorRos::publishState(bool force_ground_truth) {
   gate_->publish(clock_pub_, clock);
   gate_->publish(odom_pub_, toOdometryMsg(s, stamp));
   gate_->publish(imu_pub_, toImuMsg(s, stamp));
+  if (gcs_) gcs_->update(s, s.rotor_speeds.maxCoeff() > 0);
   tf_.sendTransform(toBaseTransform(s, stamp));
   gate_->count("/tf");
   if (force_ground_truth) publishGroundTruth();

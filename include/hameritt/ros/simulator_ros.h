@@ -21,6 +21,7 @@
 #include "hameritt/sim/setpoint_guard.h"
 #include "hameritt/sim/simulator.h"
 #include "hameritt/sitl/ardupilot_server.h"
+#include "hameritt/sitl/gcs_telemetry.h"
 #include "hameritt/sitl/px4_server.h"
 
 namespace hameritt::ros_wrappers {
@@ -47,7 +48,8 @@ namespace hameritt::ros_wrappers {
 //   ~autopilot (internal: the built-in controller flies the ADK's setpoints; px4: PX4 SITL
 //   flies the UAV through the simulator API on TCP ~px4_port (4560) + ~instance (0);
 //   ardupilot: ArduPilot SITL through its JSON interface on UDP ~ardupilot_port (9002) +
-//   10 x ~instance; the
+//   10 x ~instance; with internal, ~gcs_udp (127.0.0.1:14550, off: none) receives HEARTBEAT,
+//   ATTITUDE and GLOBAL_POSITION_INT at ~gcs_rate_hz (10); the
 //   ~sitl_* parameters in docs/reference/nodes.md).
 class SimulatorRos {
  public:
@@ -90,6 +92,7 @@ class SimulatorRos {
   std::string autopilot_ = "internal";
   std::unique_ptr<sitl::Px4Server> px4_;
   std::unique_ptr<sitl::ArduPilotServer> ardupilot_;
+  std::unique_ptr<sitl::GcsTelemetry> gcs_;  // internal controller: telemetry for ground stations
   ros::Publisher autopilot_counters_pub_;
   ros::WallTime counters_published_;
   // The last accepted velocity command (valid while velocity_mode_).
