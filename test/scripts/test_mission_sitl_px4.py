@@ -33,6 +33,7 @@ import time
 
 import rosgraph
 import rospy
+from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import String
@@ -143,6 +144,14 @@ def main():
                  60, "the simulator's PX4 port")
         wait_for(lambda: watch.sim_time() > 0.5, 60, "the free-wheeling clock")
 
+        # The ADK's setpoints are not applied while PX4 flies: one sent now must be ignored.
+        pose_pub = rospy.Publisher("/uav/cmd_pose", PoseStamped, queue_size=1, latch=True)
+        pose = PoseStamped()
+        pose.header.frame_id = "map"
+        pose.pose.position.z = 30.0
+        pose.pose.orientation.w = 1.0
+        pose_pub.publish(pose)
+
         # ---- Flight 1: bad input, arm, climb, hold (with a stall), land, disarm.
         hooks = {}
         ap = px4_standin.Autopilot(SIM_PORT, stall_at_s=None, before_arm=lambda a: bad_input(a, hooks))
@@ -195,6 +204,11 @@ def main():
             stall["end"] - stall["wall"], stall["sim"], len(during), advance))
         check(advance == 0.0 and not during, "sim time advanced %.6f s (%d /clock messages) "
               "during the stall" % (advance, len(during)))
+
+        ignored = "uav/cmd_pose ignored: the px4 autopilot flies the UAV" in open(log).read()
+        print("the ADK's pose setpoint (30 m) while PX4 flies: %s" % (
+            "ignored (logged)" if ignored else "NOT reported as ignored"))
+        check(ignored, "the simulator did not report ignoring uav/cmd_pose")
 
         # ---- Every received frame decoded by the judge.
         d = ap.decoder
@@ -279,11 +293,16 @@ def main():
         check(c.get("disconnects") == 3, "disconnects %s" % c.get("disconnects"))
         check(c.get("stalls") == 0, "stalls %s (the 2 s stall is under the 5 s timeout)" % c.get("stalls"))
         check(c.get("unknown_messages") == 0 and c.get("bad_length") == 0, "unknown/bad_length")
-        expected_steps = ap.sensors + n  # the last of each may be lost with its connection
+        expected_steps = ap.sensors + n
         check(c.get("actuator_messages") == ap.sensors + n,
               "actuator_messages %s, the stand-ins sent %d valid ones" % (c.get("actuator_messages"), ap.sensors + n))
-        check(abs(c.get("lockstep_steps", 0) - expected_steps) <= 2,
-              "lockstep_steps %s vs %d" % (c.get("lockstep_steps"), expected_steps))
+        # Each connection may end with the answers to the sensor messages still in flight
+        # (one or two: the lock-step began while the stand-in answered real-time free-wheeling)
+        # received but not yet simulated.
+        lost = expected_steps - c.get("lockstep_steps", 0)
+        print("lock-step steps %s of %d valid actuator messages (%d lost with their "
+              "connections)" % (c.get("lockstep_steps"), expected_steps, lost))
+        check(0 <= lost <= 10, "lockstep_steps %s vs %d" % (c.get("lockstep_steps"), expected_steps))
         check(c.get("sensor_messages", 0) >= sensors + n, "sensor_messages %s" % c.get("sensor_messages"))
         # Both stand-ins asked for HIL_STATE_QUATERNION.
         got_gps = d.by_name.get("HIL_GPS", 0) + ap2.decoder.by_name.get("HIL_GPS", 0)
