@@ -54,7 +54,7 @@ struct Rig {
             [&] {
               ArduPilotConfig c;
               c.port = port;
-              c.stall_timeout_s = 0.3;
+              c.stall_timeout_s = 1.0;  // well above the gaps between the packets below
               return c;
             }(),
             SensorConfig(), sentinel(), 500.0, nullptr) {
@@ -134,7 +134,7 @@ TEST(ArduPilotServer, FrameCountsAndJsonLines) {
   EXPECT_EQ(c.state_messages, 5u);
   EXPECT_NEAR(rig.sim.time(), 4 * 0.004, 1e-12);
   // Silence: the lock-step gives up after the timeout and the simulation free-wheels.
-  std::this_thread::sleep_for(std::chrono::milliseconds(350));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
   rig.server.service(0.0);
   EXPECT_FALSE(rig.server.lockstep());
   EXPECT_EQ(rig.server.counters().stalls, 1u);
