@@ -21,7 +21,7 @@ HAMERITT_PACKAGES=(
   libvisualization-msgs-dev libmessage-filters-dev libtopic-tools-dev
   libeigen3-dev nlohmann-json3-dev libopencv-dev
   libbullet-dev liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev libompl-dev
-  python3-jsonschema python3-rospy python3-nav-msgs python3-rosgraph-msgs
+  python3-jsonschema python3-crcmod python3-rospy python3-nav-msgs python3-rosgraph-msgs
   python3-geometry-msgs python3-std-msgs python3-actionlib-msgs
   # rostopic and friends on the cameras' messages, and the MarkerArray for RViz users.
   python3-rostopic python3-sensor-msgs python3-visualization-msgs

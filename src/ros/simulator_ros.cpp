@@ -3,6 +3,7 @@
 #include <ros/callback_queue.h>
 #include <ros/master.h>
 #include <rosgraph_msgs/Clock.h>
+#include <std_msgs/String.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 #include <tf2_msgs/TFMessage.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "hameritt/CrashEvent.h"
 #include "hameritt/EntityStateArray.h"
@@ -53,6 +55,16 @@ std::vector<std::string> resolvedList(const std::string& list) {
     a = b + 1;
   }
   return out;
+}
+
+// The map frame's geodetic origin (~origin_latitude/longitude/altitude; the defaults are the
+// shipped scenarios' origin).
+cop::Geodetic loadOrigin(ros::NodeHandle& pnh) {
+  cop::Geodetic o;
+  pnh.param("origin_latitude", o.latitude, 42.4851);
+  pnh.param("origin_longitude", o.longitude, -71.1873);
+  pnh.param("origin_altitude", o.altitude, 40.0);
+  return o;
 }
 
 }  // namespace
@@ -103,6 +115,19 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     steps_per_cycle_ = static_cast<int>(std::round(steps));
   }
 
+  pnh.param<std::string>("autopilot", autopilot_, autopilot_);
+  if (autopilot_ != "internal" && autopilot_ != "px4" && autopilot_ != "ardupilot") {
+    throw scenario::ConfigError("~autopilot: expected internal, px4 or ardupilot, got '" +
+                                autopilot_ + "'");
+  }
+  if (autopilot_ != "internal" && gate_->enabled()) {
+    throw scenario::ConfigError(
+        "~autopilot " + autopilot_ +
+        " with /lockstep true: not supported (the autopilot's own "
+        "lock-step paces the simulation by its actuator messages, the mission's lock-step by the "
+        "nodes' turns; run one of them: lockstep:=false with an autopilot)");
+  }
+
   config_ = scenario::loadSimConfig(sim_config);
   if (duration_ <= 0) duration_ = config_.duration;
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(config_, sim_config));
@@ -120,6 +145,23 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                         config_.uav.altitude_max + fence_margin);
   fence.brake_distance = std::min(20.0, fence_margin);
   guard_ = std::make_unique<sim::SetpointGuard>(fence, sim_->params());
+  if (autopilot_ != "internal") {
+    loadAutopilot(pnh, settings.physics_rate_hz);
+  } else {
+    // Ground-station telemetry while the built-in controller flies (off: none).
+    std::string gcs;
+    pnh.param<std::string>("gcs_udp", gcs, "127.0.0.1:14550");
+    if (gcs != "off") {
+      sitl::GcsConfig gc;
+      const std::size_t colon = gcs.rfind(':');
+      gc.address = gcs.substr(0, colon);
+      gc.port = colon == std::string::npos ? 0 : std::atoi(gcs.c_str() + colon + 1);
+      pnh.param("gcs_rate_hz", gc.rate_hz, gc.rate_hz);
+      gc.origin = loadOrigin(pnh);
+      gcs_ = std::make_unique<sitl::GcsTelemetry>(gc);
+      ROS_INFO("simulator: MAVLink telemetry for ground stations to UDP %s", gcs.c_str());
+    }
+  }
   bool cameras = true;
   pnh.param("cameras", cameras, true);
   if (cameras && !config_.uav.cameras.empty()) {
@@ -188,6 +230,105 @@ SimulatorRos::SimulatorRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
            settings.physics_rate_hz, paused_ ? "paused" : "running");
 }
 
+void SimulatorRos::loadAutopilot(ros::NodeHandle& pnh, double physics_rate_hz) {
+  sitl::Px4Config pc;
+  pnh.param("px4_port", pc.port, pc.port);
+  pnh.param("instance", pc.instance, pc.instance);
+  pnh.param<std::string>("sitl_bind_address", pc.bind_address, pc.bind_address);
+  pnh.param("sitl_sensor_rate_hz", pc.sensor_rate_hz, pc.sensor_rate_hz);
+  pnh.param("sitl_gps_rate_hz", pc.gps_rate_hz, pc.gps_rate_hz);
+  pnh.param("sitl_timeout", pc.stall_timeout_s, pc.stall_timeout_s);
+  pnh.param("sitl_silent_timeout", pc.silent_timeout_s, pc.silent_timeout_s);
+  pnh.param("sitl_max_rotor_speed", pc.max_rotor_speed, pc.max_rotor_speed);
+  std::string layout;
+  pnh.param<std::string>("rotor_layout", layout, "");
+  pc.layout = layout.empty() ? sim::quadXLayout(sim_->params())
+                             : sim::parseRotorLayout(layout, "~rotor_layout");
+  sitl::SensorConfig sc;
+  sc.origin = loadOrigin(pnh);
+  int seed = static_cast<int>(config_.seed & 0x7FFFFFFF);
+  pnh.param("sitl_seed", seed, seed);
+  sc.seed = static_cast<std::uint64_t>(seed);
+  auto& n = sc.noise;
+  pnh.param("sitl_accel_noise", n.accel_noise, n.accel_noise);
+  pnh.param("sitl_gyro_noise", n.gyro_noise, n.gyro_noise);
+  pnh.param("sitl_mag_noise", n.mag_noise, n.mag_noise);
+  pnh.param("sitl_baro_noise", n.baro_noise, n.baro_noise);
+  pnh.param("sitl_gps_horizontal", n.gps_horizontal, n.gps_horizontal);
+  pnh.param("sitl_gps_vertical", n.gps_vertical, n.gps_vertical);
+  pnh.param("sitl_gps_velocity", n.gps_velocity, n.gps_velocity);
+  std::vector<double> bias;
+  if (pnh.getParam("sitl_accel_bias", bias)) {
+    if (bias.size() != 3)
+      throw scenario::ConfigError("~sitl_accel_bias: expected 3 numbers (FRD m/s^2)");
+    n.accel_bias = sim::Vec3(bias[0], bias[1], bias[2]);
+  }
+  if (pnh.getParam("sitl_gyro_bias", bias)) {
+    if (bias.size() != 3)
+      throw scenario::ConfigError("~sitl_gyro_bias: expected 3 numbers (FRD rad/s)");
+    n.gyro_bias = sim::Vec3(bias[0], bias[1], bias[2]);
+  }
+  pnh.param("sitl_baro_bias", n.baro_bias, n.baro_bias);
+  sc.validate();
+  auto log = [](sitl::Px4Server::LogLevel level, const std::string& m) {
+    if (level == sitl::Px4Server::LogLevel::kError)
+      ROS_ERROR("simulator: %s", m.c_str());
+    else if (level == sitl::Px4Server::LogLevel::kWarn)
+      ROS_WARN("simulator: %s", m.c_str());
+    else
+      ROS_INFO("simulator: %s", m.c_str());
+  };
+  if (autopilot_ == "px4") {
+    px4_ = std::make_unique<sitl::Px4Server>(pc, sc, sim_->params(), physics_rate_hz, log);
+  } else {
+    sitl::ArduPilotConfig ac;
+    pnh.param("ardupilot_port", ac.port, ac.port);
+    ac.instance = pc.instance;
+    ac.bind_address = pc.bind_address;
+    ac.sensor_rate_hz = pc.sensor_rate_hz;
+    ac.stall_timeout_s = pc.stall_timeout_s;
+    ac.layout = pc.layout;
+    ac.max_rotor_speed = pc.max_rotor_speed;
+    ardupilot_ = std::make_unique<sitl::ArduPilotServer>(
+        ac, sc, sim_->params(), physics_rate_hz,
+        [log](sitl::ArduPilotServer::LogLevel level, const std::string& m) {
+          log(static_cast<sitl::Px4Server::LogLevel>(level), m);
+        });
+  }
+  autopilot_counters_pub_ = pnh.advertise<std_msgs::String>("autopilot_counters", 1, true);
+}
+
+bool SimulatorRos::exchangeWithAutopilot() {
+  const ros::WallTime now = ros::WallTime::now();
+  if ((now - counters_published_).toSec() >= 0.5) {
+    counters_published_ = now;
+    std_msgs::String m;
+    m.data = px4_ ? sitl::toJson(px4_->counters()) : sitl::toJson(ardupilot_->counters());
+    autopilot_counters_pub_.publish(m);
+  }
+  if (ardupilot_) {
+    ardupilot_->service(0.0);
+    if (!ardupilot_->readyToStep()) {
+      ardupilot_->service(0.002);
+      if (!ardupilot_->readyToStep()) return false;
+    }
+    ardupilot_->applyMotors(*sim_);
+    advance(ardupilot_->stepsPerExchange());
+    ardupilot_->sendState(sim_->uav());
+    return true;
+  }
+  px4_->service(0.0);
+  if (!px4_->readyToStep()) {
+    // Lock-step: sim time stands still until the autopilot answers (or the stall timeout).
+    px4_->service(0.002);
+    if (!px4_->readyToStep()) return false;
+  }
+  px4_->applyMotors(*sim_);
+  advance(px4_->stepsPerExchange());
+  px4_->sendSensors(sim_->uav());
+  return true;
+}
+
 void SimulatorRos::publishStaticFrames() {
   std::vector<geometry_msgs::TransformStamped> frames;
   for (const auto& c : config_.uav.cameras) frames.push_back(toCameraTransform(c, ros::Time(0)));
@@ -227,6 +368,7 @@ void SimulatorRos::publishState(bool force_ground_truth) {
   gate_->publish(clock_pub_, clock);
   gate_->publish(odom_pub_, toOdometryMsg(s, stamp));
   gate_->publish(imu_pub_, toImuMsg(s, stamp));
+  if (gcs_) gcs_->update(s, s.rotor_speeds.maxCoeff() > 0);
   tf_.sendTransform(toBaseTransform(s, stamp));
   gate_->count("/tf");
   if (force_ground_truth) publishGroundTruth();
@@ -360,6 +502,11 @@ void SimulatorRos::spin() {
       ros::Time stamp;
       stamp.fromSec(sim_->time());
       if (!gate_->afterCycle(++cycle, stamp)) break;
+    } else if (px4_ || ardupilot_) {
+      if (!exchangeWithAutopilot()) {
+        ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0));
+        continue;
+      }
     } else {
       advance(steps_per_publish_);
     }
@@ -396,6 +543,11 @@ void SimulatorRos::applyVelocity() {
 }
 
 void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
+  if (px4_ || ardupilot_) {
+    HAMERITT_INFO_THROTTLE(30.0, "simulator: %s ignored: the %s autopilot flies the UAV",
+                           vel_sub_.getTopic().c_str(), autopilot_.c_str());
+    return;
+  }
   sim::Vec3 v(msg->linear.x, msg->linear.y, msg->linear.z);
   double yaw_rate = msg->angular.z;
   const sim::SetpointCheck c = guard_->checkVelocity(&v, &yaw_rate);
@@ -415,6 +567,11 @@ void SimulatorRos::onVelocity(const geometry_msgs::Twist::ConstPtr& msg) {
 }
 
 void SimulatorRos::onPose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
+  if (px4_ || ardupilot_) {
+    HAMERITT_INFO_THROTTLE(30.0, "simulator: %s ignored: the %s autopilot flies the UAV",
+                           pose_sub_.getTopic().c_str(), autopilot_.c_str());
+    return;
+  }
   if (!msg->header.frame_id.empty() && msg->header.frame_id != kMapFrame) {
     HAMERITT_ERROR_THROTTLE(
         5.0, "simulator: %s: header.frame_id: expected '%s' (or empty), got '%s'; setpoint ignored",

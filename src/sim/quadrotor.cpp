@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -229,6 +230,62 @@ QuadrotorParams loadQuadrotorUrdf(const std::string& path) {
     }
   }
   return p;
+}
+
+RotorLayout quadXLayout(const QuadrotorParams& p) {
+  // (front?, right?, direction) per output.
+  const struct {
+    bool front, right;
+    int direction;
+    const char* name;
+  } want[4] = {{true, true, 1, "front-right ccw"},
+               {false, false, 1, "rear-left ccw"},
+               {true, false, -1, "front-left cw"},
+               {false, true, -1, "rear-right cw"}};
+  RotorLayout layout{-1, -1, -1, -1};
+  for (int o = 0; o < 4; ++o) {
+    for (std::size_t i = 0; i < p.rotors.size(); ++i) {
+      const Rotor& r = p.rotors[i];
+      // FLU: front is +x, right is -y.
+      if ((r.position.x() > 0) == want[o].front && (r.position.y() < 0) == want[o].right &&
+          r.direction == want[o].direction) {
+        layout[static_cast<std::size_t>(o)] = static_cast<int>(i);
+      }
+    }
+    if (layout[static_cast<std::size_t>(o)] < 0) {
+      throw ConfigError("quadrotor.rotors: expected a quad-X layout, no " +
+                        std::string(want[o].name) + " rotor for motor output " +
+                        std::to_string(o + 1));
+    }
+  }
+  return layout;
+}
+
+RotorLayout parseRotorLayout(const std::string& text, const std::string& field) {
+  RotorLayout layout{-1, -1, -1, -1};
+  std::istringstream in(text);
+  std::string item;
+  int n = 0;
+  bool seen[4] = {false, false, false, false};
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const long v = std::strtol(item.c_str(), &end, 10);
+    if (n >= 4 || end == item.c_str() || *end != '\0' || v < 0 || v > 3 || seen[v]) {
+      throw ConfigError(field +
+                        ": expected a permutation of 0,1,2,3 (the model's rotor for "
+                        "each motor output), got \"" +
+                        text + "\"");
+    }
+    seen[v] = true;
+    layout[static_cast<std::size_t>(n++)] = static_cast<int>(v);
+  }
+  if (n != 4) {
+    throw ConfigError(field +
+                      ": expected a permutation of 0,1,2,3 (the model's rotor for each "
+                      "motor output), got \"" +
+                      text + "\"");
+  }
+  return layout;
 }
 
 std::string defaultQuadrotorUrdf() { return scenario::shareDir() + "/models/sentinel.urdf"; }

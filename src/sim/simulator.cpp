@@ -258,7 +258,8 @@ struct Simulator::Impl {
     in.orientation = s.orientation;
     in.angular_velocity = s.angular_velocity;
     in.landed = s.landed;
-    const Eigen::Vector4d cmd = controller.update(in, sp, dt);
+    const Eigen::Vector4d cmd =
+        sp.mode == ControlMode::kRotors ? sp.rotor_speeds : controller.update(in, sp, dt);
     // Motors: exact discretization of the first-order lag, then the speed limits.
     for (int i = 0; i < 4; ++i) {
       const double w = s.rotor_speeds[i];
@@ -428,6 +429,16 @@ void Simulator::setAttitudeSetpoint(const Quat& attitude, double thrust) {
   impl_->sp.mode = ControlMode::kAttitude;
   impl_->sp.attitude = attitude;
   impl_->sp.thrust = thrust;
+}
+
+void Simulator::setRotorCommands(const Eigen::Vector4d& speeds) {
+  if (impl_->s.crashed) return;
+  impl_->sp.mode = ControlMode::kRotors;
+  for (int i = 0; i < 4; ++i) {
+    const double w = speeds[i];
+    impl_->sp.rotor_speeds[i] =
+        std::isfinite(w) ? std::clamp(w, 0.0, impl_->params.max_speed) : 0.0;
+  }
 }
 
 void Simulator::disarm() { impl_->sp = ControlSetpoint(); }

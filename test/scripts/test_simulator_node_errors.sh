@@ -55,6 +55,14 @@ run bad_record_depth "~record_depth: expected 16UC1 \\(millimetres\\) or 32FC1 \
   __name:=sim_j _sim_config:="$S" _record_depth:=16UC2
 run bad_png_level "~record_png_level: expected -1 \\(off\\) or a zlib level 0..9, got 12" \
   __name:=sim_k _sim_config:="$S" _record_png_level:=12
+run bad_autopilot "~autopilot: expected internal, px4 or ardupilot, got 'betaflight'" \
+  __name:=sim_l _sim_config:="$S" _autopilot:=betaflight
+run autopilot_lockstep "~autopilot px4 with /lockstep true: not supported" \
+  __name:=sim_m _sim_config:="$S" _autopilot:=px4 _lockstep:=true
+run bad_rotor_layout "~rotor_layout: expected a permutation of 0,1,2,3" \
+  __name:=sim_n _sim_config:="$S" _autopilot:=px4 _rotor_layout:=0,1,1,3
+run bad_gcs_udp "~gcs_udp: expected IPV4:PORT, got nowhere" \
+  __name:=sim_o _sim_config:="$S" _gcs_udp:=nowhere
 
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -34,3 +34,10 @@ class WallThrottle {
     static ::hameritt::ros_wrappers::WallThrottle hameritt_throttle_; \
     if (hameritt_throttle_.due(period)) ROS_ERROR(__VA_ARGS__);       \
   } while (false)
+
+// ROS_INFO at most once per `period` wall seconds from this call site (the first at once).
+#define HAMERITT_INFO_THROTTLE(period, ...)                           \
+  do {                                                                \
+    static ::hameritt::ros_wrappers::WallThrottle hameritt_throttle_; \
+    if (hameritt_throttle_.due(period)) ROS_INFO(__VA_ARGS__);        \
+  } while (false)

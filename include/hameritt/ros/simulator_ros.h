@@ -20,6 +20,9 @@
 #include "hameritt/scenario/world.h"
 #include "hameritt/sim/setpoint_guard.h"
 #include "hameritt/sim/simulator.h"
+#include "hameritt/sitl/ardupilot_server.h"
+#include "hameritt/sitl/gcs_telemetry.h"
+#include "hameritt/sitl/px4_server.h"
 
 namespace hameritt::ros_wrappers {
 
@@ -41,7 +44,13 @@ namespace hameritt::ros_wrappers {
 //   kept inside the neighborhood bounds grown by this and below altitude_max + this),
 //   ~lockstep (false: README "Lock-step missions"; the simulator coordinates the turns of
 //   ~lockstep_participants, comma-separated node names in turn order, every ~lockstep_period
-//   s of sim time, 0.02, a multiple of the publish period; ~lockstep_timeout wall s, 120).
+//   s of sim time, 0.02, a multiple of the publish period; ~lockstep_timeout wall s, 120),
+//   ~autopilot (internal: the built-in controller flies the ADK's setpoints; px4: PX4 SITL
+//   flies the UAV through the simulator API on TCP ~px4_port (4560) + ~instance (0);
+//   ardupilot: ArduPilot SITL through its JSON interface on UDP ~ardupilot_port (9002) +
+//   10 x ~instance; with internal, ~gcs_udp (127.0.0.1:14550, off: none) receives HEARTBEAT,
+//   ATTITUDE and GLOBAL_POSITION_INT at ~gcs_rate_hz (10); the
+//   ~sitl_* parameters in docs/reference/nodes.md).
 class SimulatorRos {
  public:
   // Throws scenario::ConfigError (bad parameters or sim_config): the node exits with ROS_FATAL.
@@ -52,6 +61,9 @@ class SimulatorRos {
 
  private:
   void advance(int steps);
+  // One autopilot exchange (px4 mode): false while the lock-step waits for the autopilot.
+  bool exchangeWithAutopilot();
+  void loadAutopilot(ros::NodeHandle& pnh, double physics_rate_hz);
   // Re-applies the last velocity command through the geofence (every publish tick).
   void applyVelocity();
   void waitForSubscribers();
@@ -76,6 +88,13 @@ class SimulatorRos {
   std::unique_ptr<sim::Simulator> sim_;
   std::unique_ptr<CameraRig> cameras_;
   std::unique_ptr<sim::SetpointGuard> guard_;
+  // internal | px4; the server when an external autopilot flies the UAV.
+  std::string autopilot_ = "internal";
+  std::unique_ptr<sitl::Px4Server> px4_;
+  std::unique_ptr<sitl::ArduPilotServer> ardupilot_;
+  std::unique_ptr<sitl::GcsTelemetry> gcs_;  // internal controller: telemetry for ground stations
+  ros::Publisher autopilot_counters_pub_;
+  ros::WallTime counters_published_;
   // The last accepted velocity command (valid while velocity_mode_).
   sim::Vec3 cmd_velocity_{0, 0, 0};
   double cmd_yaw_rate_ = 0.0;

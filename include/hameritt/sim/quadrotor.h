@@ -70,6 +70,20 @@ QuadrotorParams loadQuadrotorUrdf(const std::string& path);
 // The shipped model: models/sentinel.urdf in the package's data (scenario::shareDir()).
 std::string defaultQuadrotorUrdf();
 
+// Which model rotor each autopilot motor output drives: layout[i] is the model's rotor index
+// for motor output i.
+using RotorLayout = std::array<int, 4>;
+
+// The layout of PX4's (and ArduPilot's) quad-X: output 1 front-right ccw, 2 rear-left ccw,
+// 3 front-left cw, 4 rear-right cw (PX4 "Quadrotor x" airframe reference), found from the
+// model's rotor positions and spin directions. Throws scenario::ConfigError when the model
+// has no rotor in one of those places.
+RotorLayout quadXLayout(const QuadrotorParams& p);
+
+// Parses a comma-separated permutation of 0..3 ("2,0,3,1"); throws scenario::ConfigError
+// naming `field` for anything else.
+RotorLayout parseRotorLayout(const std::string& text, const std::string& field);
+
 // Control allocation for a planar rotor layout: [T, tau_x, tau_y, tau_z] = A * f with rotor
 // thrusts f (thrust along body +z at the hubs; yaw from the km/kf reaction torques).
 class Mixer {
@@ -94,6 +108,7 @@ enum class ControlMode {
   kPosition,  // position + yaw
   kVelocity,  // velocity + yaw rate
   kAttitude,  // attitude + collective thrust (bypasses the position/velocity loops)
+  kRotors,    // rotor speed commands from an external autopilot (bypasses the controller)
 };
 
 struct ControlSetpoint {
@@ -104,6 +119,7 @@ struct ControlSetpoint {
   double yaw_rate = 0.0;
   Quat attitude{1, 0, 0, 0};
   double thrust = 0.0;  // N
+  Eigen::Vector4d rotor_speeds{0, 0, 0, 0};  // rad/s, model rotor order (kRotors)
 };
 
 // Gains of the cascaded controller (PX4 mc_pos_control / mc_att_control / mc_rate_control

@@ -83,6 +83,9 @@ class Simulator {
   void setPositionSetpoint(const Vec3& position, double yaw);
   // Attitude + collective thrust (N), bypassing the position and velocity loops.
   void setAttitudeSetpoint(const Quat& attitude, double thrust);
+  // Rotor speed commands (rad/s, model rotor order, clamped to [0, max_speed]) from an
+  // external autopilot, bypassing the controller; the motors follow with their time constants.
+  void setRotorCommands(const Eigen::Vector4d& speeds);
   // Stops the rotors (disarm).
   void disarm();
 
