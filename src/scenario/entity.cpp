@@ -11,12 +11,30 @@ struct ClassName {
   int semantic;
 };
 constexpr ClassName kClassNames[] = {
-    {EntityClass::kStreet, "street", 2},     {EntityClass::kDriveway, "driveway", 3},
-    {EntityClass::kHouse, "house", 4},       {EntityClass::kGarage, "garage", 5},
-    {EntityClass::kFence, "fence", 6},       {EntityClass::kTree, "tree", 7},
-    {EntityClass::kCar, "car", 8},           {EntityClass::kPedestrian, "pedestrian", 9},
+    {EntityClass::kStreet, "street", 2},
+    {EntityClass::kDriveway, "driveway", 3},
+    {EntityClass::kHouse, "house", 4},
+    {EntityClass::kGarage, "garage", 5},
+    {EntityClass::kFence, "fence", 6},
+    {EntityClass::kTree, "tree", 7},
+    {EntityClass::kCar, "car", 8},
+    {EntityClass::kPedestrian, "pedestrian", 9},
+    {EntityClass::kBuilding, "building", 10},
+    {EntityClass::kParkingGarage, "parking_garage", 11},
+    {EntityClass::kParkingLot, "parking_lot", 12},
+    {EntityClass::kAlley, "alley", 13},
+    {EntityClass::kLampPost, "lamp_post", 14},
+    {EntityClass::kTrafficLight, "traffic_light", 15},
+    {EntityClass::kBusStop, "bus_stop", 16},
+    {EntityClass::kBench, "bench", 17},
+    {EntityClass::kStreetTree, "street_tree", 18},
 };
 }  // namespace
+
+bool isSurfaceClass(EntityClass c) {
+  return c == EntityClass::kStreet || c == EntityClass::kDriveway ||
+         c == EntityClass::kParkingLot || c == EntityClass::kAlley;
+}
 
 const char* toString(EntityClass c) {
   for (const auto& n : kClassNames) {

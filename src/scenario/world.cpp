@@ -425,6 +425,19 @@ std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t n) {
 }  // namespace
 
 void WorldParams::validate() const {
+  if (type == WorldType::kCity) {
+    // The city is a tile of 0.5 to 2 km a side; the suburb fields below stay checked so that
+    // a file can switch type without other edits.
+    for (const auto& [key, v] : {std::pair<const char*, double>{"extent_x", extent_x},
+                                 std::pair<const char*, double>{"extent_y", extent_y}}) {
+      if (!(v >= 500.0 && v <= 2000.0)) {
+        std::ostringstream os;
+        os << "world." << key << ": expected 500 to 2000 (m) for the city, got " << v;
+        throw ConfigError(os.str());
+      }
+    }
+    city.validate();
+  }
   requirePositive("extent_x", extent_x);
   requirePositive("extent_y", extent_y);
   requirePositive("block_length_min", block_length_min);
@@ -469,11 +482,10 @@ void WorldParams::validate() const {
 }
 
 std::vector<OrientedBox> occluderBoxes(const Entity& e) {
+  if (isSurfaceClass(e.cls)) return {};
   switch (e.cls) {
-    case EntityClass::kStreet:
-    case EntityClass::kDriveway:
-      return {};
-    case EntityClass::kTree: {
+    case EntityClass::kTree:
+    case EntityClass::kStreetTree: {
       // Trunk under the lower third, canopy above it.
       const double h = e.box.size.z();
       const double base = e.box.minZ();
@@ -530,12 +542,26 @@ void World::finish() {
   fingerprint_ = h;
 }
 
+double World::sidewalkWidth() const {
+  return params_.type == WorldType::kCity ? params_.city.sidewalk_width : params_.sidewalk_width;
+}
+
+double World::maxStreetWidth() const {
+  double w = 0.0;
+  for (const auto& e : edges_) w = std::max(w, e.width);
+  return w;
+}
+
 World generateWorld(const WorldParams& params) {
   params.validate();
   World w;
   w.params_ = params;
-  WorldBuilder builder(w.params_, &w);
-  builder.build(&w.entities_, &w.nodes_, &w.edges_, &w.blocks_, &w.slots_, &w.bounds_);
+  if (params.type == WorldType::kCity) {
+    buildCityWorld(params, &w);
+  } else {
+    WorldBuilder builder(w.params_, &w);
+    builder.build(&w.entities_, &w.nodes_, &w.edges_, &w.blocks_, &w.slots_, &w.bounds_);
+  }
   w.adjacency_.assign(w.nodes_.size(), {});
   for (int i = 0; i < static_cast<int>(w.edges_.size()); ++i) {
     w.adjacency_[w.edges_[i].a].push_back(i);
