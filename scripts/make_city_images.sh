@@ -12,9 +12,9 @@ out="$HAMERITT_ROOT/docs/images"
 mkdir -p "$out"
 rosrun hameritt hameritt_generate --world city --class area_search --scenario-seed 1 \
   --out "$tmp/gen" --quiet
-cfg="$(ls "$tmp"/gen/scenarios/*/sim_config.json | head -1)"
+cfg="$(ls "$tmp"/gen/*/sim_config.json | head -1)"
 rosrun hameritt hameritt_map "$(dirname "$cfg")" --full --px-per-m 0.8 --out "$out/city_map.png"
-# A UAV 35 m up over a local street south of the downtown core, looking north; and the down
+# A UAV 22 m up over a local street south of the downtown core, looking north; and the down
 # camera 60 m up over the centre.
 view=(--sim-config "$cfg" --time 30 --set noise=off --set rain=0 --set snow=0 --set foliage=0.9)
 render() {  # NAME ARGS...: renders into $tmp/NAME
@@ -22,8 +22,8 @@ render() {  # NAME ARGS...: renders into $tmp/NAME
   shift
   rosrun hameritt hameritt_render "${view[@]}" --out "$tmp/$name" "$@"
 }
-render dusk --camera front --pose "${CITY_FRONT_POSE:-0,-260,35,1.5708}" --set time_of_day=18.35 --set fog=0
-render fog --camera front --pose "${CITY_FRONT_POSE:-0,-260,35,1.5708}" --set time_of_day=11 --set fog=0.45
+render dusk --camera front --pose "${CITY_FRONT_POSE:--70,-330,22,1.5708}" --set time_of_day=18.35 --set fog=0
+render fog --camera front --pose "${CITY_FRONT_POSE:--70,-330,22,1.5708}" --set time_of_day=11 --set fog=0.45
 render down_dusk --camera down --pose "${CITY_DOWN_POSE:-0,0,160,0}" --set time_of_day=18.35 --set fog=0
 render down_fog --camera down --pose "${CITY_DOWN_POSE:-0,0,160,0}" --set time_of_day=11 --set fog=0.45
 cp "$tmp/dusk/front_rgb.png" "$out/city_front_dusk.png"

@@ -4,6 +4,7 @@
 // street furniture (lamp posts, street trees, benches, bus stops, traffic lights).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -316,9 +317,10 @@ class CityBuilder {
         const Vec2 o = a + start * u;
         // Keep only lots whose corners lie inside the (slightly skewed) interior.
         bool inside = true;
-        for (const Vec2& q :
-             {o + 0.1 * u + 0.1 * n, o + (w - 0.1) * u + 0.1 * n,
-              o + (w - 0.1) * u + (depth - 0.1) * n, o + 0.1 * u + (depth - 0.1) * n}) {
+        const std::array<Vec2, 4> corners = {
+            Vec2(o + 0.1 * u + 0.1 * n), Vec2(o + (w - 0.1) * u + 0.1 * n),
+            Vec2(o + (w - 0.1) * u + (depth - 0.1) * n), Vec2(o + 0.1 * u + (depth - 0.1) * n)};
+        for (const Vec2& q : corners) {
           inside = inside && block.interior.contains(q);
         }
         if (inside) buildLot(block, street, o, u, n, w, depth);
