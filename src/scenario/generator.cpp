@@ -35,6 +35,10 @@ std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index) {
   return deriveSeed(seed, 0x5343454E00000000ULL + index);
 }
 
+// Draw order: every random draw is its own statement. C++ leaves the order in which a call's
+// arguments (or an expression's operands) are evaluated to the compiler, so two draws in one call
+// give g++ and clang different scenarios from one seed. Where draws once shared a call they are
+// now taken in the order g++ evaluated them (right to left), which the golden files pin.
 namespace {
 
 constexpr double kLaneOffsetFromKerb = 3.45;  // lane centre = half width - this
@@ -725,7 +729,9 @@ class ScenarioBuilder {
         bool ok = false;
         for (int attempt = 0; attempt < 30 && !ok; ++attempt) {
           const auto b = world_.bounds();
-          const Vec2 p(rng_.uniform(b.min.x(), b.max.x()), rng_.uniform(b.min.y(), b.max.y()));
+          const double py = rng_.uniform(b.min.y(), b.max.y());  // "Draw order" at the top
+          const double px = rng_.uniform(b.min.x(), b.max.x());
+          const Vec2 p(px, py);
           a = makeAoi(id, p, rng_.uniform(-0.3, 0.3), len, wid);
           ok = !a.polygon.intersects(m.aois.front().polygon);
         }
@@ -743,9 +749,12 @@ class ScenarioBuilder {
     // KOZs that deny the easy vantage points: over the target, and over the street beside it.
     const int n_koz = static_cast<int>(rng_.uniformInt(cfg_.koz_count_min, cfg_.koz_count_max));
     {
-      const Vec2 c = tp + Vec2(rng_.uniform(-8, 8), rng_.uniform(-8, 8));
-      KeepOutZone k = makeKoz(geometry::orientedRectangle(c, rng_.uniform(30, 60), rng_.uniform(30, 60), yaw0),
-                              "vantage_denial");
+      const double dy = rng_.uniform(-8, 8);  // one draw per statement: "Draw order" at the top
+      const double dx = rng_.uniform(-8, 8);
+      const Vec2 c = tp + Vec2(dx, dy);
+      const double kw = rng_.uniform(30, 60);
+      const double kl = rng_.uniform(30, 60);
+      KeepOutZone k = makeKoz(geometry::orientedRectangle(c, kl, kw, yaw0), "vantage_denial");
       k.alt_min = 0.0;
       k.alt_max = std::round(uav_.altitude_max + 20.0);
       m.kozs.push_back(k);
@@ -772,10 +781,14 @@ class ScenarioBuilder {
       const auto& aoi = m.aois.front().polygon;
       const auto bb = aoi.bounds();
       for (int attempt = 0; attempt < 20; ++attempt) {
-        const Vec2 c(rng_.uniform(bb.min.x(), bb.max.x()), rng_.uniform(bb.min.y(), bb.max.y()));
+        const double cy = rng_.uniform(bb.min.y(), bb.max.y());  // "Draw order" at the top
+        const double cx = rng_.uniform(bb.min.x(), bb.max.x());
+        const Vec2 c(cx, cy);
         if (!aoi.contains(c)) continue;
-        KeepOutZone k = makeKoz(geometry::orientedRectangle(c, rng_.uniform(20, 50), rng_.uniform(20, 50), rng_.uniform(-0.5, 0.5)),
-                                "restricted");
+        const double kyaw = rng_.uniform(-0.5, 0.5);
+        const double kw = rng_.uniform(20, 50);
+        const double kl = rng_.uniform(20, 50);
+        KeepOutZone k = makeKoz(geometry::orientedRectangle(c, kl, kw, kyaw), "restricted");
         if (rng_.bernoulli(0.5)) {
           k.window.net = std::round(rng_.uniform(0.0, 0.5) * m.time_limit);
           k.window.nlt = std::round(*k.window.net + rng_.uniform(60.0, 0.5 * m.time_limit));
@@ -1174,7 +1187,8 @@ class ScenarioBuilder {
   void addTraffic() {
     const int cars = static_cast<int>(rng_.uniformInt(cfg_.traffic_count_min, cfg_.traffic_count_max));
     for (int i = 0; i < cars; ++i) {
-      std::vector<int> nodes = randomWalk(randomNode(), static_cast<int>(rng_.uniformInt(2, 5)));
+      const int hops = static_cast<int>(rng_.uniformInt(2, 5));  // "Draw order" at the top
+      std::vector<int> nodes = randomWalk(randomNode(), hops);
       if (nodes.size() < 2) continue;
       DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
       const std::vector<Vec2> path = nodePositions(nodes);
@@ -1190,8 +1204,11 @@ class ScenarioBuilder {
       const Block& b = world_.blocks()[static_cast<std::size_t>(rng_.uniformInt(0, static_cast<long>(world_.blocks().size()) - 1))];
       const double ring = geometry::polylineLength(b.sidewalk);
       const double s0 = rng_.uniform(0.0, ring);
-      const double dist = rng_.uniform(60.0, 300.0) * (rng_.bernoulli(0.5) ? 1.0 : -1.0);
-      Trajectory traj = walkRing(b.sidewalk, s0, s0 + dist, rangeDraw(rng_, cfg_.pedestrian_speed), rng_.uniform(0.0, 30.0));
+      const double span = rng_.uniform(60.0, 300.0);  // "Draw order" at the top
+      const double dist = span * (rng_.bernoulli(0.5) ? 1.0 : -1.0);
+      const double start = rng_.uniform(0.0, 30.0);
+      const double speed = rangeDraw(rng_, cfg_.pedestrian_speed);
+      Trajectory traj = walkRing(b.sidewalk, s0, s0 + dist, speed, start);
       Entity p;
       p.id = nextPedId();
       p.cls = EntityClass::kPedestrian;

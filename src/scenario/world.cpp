@@ -341,8 +341,11 @@ class WorldBuilder {
       Attributes ta;
       ta.set("species", catalog::pick(rng_, catalog::treeSpecies()));
       ta.set("foliage", rng_.bernoulli(0.7) ? std::string("leafy") : std::string("sparse"));
-      addEntity(EntityClass::kTree, "tree", Vec3(c.x(), c.y(), 0.0), rng_.uniform(-3.14, 3.14),
-                Vec3(diam, diam, rng_.uniform(5.0, 13.0)), ta, bi);
+      // One draw per statement, in the order g++ evaluated the arguments of the call these were
+      // once (right to left; C++ leaves it to the compiler): the golden files pin it.
+      const double height = rng_.uniform(5.0, 13.0);
+      const double yaw = rng_.uniform(-3.14, 3.14);
+      addEntity(EntityClass::kTree, "tree", Vec3(c.x(), c.y(), 0.0), yaw, Vec3(diam, diam, height), ta, bi);
     }
     lot_first_entity_ = entities_->size();
   }

@@ -1,4 +1,7 @@
 """Helpers shared by the Python tests that drive a ROS graph (not a test: no test_ prefix)."""
+import os
+import signal
+import subprocess
 import time
 
 import rosgraph
@@ -21,3 +24,37 @@ def subscribed(node):
     except Exception:
         return set()
     return {t for t, nodes in subs if node in nodes}
+
+
+def private_master_port(base):
+    """This test's own master port (base + pid % 2000), exported as ROS_MASTER_URI so that every
+    node, roslaunch and rospy call of the test uses it; tests pick distinct bases."""
+    port = base + os.getpid() % 2000
+    os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
+    return port
+
+
+def start_master(port, seconds=30):
+    """Starts `roscore -p port` and returns its process once the master answers: roslaunch
+    starts a master of its own unless one answers, so a test waits for its own first. Stop it
+    with stop_master(); if it never answers, it is stopped here and RuntimeError is raised."""
+    core = subprocess.Popen(["roscore", "-p", str(port)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    uri = "http://localhost:%d" % port
+    try:
+        wait_for(lambda: rosgraph.is_master_online(master_uri=uri), seconds,
+                 "the master on port %d" % port)
+    except RuntimeError:
+        stop_master(core)
+        raise
+    return core
+
+
+def stop_master(core):
+    """Stops a master from start_master(): SIGINT, then SIGKILL if it has not exited in 30 s."""
+    core.send_signal(signal.SIGINT)
+    try:
+        core.wait(30)
+    except subprocess.TimeoutExpired:
+        core.kill()
+        core.wait()

@@ -23,12 +23,10 @@ import subprocess
 import sys
 import tempfile
 
-import rosgraph
-from graph_util import wait_for
+from graph_util import private_master_port, start_master, stop_master
 from fault_util import Checks, metrics_validator
 
-PORT = 25000 + os.getpid() % 2000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
+PORT = private_master_port(25000)
 DURATION = 4
 REASON = "simulation duration %d s reached" % DURATION
 ADK_END = "adk: the simulator stopped at sim time %.3f s" % DURATION
@@ -89,11 +87,8 @@ def run(tmp, label, lockstep):
 
 def main():
     tmp = tempfile.mkdtemp(prefix="hameritt_duration_end.")
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     try:
-        # roslaunch starts a master of its own unless one answers: wait for ours first.
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         got = run(tmp, "lockstep", "true")
         run(tmp, "free_running", "false")
         if got:
@@ -109,8 +104,7 @@ def main():
             print("negative control: a log ended by the watchdog: %s" % "; ".join(
                 log_problems(stalled)))
     finally:
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_master(core)
         if not check.fails:
             shutil.rmtree(tmp, ignore_errors=True)
     return check.summary(tmp)

@@ -29,12 +29,10 @@ import subprocess
 import sys
 import tempfile
 
-import rosgraph
-from graph_util import wait_for
+from graph_util import private_master_port, start_master, stop_master
 from fault_util import BIN, SRC, Checks, metrics_state, metrics_validator, run_adk
 
-PORT = 23000 + os.getpid() % 2000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
+PORT = private_master_port(23000)
 os.environ["ROSCONSOLE_STDOUT_LINE_BUFFERED"] = "1"
 METRICS = metrics_validator()
 check = Checks()
@@ -231,19 +229,15 @@ def main():
     DIRECT = os.path.join(TMP, "direct_writer")
     subprocess.run(["cc", "-O1", "-o", DIRECT,
                     os.path.join(SRC, "test", "faults", "direct_writer.c")], check=True)
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     try:
-        # roslaunch starts a master of its own unless one answers: wait for ours first.
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         generate_on_full_disk(small)
         export_on_full_disk(small, TMP)
         recorder_reason(small)
         adk_on_full_disk(small)
         mission_recorder_stops(small)
     finally:
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_master(core)
         small.umount()
         if not check.fails:
             shutil.rmtree(TMP, ignore_errors=True)

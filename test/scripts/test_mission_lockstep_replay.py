@@ -33,13 +33,12 @@ import tempfile
 import time
 
 import rosbag
-import rosgraph
 
-from graph_util import subscribed, wait_for  # test/scripts/graph_util.py
+from graph_util import (private_master_port, start_master, stop_master,  # test/scripts/
+                        subscribed, wait_for)
 
 SRC = os.environ["HAMERITT_SOURCE_DIR"]
-PORT = 18000 + os.getpid() % 2000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
+PORT = private_master_port(18000)
 
 TOPICS = ["/clock", "/tf", "/tf_static", "/uav/odom", "/uav/imu", "/ground_truth/entities",
           "/uav/crash", "/mission", "/mission/markers", "/adk/constraints",
@@ -201,11 +200,9 @@ def generated(out, fails):
 
 def main():
     out = tempfile.mkdtemp(prefix="hameritt_lockstep.")
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     fails = []
     try:
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         for mode, limit, must in MODES:
             runs = []
             for run in (1, 2):
@@ -242,8 +239,7 @@ def main():
         generated(out, fails)
         ghost(out, fails)
     finally:
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_master(core)
         if not fails:
             subprocess.run(["rm", "-rf", out])
     if fails:

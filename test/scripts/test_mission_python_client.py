@@ -25,11 +25,11 @@ import time
 import rosbag
 import rosgraph
 
-from graph_util import subscribed, wait_for  # test/scripts/graph_util.py
+from graph_util import (private_master_port, start_master, stop_master,  # test/scripts/
+                        subscribed, wait_for)
 
 SRC = os.environ["HAMERITT_SOURCE_DIR"]
-PORT = 14000 + os.getpid() % 2000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
+PORT = private_master_port(14000)
 CLIENT = os.path.join(SRC, "scripts", "example_client.py")
 TOPICS = ["/clock", "/uav/odom", "/mission", "/mission/uav", "/adk/state", "/adk/constraints",
           "/adk/perfect_perception", "/adk/detection_scores", "/adk/metrics", "/uav/cmd_pose",
@@ -110,11 +110,9 @@ def differences(a, b):
 
 def main():
     base = tempfile.mkdtemp(prefix="hameritt_pyclient.")
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     fails = []
     try:
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         started = time.time()
         m, rc, _ = run(os.path.join(base, "maneuver"), "maneuver_only", 120)
         print("maneuver_only: %s at %.1f s (%s), client exit %s, %.0f wall s"
@@ -165,8 +163,7 @@ def main():
     except Exception as e:  # a timeout or a missing file: report it with the runs kept
         fails.append("%s: %s" % (type(e).__name__, e))
     finally:
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_master(core)
     if fails:
         print("FAIL (runs kept in %s):\n  " % base + "\n  ".join(fails))
         return 1

@@ -17,17 +17,16 @@ import tempfile
 import time
 
 import rosbag
-import rosgraph
 import rospy
 from geometry_msgs.msg import Twist
 
 from hameritt.srv import StepSimulation
 
-from graph_util import subscribed, wait_for  # test/scripts/graph_util.py
+from graph_util import (private_master_port, start_master, stop_master,  # test/scripts/
+                        subscribed, wait_for)
 
 SRC = os.environ["HAMERITT_SOURCE_DIR"]
-PORT = 16000 + os.getpid() % 2000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
+PORT = private_master_port(16000)
 TOPICS = ["/clock", "/uav/odom", "/uav/imu", "/tf", "/tf_static", "/ground_truth/entities"]
 for cam in ["down", "front"]:
     for kind in ["image_raw", "depth", "segmentation", "instances", "camera_info", "boxes"]:
@@ -87,11 +86,9 @@ def messages(path):
 
 def main():
     out = tempfile.mkdtemp(prefix="hameritt_replay.")
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     fails = []
     try:
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         rospy.init_node("replay_driver", disable_signals=True)
         bags = []
         for run in (1, 2):
@@ -119,8 +116,7 @@ def main():
             fails.append("/clock: %d messages, expected %d (every publish tick, every call)"
                          % (len(a.get("/clock", [])), expected_clock))
     finally:
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_master(core)
         subprocess.run(["rm", "-rf", out])
     if fails:
         print("FAIL:\n  " + "\n  ".join(fails))

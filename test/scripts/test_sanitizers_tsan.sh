@@ -6,13 +6,17 @@
 # lock-step inbox and counters fed from many threads, and batch generation on several threads
 # (--jobs). Negative control first: a data race in test/sanitizers/control.cpp, compiled the same
 # way, must be reported and fail the judge. docs/RELIABILITY.md "Sanitizers" has the cost.
+# The same clang-14 build also runs hameritt_generate through the golden-output check: the
+# golden files are g++'s, so this shows that generation does not depend on the compiler (C++
+# leaves the order of a call's arguments to it: see "Draw order" in generator.cpp), and it runs
+# batch generation with --jobs 2 under TSan.
 set -euo pipefail
 source "$(dirname "$0")/../../scripts/sanitizers_common.sh"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
 sanitizer_configure tsan
-sanitizer_build tsan test_sanitizer_control test_threads >"$work/build.log" 2>&1 ||
+sanitizer_build tsan test_sanitizer_control test_threads hameritt_generate >"$work/build.log" 2>&1 ||
   { tail -40 "$work/build.log"; exit 1; }
 sanitizer_source_devel tsan
 bin="$(sanitizer_build_dir tsan)/devel/lib/hameritt"
@@ -32,4 +36,15 @@ if [[ "${n:-0}" != "$total" ]]; then echo "FAIL: not every test passed"; failed=
 for suite in EncodePool. TakSender. LockstepInbox. PublicationCounter. GeneratorReuseTest. BatchSliceTest.; do
   printf '%s\n' "${listed[@]}" | grep -qx "$suite" || { echo "FAIL: no $suite tests"; failed=1; }
 done
+
+# Compiler independence: clang-14's generator against the golden files of the g++ build (the
+# check has its own negative control: a flipped byte, a missing and an extra file).
+if HAMERITT_BIN_DIR="$bin" HAMERITT_SOURCE_DIR="$HAMERITT_ROOT" /usr/bin/python3 "$HAMERITT_ROOT/test/scripts/test_golden_outputs.py" \
+  >"$work/golden.log" 2>&1 && ! grep -qE "$SANITIZER_REPORT_RE" "$work/golden.log"; then
+  echo "clang-14 generation: $(tail -1 "$work/golden.log")"
+else
+  echo "FAIL: clang-14 (TSan) generation differs from the golden files or was reported:"
+  grep -E "FAIL|$SANITIZER_REPORT_RE" "$work/golden.log" | head -20
+  failed=1
+fi
 exit "$failed"
