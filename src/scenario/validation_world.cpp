@@ -1,0 +1,190 @@
+// Semantic checks of sim_config.json, world.json and manifest.json.
+#include "validation_internal.h"
+
+namespace hameritt::scenario::validation_internal {
+
+void Semantics::simConfig() {
+  scenarioId(doc_, "/scenario_id");
+  if (exists("/world/params")) worldParams("/world/params");
+
+  IdSet ids(this, "entity id");
+  bool has_target = false;
+  const json& ents = arrayOrEmpty(doc_, "entities");
+  for (std::size_t i = 0; i < ents.size(); ++i) {
+    const std::string p = jsonPointerAppend("/entities", i);
+    ids.note(ents[i], p);
+    has_target = has_target || stringAt(ents[i], "role") == std::optional<std::string>("target");
+    trajectoryOrder(arrayOrEmpty(ents[i], "trajectory"), p + "/trajectory");
+  }
+  if (!ents.empty() && !has_target) add("/entities", "role_target", "no entity has role 'target'");
+
+  IdSet group_ids(this, "group id");
+  const json& groups = arrayOrEmpty(doc_, "groups");
+  for (std::size_t i = 0; i < groups.size(); ++i) {
+    const std::string p = jsonPointerAppend("/groups", i);
+    group_ids.note(groups[i], p);
+    const json& members = arrayOrEmpty(groups[i], "members");
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      if (members[k].is_string() && !ids.has(members[k].get<std::string>())) {
+        add(jsonPointerAppend(p + "/members", k), "group_member",
+            "'" + members[k].get<std::string>() + "' is not an entity of this scenario");
+      }
+    }
+  }
+  if (exists("/uav/altitude"))
+    altitude(doc_.at(json::json_pointer("/uav/altitude")), "/uav/altitude");
+  if (exists("/uav/perception_path")) perceptionPath(ents);
+}
+
+void Semantics::trajectoryOrder(const json& traj, const std::string& pointer) {
+  double prev = 0.0;
+  for (std::size_t k = 0; k < traj.size(); ++k) {
+    if (!traj[k].is_array() || traj[k].empty() || !traj[k][0].is_number()) break;
+    const double t = traj[k][0].get<double>();
+    const std::string sp = jsonPointerAppend(pointer, k);
+    if (k == 0 && t < 0) {
+      add(sp, "trajectory_order", "t = " + num(t) + " is before the mission start");
+    } else if (k > 0 && !(t > prev)) {
+      add(sp, "trajectory_order",
+          "t = " + num(t) + " does not increase on the previous sample's t = " + num(prev));
+    }
+    prev = t;
+  }
+}
+
+void Semantics::perceptionPath(const json& ents) {
+  const std::string base = "/uav/perception_path";
+  const json& pp = doc_.at(json::json_pointer(base));
+  trajectoryOrder(arrayOrEmpty(pp, "trajectory"), base + "/trajectory");
+  std::set<std::string> targets;
+  for (const auto& e : ents) {
+    if (stringAt(e, "role") == std::optional<std::string>("target")) {
+      if (auto id = stringAt(e, "id")) targets.insert(*id);
+    }
+  }
+  const json& seen = arrayOrEmpty(pp, "targets_seen");
+  for (std::size_t k = 0; k < seen.size(); ++k) {
+    if (seen[k].is_string() && !targets.count(seen[k].get<std::string>())) {
+      add(jsonPointerAppend(base + "/targets_seen", k), "reference",
+          "'" + seen[k].get<std::string>() + "' is not a target of this scenario");
+    }
+  }
+}
+
+void Semantics::world() {
+  if (exists("/params")) worldParams("/params");
+  if (const json* b = member(doc_, "bounds")) {
+    Vec2 lo, hi;
+    const json* mn = member(*b, "min");
+    const json* mx = member(*b, "max");
+    if (mn && mx && toPoint(*mn, &lo) && toPoint(*mx, &hi) &&
+        (lo.x() > hi.x() || lo.y() > hi.y())) {
+      add("/bounds", "bounds", "min is not below max");
+    }
+  }
+  // Entities first: edges and slots refer to them.
+  IdSet ids(this, "entity id");
+  std::unordered_map<std::string, std::string> classes;
+  const json& ents = arrayOrEmpty(doc_, "entities");
+  for (std::size_t i = 0; i < ents.size(); ++i) {
+    const std::string p = jsonPointerAppend("/entities", i);
+    if (ids.note(ents[i], p)) {
+      if (const auto id = stringAt(ents[i], "id"))
+        classes[*id] = stringAt(ents[i], "class").value_or("");
+    }
+  }
+  const json& blocks = arrayOrEmpty(doc_, "blocks");
+  for (std::size_t i = 0; i < ents.size(); ++i) {
+    const json* b = member(ents[i], "block");
+    if (b && isInteger(*b) && b->get<double>() >= static_cast<double>(blocks.size())) {
+      add(jsonPointerAppend("/entities", i) + "/block", "reference",
+          "block index " + b->dump() + " but there are " + std::to_string(blocks.size()) +
+              " blocks");
+    }
+  }
+  static const json kNone = json::object();
+  const json* streets = member(doc_, "streets");
+  const std::size_t n_nodes = arrayOrEmpty(streets ? *streets : kNone, "nodes").size();
+  {
+    const json& edges = arrayOrEmpty(streets ? *streets : kNone, "edges");
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      const std::string p = jsonPointerAppend("/streets/edges", i);
+      const json* a = member(edges[i], "a");
+      const json* b = member(edges[i], "b");
+      for (const json* e : {a, b}) {
+        if (e && isInteger(*e) && e->get<double>() >= static_cast<double>(n_nodes)) {
+          add(p + (e == a ? "/a" : "/b"), "reference",
+              "node index " + e->dump() + " but there are " + std::to_string(n_nodes) + " nodes");
+        }
+      }
+      if (a && b && *a == *b) add(p, "reference", "the edge starts and ends at node " + a->dump());
+      if (const auto ent = stringAt(edges[i], "entity")) {
+        auto it = classes.find(*ent);
+        if (it == classes.end() || it->second != "street") {
+          add(p + "/entity", "reference", "'" + *ent + "' is not a street entity of this world");
+        }
+      }
+    }
+  }
+  IdSet names(this, "block name");
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const std::string p = jsonPointerAppend("/blocks", i);
+    names.note(blocks[i], p, "name");
+    if (const json* o = member(blocks[i], "outline")) polygon(*o, p + "/outline");
+    std::vector<Vec2> ring;
+    if (const json* sw = member(blocks[i], "sidewalk");
+        sw && toPoints(*sw, &ring) && ring.size() >= 4) {
+      if (ring.front() != ring.back()) {
+        add(p + "/sidewalk", "sidewalk_ring", "the sidewalk ring must end at its first point");
+      } else {
+        ring.pop_back();
+        if (!Polygon(ring).isSimple())
+          add(p + "/sidewalk", "polygon_simple", "the sidewalk ring is not simple");
+      }
+    }
+  }
+  const json& slots = arrayOrEmpty(doc_, "parking_slots");
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    if (const auto occ = stringAt(slots[i], "occupant"); occ && !ids.has(*occ)) {
+      add(jsonPointerAppend("/parking_slots", i) + "/occupant", "reference",
+          "'" + *occ + "' is not an entity of this world");
+    }
+  }
+}
+
+void Semantics::manifest() {
+  const json& scen = arrayOrEmpty(doc_, "scenarios");
+  const json* count = member(doc_, "count");
+  if (count && isInteger(*count) && count->get<double>() != static_cast<double>(scen.size())) {
+    add("/scenarios", "manifest_count",
+        "count is " + count->dump() + " but " + std::to_string(scen.size()) +
+            " scenarios are listed");
+  }
+  const json& classes = arrayOrEmpty(doc_, "classes");
+  IdSet ids(this, "scenario id");
+  for (std::size_t i = 0; i < scen.size(); ++i) {
+    const json& e = scen[i];
+    const std::string p = jsonPointerAppend("/scenarios", i);
+    ids.note(e, p);
+    const json* index = member(e, "index");
+    if (index && isInteger(*index) && index->get<double>() != static_cast<double>(i)) {
+      add(p + "/index", "manifest_index",
+          "expected index " + std::to_string(i) + ", got " + index->dump());
+    }
+    const auto cls = stringAt(e, "class");
+    if (cls && !classes.empty() && classes[i % classes.size()] != *cls) {
+      add(p + "/class", "manifest_class",
+          "scenario " + std::to_string(i) + " should have class " +
+              classes[i % classes.size()].dump() + " (classes[" + std::to_string(i) + " % " +
+              std::to_string(classes.size()) + "])");
+    }
+    scenarioId(e, p + "/id");
+    const auto id = stringAt(e, "id"), path = stringAt(e, "path");
+    if (id && path && *id != *path) {
+      add(p + "/path", "manifest_path",
+          "expected the scenario directory '" + *id + "', got '" + *path + "'");
+    }
+  }
+}
+
+}  // namespace hameritt::scenario::validation_internal
