@@ -7,12 +7,14 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/world.h"
+#include "world_entities.h"
 
 namespace hameritt::scenario {
 
@@ -97,8 +99,6 @@ bool parseWorldType(const std::string& s, WorldType* out) {
 
 namespace {
 
-Vec3 roundVec(const Vec3& v) { return {roundMilli(v.x()), roundMilli(v.y()), roundMilli(v.z())}; }
-
 // Moves each edge of a convex counter-clockwise quadrilateral inwards by its own distance
 // (by[i] for the edge from vertex i to vertex i+1) and returns the inner quadrilateral.
 Polygon insetEdges(const Polygon& poly, const double by[4]) {
@@ -145,15 +145,8 @@ class CityBuilder {
  private:
   int addEntity(EntityClass cls, const std::string& prefix, const Vec3& bottom, double yaw,
                 const Vec3& size, Attributes attrs, int block) {
-    Entity e;
-    int& counter = counters_[static_cast<int>(cls)];
-    e.id = prefix + "_" + std::to_string(++counter);
-    e.cls = cls;
-    e.attributes = std::move(attrs);
-    e.box = boxFromPose(roundVec(bottom), roundMilli(geometry::wrapPi(yaw)), roundVec(size));
-    e.block = block;
-    entities_->push_back(std::move(e));
-    return static_cast<int>(entities_->size()) - 1;
+    return world_entities::appendEntity(entities_, &counters_, cls, prefix, bottom, yaw, size,
+                                        std::move(attrs), block);
   }
 
   // Street positions along one axis: n gaps drawn in [lo, hi] and scaled to the extent, redrawn
@@ -445,6 +438,15 @@ class CityBuilder {
       const bool art = w[s] >= c_.arterial_width - 1e-9;
       auto point = [&](double along, double in) { return a + along * u + in * n; };
       std::vector<double> used;  // positions taken along this side
+      // A position drawn in [lo, hi], kept (and taken) when `gap` from every taken one.
+      auto freeSpot = [&](double lo, double hi, double gap) -> std::optional<double> {
+        const double t = rng_.uniform(lo, hi);
+        for (double q : used) {
+          if (std::abs(q - t) <= gap) return std::nullopt;
+        }
+        used.push_back(t);
+        return t;
+      };
       for (double t = 0.5 * c_.lamp_spacing; t < len - 4.0; t += c_.lamp_spacing) {
         const Vec2 p = point(t, 0.0);
         Attributes la;
@@ -469,28 +471,18 @@ class CityBuilder {
           used.push_back(t);
         }
       } else if (len > 40.0 && rng_.bernoulli(c_.bus_stop_probability)) {
-        const double t = rng_.uniform(15.0, len - 15.0);
-        bool clear = true;
-        for (double q : used) clear = clear && std::abs(q - t) > 4.0;
-        if (clear) {
-          const Vec2 p = point(t, 0.3);
+        if (const auto t = freeSpot(15.0, len - 15.0, 4.0)) {
+          const Vec2 p = point(*t, 0.3);
+          const int street[4] = {bj, bi + 1, bj + 1, bi};
           Attributes ba;
-          ba.set("name", catalog::streetName(s % 2 == 1, s == 0   ? bj
-                                                         : s == 1 ? bi + 1
-                                                         : s == 2 ? bj + 1
-                                                                  : bi) +
-                             " stop");
+          ba.set("name", catalog::streetName(s % 2 == 1, street[s]) + " stop");
           addEntity(EntityClass::kBusStop, "bus_stop", Vec3(p.x(), p.y(), 0.0), yaw,
                     Vec3(4.0, 1.1, 2.6), ba, block.index);
-          used.push_back(t);
         }
       }
       if (len > 30.0 && rng_.bernoulli(c_.bench_probability)) {
-        const double t = rng_.uniform(10.0, len - 10.0);
-        bool clear = true;
-        for (double q : used) clear = clear && std::abs(q - t) > 3.5;
-        if (clear) {
-          const Vec2 p = point(t, 0.2);
+        if (const auto t = freeSpot(10.0, len - 10.0, 3.5)) {
+          const Vec2 p = point(*t, 0.2);
           Attributes ba;
           ba.set("color", std::string("brown"));
           addEntity(EntityClass::kBench, "bench", Vec3(p.x(), p.y(), 0.0), yaw, Vec3(1.8, 0.6, 0.9),
@@ -523,47 +515,16 @@ class CityBuilder {
       }
     }
     keep_clear.build();
-    for (int ei = 0; ei < static_cast<int>(edges.size()); ++ei) {
-      const auto& e = edges[ei];
-      if (e.width >= c_.arterial_width - 1e-9) continue;
-      const Vec2 a = nodes[e.a].position, b = nodes[e.b].position;
-      const double len = (b - a).norm();
-      const Vec2 u = (b - a) / len, n(-u.y(), u.x());
-      const double corner = 0.5 * c_.arterial_width + 8.0;
-      for (int side = -1; side <= 1; side += 2) {
-        const double offset = 0.5 * e.width - 1.05;
-        const double yaw = side < 0 ? std::atan2(u.y(), u.x()) : std::atan2(-u.y(), -u.x());
-        for (double s = corner; s < len - corner; s += 6.5) {
-          const Vec2 c = a + s * u + side * offset * n;
-          if (!keep_clear.near(c, 3.2).empty()) continue;
-          ParkingSlot slot;
-          slot.position = Vec2(roundMilli(c.x()), roundMilli(c.y()));
-          slot.yaw = roundMilli(geometry::wrapPi(yaw));
-          slot.edge = ei;
-          const Vec2 probe = c + side * (0.5 * e.width + 3.0) * n;
-          for (const auto& bl : blocks) {
-            if (bl.outline.contains(probe)) slot.block = bl.index;
-          }
-          slots_->push_back(slot);
-        }
-      }
-    }
+    const double corner = 0.5 * c_.arterial_width + 8.0;
+    world_entities::addKerbSlots(
+        nodes, edges, blocks, keep_clear, 3.2, 6.5,
+        [&](const StreetEdge& e) { return e.width >= c_.arterial_width - 1e-9 ? -1.0 : corner; },
+        slots_);
   }
 
   void parkCars() {
-    for (auto& s : *slots_) {
-      const double p = s.driveway ? c_.lot_parking_probability : c_.street_parking_probability;
-      if (!rng_.bernoulli(p)) continue;
-      const auto& model = catalog::pickModel(rng_);
-      Attributes a;
-      a.set("vehicle_class", model.vehicle_class);
-      a.set("make", model.make);
-      a.set("model", model.model);
-      a.set("color", catalog::pick(rng_, catalog::carColors()));
-      s.occupant =
-          addEntity(EntityClass::kCar, "car", Vec3(s.position.x(), s.position.y(), s.ground_z),
-                    s.yaw, Vec3(model.length, model.width, model.height), a, s.block);
-    }
+    world_entities::parkCars(rng_, c_.lot_parking_probability, c_.street_parking_probability,
+                             slots_, entities_, &counters_);
   }
 
   const WorldParams& p_;
@@ -573,7 +534,7 @@ class CityBuilder {
   std::vector<ParkingSlot>* slots_;
   std::vector<double> xs_, ys_;
   int nx_ = 0, ny_ = 0;
-  int counters_[32] = {};
+  world_entities::EntityCounters counters_;
   int numbers_ = 0;
   std::vector<int> buildings_;
 };

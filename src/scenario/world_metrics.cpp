@@ -93,6 +93,16 @@ bool insideOccluder(const World& world, const Vec3& p) {
 
 double round4(double v) { return std::round(v * 1e4) / 1e4; }
 
+// Widens [*lo, *hi] to hold v (the first value sets both, `*first` is then cleared).
+void widen(double v, double* lo, double* hi, bool* first) {
+  if (*first) {
+    *lo = *hi = v;
+    *first = false;
+  }
+  *lo = std::min(*lo, v);
+  *hi = std::max(*hi, v);
+}
+
 }  // namespace
 
 double skyViewFactor(const World& world, const Vec3& p, int rays, double length) {
@@ -122,15 +132,9 @@ WorldMetrics measureWorld(const World& world, const MetricsSettings& s) {
     const auto& v = b.outline.vertices();
     const double len = 0.5 * ((v[1] - v[0]).norm() + (v[2] - v[3]).norm());
     const double dep = 0.5 * ((v[3] - v[0]).norm() + (v[2] - v[1]).norm());
-    if (first) {
-      m.block_length_min = m.block_length_max = len;
-      m.block_depth_min = m.block_depth_max = dep;
-      first = false;
-    }
-    m.block_length_min = std::min(m.block_length_min, len);
-    m.block_length_max = std::max(m.block_length_max, len);
-    m.block_depth_min = std::min(m.block_depth_min, dep);
-    m.block_depth_max = std::max(m.block_depth_max, dep);
+    bool first_depth = first;
+    widen(len, &m.block_length_min, &m.block_length_max, &first);
+    widen(dep, &m.block_depth_min, &m.block_depth_max, &first_depth);
   }
   m.arterial_width = world.maxStreetWidth();
   m.local_width = m.arterial_width;
@@ -149,10 +153,7 @@ WorldMetrics measureWorld(const World& world, const MetricsSettings& s) {
     switch (e.cls) {
       case EntityClass::kAlley:
         ++m.alleys;
-        if (first_alley)
-          m.alley_width_min = m.alley_width_max = e.box.size.y(), first_alley = false;
-        m.alley_width_min = std::min(m.alley_width_min, e.box.size.y());
-        m.alley_width_max = std::max(m.alley_width_max, e.box.size.y());
+        widen(e.box.size.y(), &m.alley_width_min, &m.alley_width_max, &first_alley);
         break;
       case EntityClass::kParkingGarage:
         ++m.parking_garages;
@@ -189,10 +190,7 @@ WorldMetrics measureWorld(const World& world, const MetricsSettings& s) {
     if (e.cls == EntityClass::kBuilding) frontage.push_back(e.box.size.y());
     if (e.box.size.z() >= 60.0) {
       ++towers;
-      if (first_tower)
-        m.tower_height_min = m.tower_height_max = e.box.size.z(), first_tower = false;
-      m.tower_height_min = std::min(m.tower_height_min, e.box.size.z());
-      m.tower_height_max = std::max(m.tower_height_max, e.box.size.z());
+      widen(e.box.size.z(), &m.tower_height_min, &m.tower_height_max, &first_tower);
     }
   }
   for (const auto& sl : world.slots()) m.kerb_slots += sl.edge >= 0 ? 1 : 0;
