@@ -43,6 +43,8 @@ HAMERITT_PACKAGES=(
   # Package checks: catkin_lint; the workspace build (Ninja); strace judges that the install
   # space runs alone.
   catkin-lint ninja-build strace
+  # The TAK bridge's TLS (OpenSSL); its test makes certificates with the openssl tool.
+  libssl-dev openssl
 )
 
 install_deps() {

@@ -76,27 +76,14 @@ std::string isoTime(double unix_seconds) {
   return buf;
 }
 
-std::string toXml(const CotEvent& e) {
-  std::string out = "<event version=\"2.0\"";
-  attr(out, "uid", e.uid);
-  attr(out, "type", e.type);
-  attr(out, "how", e.how);
-  attr(out, "time", isoTime(e.time));
-  attr(out, "start", isoTime(e.start));
-  attr(out, "stale", isoTime(e.stale));
-  out += "><point";
-  attr(out, "lat", num(e.point.lat, 8));
-  attr(out, "lon", num(e.point.lon, 8));
-  attr(out, "hae", num(e.point.hae, 3));
-  attr(out, "ce", num(e.point.ce, 1));
-  attr(out, "le", num(e.point.le, 1));
-  out += "/><detail>";
-  if (!e.callsign.empty()) {
+std::string detailXml(const CotEvent& e, bool contact_and_track) {
+  std::string out;
+  if (contact_and_track && !e.callsign.empty()) {
     out += "<contact";
     attr(out, "callsign", e.callsign);
     out += "/>";
   }
-  if (e.track) {
+  if (contact_and_track && e.track) {
     out += "<track";
     attr(out, "course", num(e.track->first, 2));
     attr(out, "speed", num(e.track->second, 2));
@@ -129,6 +116,25 @@ std::string toXml(const CotEvent& e) {
     for (const auto& [k, v] : e.extra) attr(out, k.c_str(), v);
     out += "/>";
   }
+  return out;
+}
+
+std::string toXml(const CotEvent& e) {
+  std::string out = "<event version=\"2.0\"";
+  attr(out, "uid", e.uid);
+  attr(out, "type", e.type);
+  attr(out, "how", e.how);
+  attr(out, "time", isoTime(e.time));
+  attr(out, "start", isoTime(e.start));
+  attr(out, "stale", isoTime(e.stale));
+  out += "><point";
+  attr(out, "lat", num(e.point.lat, 8));
+  attr(out, "lon", num(e.point.lon, 8));
+  attr(out, "hae", num(e.point.hae, 3));
+  attr(out, "ce", num(e.point.ce, 1));
+  attr(out, "le", num(e.point.le, 1));
+  out += "/><detail>";
+  out += detailXml(e, true);
   out += "</detail></event>";
   return out;
 }

@@ -6,6 +6,8 @@
 #include <stdexcept>
 
 #include "hameritt/cop/cot.h"
+#include "hameritt/cop/tak_proto.h"
+#include "hameritt/cop/tak_tls.h"
 #include "hameritt/ros/cop_conversions.h"
 
 namespace hameritt::ros_wrappers {
@@ -37,7 +39,7 @@ TakBridgeRos::TakBridgeRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (urls.empty())
     throw std::invalid_argument(
         "~endpoints is empty (expected udp://A.B.C.D:PORT, "
-        "tcp://A.B.C.D:PORT or udp:// for multicast, comma-separated)");
+        "tcp://A.B.C.D:PORT, ssl://HOST:PORT or udp:// for multicast, comma-separated)");
   double rate = 1.0;
   pnh.param("rate_hz", rate, rate);
   requirePositive(rate, "rate_hz");
@@ -85,8 +87,35 @@ TakBridgeRos::TakBridgeRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   requirePositive(sc.reconnect_initial_s, "reconnect_initial_s");
   requirePositive(sc.reconnect_max_s, "reconnect_max_s");
   requirePositive(sc.connect_timeout_s, "connect_timeout_s");
-  for (const std::string& url : urls)
+  std::string encoding = "xml";
+  pnh.param<std::string>("encoding", encoding, encoding);
+  sc.encoding = cop::parseTakEncoding(encoding, "~encoding");
+  pnh.param<std::string>("tls_client_p12", sc.tls.client_p12, "");
+  pnh.param<std::string>("tls_client_cert", sc.tls.client_cert, "");
+  pnh.param<std::string>("tls_client_key", sc.tls.client_key, "");
+  pnh.param<std::string>("tls_client_password", sc.tls.client_password, "");
+  pnh.param<std::string>("tls_trust_store", sc.tls.trust_store, "");
+  pnh.param<std::string>("tls_trust_password", sc.tls.trust_password, "");
+  pnh.param<std::string>("tls_pin_sha256", sc.tls.pin_sha256, "");
+  pnh.param<std::string>("tls_server_name", sc.tls.server_name, "");
+  sc.tls.validate();
+  // The senders' threads log each failure once with its reason, and each connect.
+  sc.log = [](bool error, const std::string& message) {
+    if (error) {
+      ROS_ERROR("tak_bridge: %s", message.c_str());
+    } else {
+      ROS_INFO("tak_bridge: %s", message.c_str());
+    }
+  };
+  for (const std::string& url : urls) {
     senders_.push_back(std::make_unique<cop::TakSender>(cop::parseTakUrl(url), sc));
+    if (senders_.back()->endpoint().protocol == cop::TakEndpoint::Protocol::kSsl &&
+        !sc.tls.hasClientCertificate())
+      ROS_WARN(
+          "tak_bridge: %s without a client certificate (~tls_client_p12 or "
+          "~tls_client_cert): a TAK Server's TLS input refuses the connection",
+          url.c_str());
+  }
 
   tracks_sub_ = nh.subscribe("cop/tracks", 5, &TakBridgeRos::onTracks, this);
   odom_sub_ = nh.subscribe("uav/odom", 5, &TakBridgeRos::onOdometry, this);
@@ -94,8 +123,9 @@ TakBridgeRos::TakBridgeRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   timer_ = nh.createWallTimer(ros::WallDuration(1.0 / rate), &TakBridgeRos::onTimer, this);
   std::string names;
   for (const auto& s : senders_) names += (names.empty() ? "" : ", ") + s->endpoint().url();
-  ROS_INFO("tak_bridge: CoT to %s at %.1f Hz, zones every %.0f s, origin %s", names.c_str(), rate,
-           zone_period_, origin_override_ ? "from ~origin_*" : "from the mission");
+  ROS_INFO("tak_bridge: CoT (%s) to %s at %.1f Hz, zones every %.0f s, origin %s", encoding.c_str(),
+           names.c_str(), rate, zone_period_,
+           origin_override_ ? "from ~origin_*" : "from the mission");
 }
 
 void TakBridgeRos::onTracks(const hameritt::CopTrackArray::ConstPtr& msg) { tracks_ = msg; }
@@ -118,9 +148,8 @@ void TakBridgeRos::onMission(const hameritt::Mission::ConstPtr& msg) {
 }
 
 void TakBridgeRos::broadcast(const cop::CotEvent& event) {
-  const std::string xml = cop::toXml(event);
   events_built_++;
-  for (const auto& s : senders_) s->send(xml);
+  for (const auto& s : senders_) s->send(event);
 }
 
 void TakBridgeRos::onTimer(const ros::WallTimerEvent&) {
@@ -158,11 +187,13 @@ void TakBridgeRos::warnUnreachable() {
   for (const auto& s : senders_) {
     const cop::TakSenderStats st = s->stats();
     if (st.connected || st.last_error.empty()) continue;
-    ROS_WARN_THROTTLE(5.0,
-                      "tak_bridge: %s unreachable (%s): %llu connect attempts, reconnect back-off "
-                      "%.1f s, %llu events dropped",
-                      s->endpoint().url().c_str(), st.last_error.c_str(),
-                      static_cast<unsigned long long>(st.connect_attempts), st.next_backoff_s,
+    // The reason itself was logged once when it first occurred.
+    ROS_WARN_THROTTLE(30.0,
+                      "tak_bridge: %s unreachable: %llu connect attempts (%llu TLS "
+                      "failures), reconnect back-off %.1f s, %llu events dropped",
+                      s->endpoint().url().c_str(),
+                      static_cast<unsigned long long>(st.connect_attempts),
+                      static_cast<unsigned long long>(st.tls_failures), st.next_backoff_s,
                       static_cast<unsigned long long>(st.dropped));
   }
 }
@@ -172,13 +203,14 @@ void TakBridgeRos::logSummary() const {
            static_cast<unsigned long long>(events_built_));
   for (const auto& s : senders_) {
     const cop::TakSenderStats st = s->stats();
-    const bool tcp = s->endpoint().protocol == cop::TakEndpoint::Protocol::kTcp;
+    const bool tcp = s->endpoint().stream();
     ROS_INFO("tak_bridge: summary: %s: %llu sent, %llu dropped, %llu send errors%s",
              s->endpoint().url().c_str(), static_cast<unsigned long long>(st.sent),
              static_cast<unsigned long long>(st.dropped),
              static_cast<unsigned long long>(st.send_errors),
              tcp ? (", " + std::to_string(st.connects) + " connects of " +
-                    std::to_string(st.connect_attempts) + " attempts")
+                    std::to_string(st.connect_attempts) + " attempts, " +
+                    std::to_string(st.tls_failures) + " TLS failures")
                        .c_str()
                  : "");
   }

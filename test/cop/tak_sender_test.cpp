@@ -82,12 +82,19 @@ TEST(TakEndpoint, ParsesUnicastMulticastAndTcpUrls) {
   EXPECT_EQ(t.protocol, TakEndpoint::Protocol::kTcp);
   EXPECT_EQ(t.host, "10.1.2.3");
   EXPECT_FALSE(t.multicast);
+  const TakEndpoint s = parseTakUrl("ssl://tak.example.org:8089");  // TLS: a DNS name too
+  EXPECT_EQ(s.protocol, TakEndpoint::Protocol::kSsl);
+  EXPECT_EQ(s.url(), "ssl://tak.example.org:8089");
+  EXPECT_TRUE(s.stream());
+  EXPECT_EQ(parseTakUrl("ssl://10.0.0.5:8089").host, "10.0.0.5");
 }
 
 TEST(TakEndpoint, RejectsMalformedUrlsNamingThem) {
-  for (const char* bad : {"http://1.2.3.4:5", "udp://1.2.3.4", "udp://1.2.3.4:0",
-                          "udp://1.2.3.4:70000", "udp://host.example:5", "tcp://", "tcp",
-                          "tcp://239.2.3.1:6969", "udp:/1.2.3.4:5", "udp://1.2.3.4:5x", ""}) {
+  for (const char* bad :
+       {"http://1.2.3.4:5", "udp://1.2.3.4", "udp://1.2.3.4:0", "udp://1.2.3.4:70000",
+        "udp://host.example:5", "tcp://", "tcp", "tcp://239.2.3.1:6969", "udp:/1.2.3.4:5",
+        "udp://1.2.3.4:5x", "", "ssl://", "ssl://tak_server:8089", "ssl://tak.example.org",
+        "ssl://239.2.3.1:8089", "tcp://tak.example.org:8087"}) {
     try {
       parseTakUrl(bad);
       ADD_FAILURE() << bad;
@@ -174,6 +181,39 @@ TEST(TakSender, UnreachableTcpServerBacksOffThenConnects) {
             "<event uid=\"e15\"/><event uid=\"e16\"/><event uid=\"e17\"/>"
             "<event uid=\"e18\"/><event uid=\"e19\"/>");
   EXPECT_TRUE(waitFor([&] { return sender.stats().connects == 1; }, 60.0));
+}
+
+// A server that closed the connection: the sender notices before it writes the next event,
+// which then goes out on a new connection (not lost, not counted as an error).
+TEST(TakSender, EventAfterTheServerClosedGoesOnTheNextConnection) {
+  LoopbackSocket server(SOCK_STREAM);
+  ASSERT_EQ(::listen(server.fd, 2), 0);
+  TakSenderConfig c;
+  c.reconnect_initial_s = 0.05;
+  TakSender sender(parseTakUrl("tcp://127.0.0.1:" + std::to_string(server.port)), c);
+  sender.send("<event uid=\"a\"/>");
+  pollfd p{server.fd, POLLIN, 0};
+  ASSERT_GT(::poll(&p, 1, 60000), 0);
+  int conn = ::accept(server.fd, nullptr, nullptr);
+  ASSERT_GE(conn, 0);
+  EXPECT_EQ(server.receive(conn, 60000), "<event uid=\"a\"/>");
+  ASSERT_TRUE(waitFor([&] { return sender.stats().sent == 1; }, 60.0));
+  ::close(conn);  // the server hangs up
+  // On loopback the FIN is in the sender's socket when close() returns; the pause is only a
+  // margin for that (no time is asserted).
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  sender.send("<event uid=\"b\"/>");
+  ASSERT_GT(::poll(&p, 1, 60000), 0);
+  conn = ::accept(server.fd, nullptr, nullptr);
+  ASSERT_GE(conn, 0);
+  EXPECT_EQ(server.receive(conn, 60000), "<event uid=\"b\"/>");
+  ::close(conn);
+  ASSERT_TRUE(waitFor([&] { return sender.stats().sent == 2; }, 60.0));
+  const TakSenderStats s = sender.stats();
+  EXPECT_EQ(s.connects, 2u);
+  EXPECT_EQ(s.send_errors, 0u);
+  EXPECT_EQ(s.dropped, 0u);
+  EXPECT_EQ(s.connect_attempts, 2u);
 }
 
 // The destructor wakes the thread from its back-off: with a one-hour back-off, a destructor that

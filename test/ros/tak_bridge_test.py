@@ -283,6 +283,10 @@ class TakBridgeTest(unittest.TestCase):
         self.assertTrue(any("tcp://127.0.0.1:%d unreachable" % self.tcp_port in w and
                             "back-off" in w for w in warnings), warnings)
         self.assertLess(len(warnings), 5, "the unreachable warning is not throttled")
+        # The reason itself is logged once (an error), however many attempts failed with it.
+        reasons = [m.msg for m in self.logs if m.name == "/tak_bridge" and m.level == Log.ERROR
+                   and "tcp://127.0.0.1:%d: connect: Connection refused" % self.tcp_port in m.msg]
+        self.assertEqual(len(reasons), 1, [m.msg for m in self.logs if m.name == "/tak_bridge"])
         self.assertIsNone(self.launch.poll(), "roslaunch exited")
         # A topic round trip through the bridge's callbacks: the UAV moves, the next UAV event
         # over UDP shows it (a liveness bound, generous for a loaded machine).

@@ -119,7 +119,7 @@ for m in "$R"/msg/*.msg "$R"/srv/*.srv; do
 done
 [[ $missing -eq 0 ]] && ok
 for p in hameritt_generate hameritt_validate hameritt_world hameritt_summary hameritt_check_path \
-         hameritt_map hameritt_render hameritt_export hameritt_campaign cot_listen.py \
+         hameritt_map hameritt_render hameritt_export hameritt_campaign cot_listen.py hameritt_tak_check \
          scenario_generator simulator planner path_player adk coverage_search_client \
          color_shape_detector cop tak_bridge; do
   [[ -x "$I/lib/hameritt/$p" ]] && ok || bad "$p not installed in lib/hameritt"

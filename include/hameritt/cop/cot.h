@@ -61,4 +61,8 @@ std::string isoTime(double unix_seconds);
 // The event as one XML document (no XML declaration: TAK streams events back to back).
 std::string toXml(const CotEvent& e);
 
+// The children of the event's <detail> element; without <contact> and <track> when
+// contact_and_track is false (TAK Protocol Version 1 carries those two as protobuf fields).
+std::string detailXml(const CotEvent& e, bool contact_and_track);
+
 }  // namespace hameritt::cop

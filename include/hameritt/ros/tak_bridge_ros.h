@@ -1,14 +1,18 @@
 #pragma once
 // The TAK bridge: sends the COP (cop/tracks), the UAV's own position (uav/odom) and the mission's
 // areas of interest and keep-out zones (mission) as Cursor-on-Target events to TAK endpoints
-// (UDP unicast/multicast, TCP to a TAK server). Sending happens on each endpoint's own thread
+// (UDP unicast/multicast, TCP or mutual TLS to a TAK server), as CoT XML or TAK Protocol
+// Version 1. Sending happens on each endpoint's own thread
 // (cop::TakSender): no ROS callback waits on the network.
 //
 // Topics (relative names): sub cop/tracks (hameritt/CopTrackArray), uav/odom (nav_msgs/Odometry,
 // map frame), mission (hameritt/Mission, latched).
 //
 // Parameters (private): ~endpoints (comma-separated URLs, e.g. "udp://127.0.0.1:6969,
-// tcp://10.0.0.5:8087"; "udp://" = multicast 239.2.3.1:6969, the default when unset), ~rate_hz (1:
+// tcp://10.0.0.5:8087,ssl://tak.example.org:8089"; "udp://" = multicast 239.2.3.1:6969, the
+// default when unset), ~encoding (xml | protobuf), ~tls_client_p12, ~tls_client_cert,
+// ~tls_client_key, ~tls_client_password, ~tls_trust_store, ~tls_trust_password,
+// ~tls_pin_sha256, ~tls_server_name (cop::TakTlsConfig, ssl:// endpoints), ~rate_hz (1:
 // UAV and tracks, wall time), ~zone_period_s (10), ~send_tentative (false: tentative tracks stay
 // off TAK unless believed to be a target), ~origin_latitude, ~origin_longitude, ~origin_altitude
 // (all three or none: overrides the mission's frame origin), ~uid_prefix, ~uav_callsign, ~stale_s,
