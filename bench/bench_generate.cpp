@@ -1,5 +1,5 @@
 // Benchmark: scenarios per second, all relations computed and files written.
-//   bench_generate [--count N] [--jobs J] [--out DIR]
+//   bench_generate [--count N] [--jobs J] [--out DIR] [--world suburb|city]
 // Default: 9000 scenarios of all three classes on every core, into a temporary directory
 // that is removed afterwards. Prints one line per figure.
 
@@ -37,17 +37,23 @@ std::uintmax_t dirBytes(const std::string& dir) {
 int main(int argc, char** argv) {
   int count = 9000;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::string out;
+  std::string out, world_type = "suburb";
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--count") count = std::stoi(argv[i + 1]);
     else if (a == "--jobs") jobs = std::stoi(argv[i + 1]);
     else if (a == "--out") out = argv[i + 1];
+    else if (a == "--world")
+      world_type = argv[i + 1];
   }
   const bool temp = out.empty();
   if (temp) out = fs::temp_directory_path().string() + "/hameritt_bench_" + std::to_string(::getpid());
 
-  const WorldParams wp = loadWorldParams(defaultConfigDir() + "/world.json");
+  WorldParams wp = loadWorldParams(defaultConfigDir() + "/world.json");
+  if (!parseWorldType(world_type, &wp.type)) {
+    std::fprintf(stderr, "bench_generate: --world: expected suburb or city\n");
+    return 2;
+  }
   const GeneratorConfig gc = loadGeneratorConfig(defaultConfigDir() + "/generator.json");
   auto t0 = std::chrono::steady_clock::now();
   const World world = generateWorld(wp);
@@ -89,6 +95,7 @@ int main(int argc, char** argv) {
   const double solo_s = seconds(t0);
 
   std::printf("machine_threads            %u\n", std::thread::hardware_concurrency());
+  std::printf("world_type                 %s\n", toString(wp.type));
   std::printf("world_entities             %zu\n", world.entities().size());
   std::printf("world_generation_ms        %.1f\n", world_s * 1e3);
   std::printf("batch_scenarios            %d (all classes, %d jobs)\n", count, jobs);

@@ -6,7 +6,8 @@
 // then the time per stage from a run that waits for the GL at the end of each stage, the GL
 // renderer, and the triangles and instances drawn per frame.
 //
-// Usage: bench_render [frame_sets] [--backend auto|surfaceless|device]
+// Usage: bench_render [frame_sets] [--backend auto|surfaceless|device] [--sim-config FILE]
+// (--sim-config: another scenario, e.g. one generated with hameritt_generate --world city)
 
 #include <sys/resource.h>
 
@@ -72,10 +73,13 @@ int main(int argc, char** argv) {
   int frames = 100;
   std::string backend = "auto";
   double lod_px = render::RendererOptions().lod_max_error_px;
+  std::string file = scenario::shareDir() + "/scenarios/default/sim_config.json";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--backend" && i + 1 < argc) {
       backend = argv[++i];
+    } else if (a == "--sim-config" && i + 1 < argc) {
+      file = argv[++i];
     } else if (a == "--lod" && i + 1 < argc) {
       lod_px = std::atof(argv[++i]);
     } else if (!a.empty() && a[0] != '-') {
@@ -83,11 +87,10 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_render [frame_sets] [--backend auto|surfaceless|device] "
-                   "[--lod MAX_ERROR_PX (0: full detail)]\n");
+                   "[--lod MAX_ERROR_PX (0: full detail)] [--sim-config FILE]\n");
       return 2;
     }
   }
-  const std::string file = scenario::shareDir() + "/scenarios/default/sim_config.json";
   const scenario::SimConfig cfg = scenario::loadSimConfig(file);
   const scenario::World world = scenario::generateCheckedWorld(cfg, file);
   if (!cfg.uav.perception_path || cfg.uav.perception_path->trajectory.empty()) {

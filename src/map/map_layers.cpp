@@ -11,11 +11,17 @@ void MapPainter::drawWorld(const scenario::World& world) {
   for (const auto& b : world.blocks()) {
     fill(b.interior.vertices(), kLawn, nullptr, lt);
   }
-  const int walk = std::max(1, static_cast<int>(std::lround(world.params().sidewalk_width * ppm)));
+  const int walk = std::max(1, static_cast<int>(std::lround(world.sidewalkWidth() * ppm)));
   for (const auto& b : world.blocks()) outline(b.sidewalk, false, kSidewalk, walk);
-  const EntityClass order[] = {EntityClass::kStreet, EntityClass::kDriveway, EntityClass::kHouse,
-                               EntityClass::kGarage, EntityClass::kFence,    EntityClass::kCar,
-                               EntityClass::kTree};
+  // The suburb's classes first, in their order; the city's classes (absent from a suburb)
+  // interleaved where they belong: surfaces under buildings, furniture on top.
+  const EntityClass order[] = {
+      EntityClass::kStreet,      EntityClass::kAlley,         EntityClass::kParkingLot,
+      EntityClass::kDriveway,    EntityClass::kHouse,         EntityClass::kGarage,
+      EntityClass::kBuilding,    EntityClass::kParkingGarage, EntityClass::kFence,
+      EntityClass::kCar,         EntityClass::kTree,          EntityClass::kStreetTree,
+      EntityClass::kBusStop,     EntityClass::kBench,         EntityClass::kLampPost,
+      EntityClass::kTrafficLight};
   for (EntityClass cls : order) {
     for (const auto& e : world.entities()) {
       if (e.cls != cls || !visible(e.box.bounds2())) continue;
@@ -23,8 +29,33 @@ void MapPainter::drawWorld(const scenario::World& world) {
       const std::vector<Vec2> poly(c.begin(), c.end());
       switch (cls) {
         case EntityClass::kStreet:
+        case EntityClass::kAlley:
           fill(poly, kStreet, nullptr, lt);
           break;
+        case EntityClass::kParkingLot:
+          fill(poly, kDriveway, nullptr, lt);
+          outline(poly, true, kGarageEdge, 1, lt);
+          break;
+        case EntityClass::kBuilding:
+        case EntityClass::kParkingGarage: {
+          // Darker with height: 1 at the ground, 0.45 at 150 m (towers stand out).
+          const double k = 1.0 - 0.55 * std::min(1.0, e.box.size.z() / 150.0);
+          const cv::Scalar base = cls == EntityClass::kBuilding ? kHouse : kGarage;
+          fill(poly, base * k, nullptr, lt);
+          outline(poly, true, cls == EntityClass::kBuilding ? kHouseEdge : kGarageEdge, 1, lt);
+          break;
+        }
+        case EntityClass::kBusStop:
+        case EntityClass::kBench:
+          fill(poly, kFence, nullptr, lt);
+          break;
+        case EntityClass::kLampPost:
+        case EntityClass::kTrafficLight: {
+          const int r = static_cast<int>(std::lround(std::max(1.0, 0.6 * ppm) * kOne));
+          cv::circle(img_, fx(e.box.center2()), r,
+                     cls == EntityClass::kTrafficLight ? kKozEdge : kText, cv::FILLED, lt, kShift);
+          break;
+        }
         case EntityClass::kDriveway:
           fill(poly, kDriveway, nullptr, lt);
           break;
@@ -46,7 +77,8 @@ void MapPainter::drawWorld(const scenario::World& world) {
         case EntityClass::kCar:
           fill(poly, kWorldCar, nullptr, lt);
           break;
-        case EntityClass::kTree: {
+        case EntityClass::kTree:
+        case EntityClass::kStreetTree: {
           const int r = static_cast<int>(std::lround(0.5 * e.box.size.x() * ppm * kOne));
           cv::circle(img_, fx(e.box.center2()), r, kTree, cv::FILLED, lt, kShift);
           cv::circle(img_, fx(e.box.center2()), r, kTreeEdge, 1, lt, kShift);

@@ -258,7 +258,7 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
   loadLods(dir, file_model);
   procedural_.uav = model("sentinel.obj");
   procedural_.ground = addModel(groundMesh(world.bounds()));
-  procedural_.sidewalks = addModel(sidewalkMesh(world.blocks(), world.params().sidewalk_width));
+  procedural_.sidewalks = addModel(sidewalkMesh(world.blocks(), world.sidewalkWidth()));
   procedural_.street =
       addModel(unitQuad("street", MaterialKind::kStreet, srgbToLinear(64, 65, 68)));
   procedural_.driveway =
@@ -289,6 +289,16 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     instances_.push_back(si);
   }
 
+  // Procedural boxes of the city classes, made on first use (a suburb scene has none).
+  std::unordered_map<std::string, int> city_model;
+  auto cityBox = [&](const std::string& name, MaterialKind kind, const Eigen::Vector3f& kd) {
+    auto it = city_model.find(name);
+    if (it != city_model.end()) return it->second;
+    const int m = addModel(unitBox(name, kind, kd));
+    lods_.resize(models_.size());
+    city_model[name] = m;
+    return m;
+  };
   int street_index = 0;
   auto add = [&](const scenario::Entity& e, int instance_id, int scenario_entity, bool mover) {
     SceneInstance si;
@@ -302,8 +312,37 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     std::string color_key;
     switch (e.cls) {
       case EntityClass::kStreet:
+      case EntityClass::kAlley:
         si.model = procedural_.street;
         lift = streetTopZ(street_index++) - e.box.minZ();  // the slab's top face only
+        break;
+      case EntityClass::kBuilding:
+        si.model = cityBox("building", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        color_key = "color";
+        break;
+      case EntityClass::kParkingGarage:
+        si.model =
+            cityBox("parking_garage", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        color_key = "color";
+        break;
+      case EntityClass::kParkingLot:
+        si.model = procedural_.driveway;
+        if (!paintColor("asphalt", &si.record.color)) {
+          throw RenderError(attributeError(e, "material", "asphalt"));
+        }
+        break;
+      case EntityClass::kLampPost:
+        si.model = cityBox("lamp_post", MaterialKind::kPlain, srgbToLinear(70, 72, 76));
+        break;
+      case EntityClass::kTrafficLight:
+        si.model = cityBox("traffic_light", MaterialKind::kPlain, srgbToLinear(30, 32, 30));
+        break;
+      case EntityClass::kBusStop:
+        si.model = cityBox("bus_stop", MaterialKind::kPlain, srgbToLinear(120, 150, 170));
+        break;
+      case EntityClass::kBench:
+        si.model = cityBox("bench", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        color_key = "color";
         break;
       case EntityClass::kDriveway: {
         si.model = procedural_.driveway;
@@ -330,7 +369,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
         color_key = "color";
         break;
       }
-      case EntityClass::kTree: {
+      case EntityClass::kTree:
+      case EntityClass::kStreetTree: {
         const std::string species = e.attributes.str("species");
         si.model = model(species == "pine" ? "tree_pine.obj" : "tree_deciduous.obj");
         // Foliage density: canopies scale about their centre by 0.35 + 0.65 * foliage, a

@@ -11,12 +11,30 @@ struct ClassName {
   int semantic;
 };
 constexpr ClassName kClassNames[] = {
-    {EntityClass::kStreet, "street", 2},     {EntityClass::kDriveway, "driveway", 3},
-    {EntityClass::kHouse, "house", 4},       {EntityClass::kGarage, "garage", 5},
-    {EntityClass::kFence, "fence", 6},       {EntityClass::kTree, "tree", 7},
-    {EntityClass::kCar, "car", 8},           {EntityClass::kPedestrian, "pedestrian", 9},
+    {EntityClass::kStreet, "street", 2},
+    {EntityClass::kDriveway, "driveway", 3},
+    {EntityClass::kHouse, "house", 4},
+    {EntityClass::kGarage, "garage", 5},
+    {EntityClass::kFence, "fence", 6},
+    {EntityClass::kTree, "tree", 7},
+    {EntityClass::kCar, "car", 8},
+    {EntityClass::kPedestrian, "pedestrian", 9},
+    {EntityClass::kBuilding, "building", 11},
+    {EntityClass::kParkingGarage, "parking_garage", 12},
+    {EntityClass::kParkingLot, "parking_lot", 13},
+    {EntityClass::kAlley, "alley", 14},
+    {EntityClass::kLampPost, "lamp_post", 15},
+    {EntityClass::kTrafficLight, "traffic_light", 16},
+    {EntityClass::kBusStop, "bus_stop", 17},
+    {EntityClass::kBench, "bench", 18},
+    {EntityClass::kStreetTree, "street_tree", 19},
 };
 }  // namespace
+
+bool isSurfaceClass(EntityClass c) {
+  return c == EntityClass::kStreet || c == EntityClass::kDriveway ||
+         c == EntityClass::kParkingLot || c == EntityClass::kAlley;
+}
 
 const char* toString(EntityClass c) {
   for (const auto& n : kClassNames) {

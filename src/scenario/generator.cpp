@@ -769,7 +769,7 @@ class ScenarioBuilder {
       }
       const auto& e = world_.edges()[static_cast<std::size_t>(best)];
       const Vec2 a = world_.nodes()[e.a].position, b = world_.nodes()[e.b].position;
-      const double w = e.width + 2 * world_.params().sidewalk_width;
+      const double w = e.width + 2 * world_.sidewalkWidth();
       KeepOutZone k = makeKoz(geometry::orientedRectangle(0.5 * (a + b), std::max(10.0, (b - a).norm() - e.width), w,
                                                           std::atan2((b - a).y(), (b - a).x())),
                               "vantage_denial");

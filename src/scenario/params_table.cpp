@@ -124,6 +124,11 @@ class ObjectReader {
   ObjectReader(const json& j, std::string where) : j_(j), where_(std::move(where)) {
     if (!j_.is_object()) throw ConfigError(where_ + ": expected an object, got " + j_.type_name());
   }
+  // True when the (optional) key is present; marks it as known.
+  bool has(const std::string& key) {
+    seen_.insert(key);
+    return j_.contains(key);
+  }
   const json& at(const std::string& key) {
     seen_.insert(key);
     if (!j_.contains(key)) throw ConfigError(where_ + "." + key + ": missing required key");
@@ -185,7 +190,14 @@ class ObjectReader {
 void writeWorldParams(JsonWriter& w, const WorldParams& p) {
   w.beginObject();
   w.key("seed").value(p.seed);
+  // The suburb (the default type) writes no "type" and no "city" key.
+  if (p.type != WorldType::kSuburb) w.key("type").value(std::string(toString(p.type)));
   for (const auto& f : kWorldFields) w.key(f.key).value(p.*(f.member));
+  if (p.type == WorldType::kCity) {
+    w.key("city").beginObject();
+    for (const auto& f : cityFieldTable()) w.key(f.key).value(p.city.*(f.member));
+    w.endObject();
+  }
   w.endObject();
 }
 
@@ -193,7 +205,24 @@ WorldParams worldParamsFromJson(const json& j, const std::string& file) {
   ObjectReader r(j, file + ": world");
   WorldParams p;
   p.seed = r.unsignedInteger("seed");
+  if (r.has("type")) {
+    const json& t = r.at("type");
+    if (!t.is_string() || !parseWorldType(t.get<std::string>(), &p.type)) {
+      throw ConfigError(r.where() + ".type: expected \"suburb\" or \"city\", got " + t.dump());
+    }
+  }
   for (const auto& f : kWorldFields) p.*(f.member) = r.number(f.key);
+  if (r.has("city")) {
+    if (p.type != WorldType::kCity) {
+      throw ConfigError(r.where() + ".city: only allowed with \"type\": \"city\"");
+    }
+    // Every city key is optional: a missing one keeps its default.
+    ObjectReader c(r.at("city"), r.where() + ".city");
+    for (const auto& f : cityFieldTable()) {
+      if (c.has(f.key)) p.city.*(f.member) = c.number(f.key);
+    }
+    c.finish();
+  }
   r.finish();
   try {
     p.validate();

@@ -38,7 +38,7 @@ void RelationConfig::validate() const {
 }
 
 bool operatorApplies(RelationOp op, EntityClass c) {
-  const bool surface = c == EntityClass::kStreet || c == EntityClass::kDriveway;
+  const bool surface = isSurfaceClass(c);
   switch (op) {
     case RelationOp::kOnTopOf:
     case RelationOp::kNotOnTopOf:
@@ -109,7 +109,7 @@ RelationFacts RelationEvaluator::measure(const Subject& target, const Subject& r
   f.over =
       d.squaredNorm() <= corner * corner && related.box.footprint().contains(target.box.center2());
   // Sight only matters for the operators that need it; surfaces are never occluded.
-  if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
+  if (isSurfaceClass(related.cls)) {
     f.line_of_sight = true;
   } else if (f.distance <= config_.radius) {
     f.line_of_sight = lineOfSight(target, related);
@@ -125,7 +125,7 @@ RelationFacts RelationEvaluator::measureSideways(const Subject& target, const Su
   f.bearing_deg =
       geometry::wrapDeg360(geometry::radToDeg(std::atan2(d.y(), d.x()) - target.box.yaw));
   f.dz = target.box.minZ() - related.box.maxZ();
-  if (related.cls == EntityClass::kStreet || related.cls == EntityClass::kDriveway) {
+  if (isSurfaceClass(related.cls)) {
     f.line_of_sight = true;
   } else if (f.distance <= config_.radius) {
     const double tol = config_.bearing_tolerance_deg;

@@ -8,6 +8,7 @@
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
+#include "world_entities.h"
 
 namespace hameritt::scenario {
 
@@ -70,8 +71,6 @@ Polygon insetConvex(const Polygon& poly, double by) {
   return Polygon(out);
 }
 
-Vec3 roundVec(const Vec3& v) { return {roundMilli(v.x()), roundMilli(v.y()), roundMilli(v.z())}; }
-
 class WorldBuilder {
  public:
   WorldBuilder(const WorldParams& p, World* w) : p_(p), rng_(deriveSeed(p.seed, 0x574F524C44ULL)), w_(w) {}
@@ -91,15 +90,8 @@ class WorldBuilder {
  private:
   int addEntity(EntityClass cls, const std::string& prefix, const Vec3& bottom, double yaw,
                 const Vec3& size, Attributes attrs, int block) {
-    Entity e;
-    int& counter = counters_[static_cast<int>(cls)];
-    e.id = prefix + "_" + std::to_string(++counter);
-    e.cls = cls;
-    e.attributes = std::move(attrs);
-    e.box = boxFromPose(roundVec(bottom), roundMilli(geometry::wrapPi(yaw)), roundVec(size));
-    e.block = block;
-    entities_->push_back(std::move(e));
-    return static_cast<int>(entities_->size()) - 1;
+    return world_entities::appendEntity(entities_, &counters_, cls, prefix, bottom, yaw, size,
+                                        std::move(attrs), block);
   }
 
   void buildGrid(std::vector<StreetNode>* nodes, std::vector<StreetEdge>* edges,
@@ -359,48 +351,14 @@ class WorldBuilder {
       if (e.cls == EntityClass::kDriveway) driveways.add(e.box);
     }
     driveways.build();
-    for (int ei = 0; ei < static_cast<int>(edges.size()); ++ei) {
-      const auto& e = edges[ei];
-      const Vec2 a = nodes[e.a].position, b = nodes[e.b].position;
-      const double len = (b - a).norm();
-      const Vec2 u = (b - a) / len;
-      const Vec2 n(-u.y(), u.x());
-      for (int side = -1; side <= 1; side += 2) {
-        const double offset = 0.5 * e.width - 1.05;
-        // Right-hand traffic: cars on the right of the travel direction face along it.
-        const double yaw = side < 0 ? std::atan2(u.y(), u.x()) : std::atan2(-u.y(), -u.x());
-        for (double s = 0.5 * e.width + 8.0; s < len - 0.5 * e.width - 8.0; s += 7.0) {
-          const Vec2 c = a + s * u + side * offset * n;
-          if (!driveways.near(c, 4.5).empty()) continue;
-          ParkingSlot slot;
-          slot.position = Vec2(roundMilli(c.x()), roundMilli(c.y()));
-          slot.yaw = roundMilli(geometry::wrapPi(yaw));
-          slot.ground_z = 0.0;
-          slot.edge = ei;
-          const Vec2 probe = c + side * (0.5 * e.width + 3.0) * n;
-          slot.block = -1;
-          for (const auto& bl : blocks) {
-            if (bl.outline.contains(probe)) slot.block = bl.index;
-          }
-          slots_->push_back(slot);
-        }
-      }
-    }
+    world_entities::addKerbSlots(
+        nodes, edges, blocks, driveways, 4.5, 7.0,
+        [](const StreetEdge& e) { return 0.5 * e.width + 8.0; }, slots_);
   }
 
   void parkWorldCars() {
-    for (auto& s : *slots_) {
-      const double p = s.driveway ? p_.driveway_car_probability : p_.street_parking_probability;
-      if (!rng_.bernoulli(p)) continue;
-      const auto& model = catalog::pickModel(rng_);
-      Attributes a;
-      a.set("vehicle_class", model.vehicle_class);
-      a.set("make", model.make);
-      a.set("model", model.model);
-      a.set("color", catalog::pick(rng_, catalog::carColors()));
-      s.occupant = addEntity(EntityClass::kCar, "car", Vec3(s.position.x(), s.position.y(), s.ground_z),
-                             s.yaw, Vec3(model.length, model.width, model.height), a, s.block);
-    }
+    world_entities::parkCars(rng_, p_.driveway_car_probability, p_.street_parking_probability,
+                             slots_, entities_, &counters_);
   }
 
   const WorldParams& p_;
@@ -410,7 +368,7 @@ class WorldBuilder {
   std::vector<ParkingSlot>* slots_ = nullptr;
   std::vector<double> xs_, ys_;
   int nx_ = 0, ny_ = 0;
-  int counters_[16] = {};
+  world_entities::EntityCounters counters_;
   int house_numbers_ = 0;
   std::size_t lot_first_entity_ = 0;
   std::string street_name_;
@@ -428,6 +386,19 @@ std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t n) {
 }  // namespace
 
 void WorldParams::validate() const {
+  if (type == WorldType::kCity) {
+    // The city is a tile of 0.5 to 2 km a side; the suburb fields below stay checked so that
+    // a file can switch type without other edits.
+    for (const auto& [key, v] : {std::pair<const char*, double>{"extent_x", extent_x},
+                                 std::pair<const char*, double>{"extent_y", extent_y}}) {
+      if (!(v >= 500.0 && v <= 2000.0)) {
+        std::ostringstream os;
+        os << "world." << key << ": expected 500 to 2000 (m) for the city, got " << v;
+        throw ConfigError(os.str());
+      }
+    }
+    city.validate();
+  }
   requirePositive("extent_x", extent_x);
   requirePositive("extent_y", extent_y);
   requirePositive("block_length_min", block_length_min);
@@ -472,11 +443,10 @@ void WorldParams::validate() const {
 }
 
 std::vector<OrientedBox> occluderBoxes(const Entity& e) {
+  if (isSurfaceClass(e.cls)) return {};
   switch (e.cls) {
-    case EntityClass::kStreet:
-    case EntityClass::kDriveway:
-      return {};
-    case EntityClass::kTree: {
+    case EntityClass::kTree:
+    case EntityClass::kStreetTree: {
       // Trunk under the lower third, canopy above it.
       const double h = e.box.size.z();
       const double base = e.box.minZ();
@@ -533,12 +503,26 @@ void World::finish() {
   fingerprint_ = h;
 }
 
+double World::sidewalkWidth() const {
+  return params_.type == WorldType::kCity ? params_.city.sidewalk_width : params_.sidewalk_width;
+}
+
+double World::maxStreetWidth() const {
+  double w = 0.0;
+  for (const auto& e : edges_) w = std::max(w, e.width);
+  return w;
+}
+
 World generateWorld(const WorldParams& params) {
   params.validate();
   World w;
   w.params_ = params;
-  WorldBuilder builder(w.params_, &w);
-  builder.build(&w.entities_, &w.nodes_, &w.edges_, &w.blocks_, &w.slots_, &w.bounds_);
+  if (params.type == WorldType::kCity) {
+    buildCityWorld(params, &w);
+  } else {
+    WorldBuilder builder(w.params_, &w);
+    builder.build(&w.entities_, &w.nodes_, &w.edges_, &w.blocks_, &w.slots_, &w.bounds_);
+  }
   w.adjacency_.assign(w.nodes_.size(), {});
   for (int i = 0; i < static_cast<int>(w.edges_.size()); ++i) {
     w.adjacency_[w.edges_[i].a].push_back(i);

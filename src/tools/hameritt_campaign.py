@@ -145,7 +145,7 @@ def parse_config(text, path="campaign.yaml"):
     except yaml.YAMLError as e:
         raise CampaignError("%s: not valid YAML: %s" % (path, str(e).replace("\n", " ")))
     _expect(isinstance(raw, dict), path, "(top level)", "a mapping", raw)
-    known = {"name", "seed", "classes", "count", "shards", "generate", "missions", "slurm"}
+    known = {"name", "seed", "classes", "count", "shards", "world", "generate", "missions", "slurm"}
     for k in raw:
         _expect(k in known, path, k, "one of " + ", ".join(sorted(known)), "unknown field")
     name = raw.get("name", "campaign")
@@ -158,6 +158,11 @@ def parse_config(text, path="campaign.yaml"):
         "count": _int_field(raw, path, "count", None, 1, 10000000),
         "shards": _int_field(raw, path, "shards", 1, 1, 10000),
     }
+    # The world type (hameritt_generate --world); kept out of the plan when it is the default.
+    world = raw.get("world", "suburb")
+    _expect(world in ("suburb", "city"), path, "world", "suburb or city", world)
+    if world != "suburb":
+        cfg["world"] = world
     gen = raw.get("generate", {}) or {}
     _expect(isinstance(gen, dict), path, "generate", "a mapping", gen)
     for k in gen:
@@ -403,11 +408,16 @@ def finish_unit(work, final, record):
         raise
 
 
+def world_args(cfg):
+    """hameritt_generate's --world flag for a campaign that names a world type."""
+    return ["--world", cfg["world"]] if "world" in cfg else []
+
+
 def run_generate_unit(cfg, unit, work, log):
     cmd = [os.path.join(tool_dir(), "hameritt_generate"), "--class", ",".join(cfg["classes"]),
            "--count", str(unit["count"]), "--first", str(unit["first"]), "--seed",
            str(cfg["seed"]), "--out", os.path.join(work, "scenarios"), "--jobs",
-           str(cfg["generate"]["jobs"]), "--quiet"]
+           str(cfg["generate"]["jobs"]), "--quiet"] + world_args(cfg)
     r = subprocess.run(cmd, stdout=log, stderr=log)
     if r.returncode != 0:
         raise RuntimeError("hameritt_generate exited %d" % r.returncode)
@@ -472,7 +482,7 @@ def run_mission_unit(cfg, unit, work, log, task_id, slot):
     # The scenario alone (--first INDEX --count 1): byte-identical to the batch's, no shared state.
     cmd = [os.path.join(tool_dir(), "hameritt_generate"), "--class", ",".join(cfg["classes"]),
            "--count", "1", "--first", str(unit["scenario_index"]), "--seed", str(cfg["seed"]),
-           "--out", gen, "--jobs", "1", "--quiet"]
+           "--out", gen, "--jobs", "1", "--quiet"] + world_args(cfg)
     r = subprocess.run(cmd, stdout=log, stderr=log)
     if r.returncode != 0:
         raise RuntimeError("hameritt_generate exited %d" % r.returncode)

@@ -1,6 +1,7 @@
 // hameritt_generate: random scenarios as mission.json + sim_config.json, with a manifest.
 //   hameritt_generate --class area_search|route_search|pursuit|all --count N --seed S --out DIR
-//                     [--first K] [--jobs J] [--world-config FILE] [--generator-config FILE]
+//                     [--first K] [--jobs J] [--world-config FILE] [--world suburb|city]
+//                     [--generator-config FILE]
 //   hameritt_generate --class CLASS --scenario-seed S --out DIR   (regenerates one scenario)
 // Exit codes: 0 success, 2 bad input or unwritable output, 1 generation failure.
 
@@ -20,11 +21,13 @@ namespace {
 
 const char* kUsage =
     "usage: hameritt_generate --class CLASS --count N --seed S --out DIR [--first K] [--jobs J]\n"
-    "                         [--world-config FILE] [--generator-config FILE] [--quiet]\n"
+    "                         [--world-config FILE] [--world suburb|city]\n"
+    "                         [--generator-config FILE] [--quiet]\n"
     "       hameritt_generate --class CLASS --scenario-seed S --out DIR   (one scenario, seed S)\n"
     "  CLASS: area_search, route_search, pursuit, all, or a comma-separated list\n"
     "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n"
-    "  --first K: write only indices K..K+N-1 of the batch (a shard), byte-identical to them.\n";
+    "  --first K: write only indices K..K+N-1 of the batch (a shard), byte-identical to them.\n"
+    "  --world: the world type, overriding the world config's \"type\" (default suburb).\n";
 
 std::uint64_t parseUnsigned(const std::string& flag, const std::string& v) {
   if (v.empty() || v[0] == '-' || v.find_first_not_of("0123456789") != std::string::npos) {
@@ -49,7 +52,7 @@ long parseCount(const std::string& flag, const std::string& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string cls, out, world_cfg = defaultConfigDir() + "/world.json";
+  std::string cls, out, world_type, world_cfg = defaultConfigDir() + "/world.json";
   std::string gen_cfg = defaultConfigDir() + "/generator.json";
   long count = -1, first = 0;
   std::uint64_t seed = 0;
@@ -75,6 +78,8 @@ int main(int argc, char** argv) {
       } else if (a == "--out") out = next();
       else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
       else if (a == "--world-config") world_cfg = next();
+      else if (a == "--world")
+        world_type = next();
       else if (a == "--generator-config") gen_cfg = next();
       else if (a == "--quiet") quiet = true;
       else if (a == "-h" || a == "--help") {
@@ -98,7 +103,13 @@ int main(int argc, char** argv) {
     req.out_dir = out;
     req.jobs = jobs;
     req.exact_seed = exact;
-    const WorldParams wp = loadWorldParams(world_cfg);
+    WorldParams wp = loadWorldParams(world_cfg);
+    if (!world_type.empty()) {
+      if (!parseWorldType(world_type, &wp.type)) {
+        throw ConfigError("--world: expected suburb or city, got '" + world_type + "'");
+      }
+      wp.validate();
+    }
     const GeneratorConfig gc = loadGeneratorConfig(gen_cfg);
     const auto t0 = std::chrono::steady_clock::now();
     const World world = generateWorld(wp);

@@ -240,6 +240,15 @@ cv::Vec3b semanticColor(int id) {
       {0, 60, 230},     // 8 car
       {220, 20, 200},   // 9 pedestrian
       {255, 255, 255},  // 10 uav
+      {180, 70, 60},    // 11 building
+      {200, 130, 40},   // 12 parking_garage
+      {150, 130, 140},  // 13 parking_lot
+      {100, 50, 100},   // 14 alley
+      {230, 230, 0},    // 15 lamp_post
+      {250, 60, 0},     // 16 traffic_light
+      {0, 170, 200},    // 17 bus_stop
+      {140, 90, 40},    // 18 bench
+      {80, 180, 60},    // 19 street_tree
   };
   const int n = static_cast<int>(sizeof(kPalette) / sizeof(kPalette[0]));
   const int* c = kPalette[id >= 0 && id < n ? id : 0];

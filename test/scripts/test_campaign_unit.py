@@ -76,6 +76,7 @@ class ConfigTest(unittest.TestCase):
             ("name: 'a b'\nseed: 1\ncount: 3", "field 'name'"),
             ("[1, 2]", "(top level)"),
             ("seed: [", "not valid YAML"),
+            ("seed: 1\ncount: 3\nworld: metropolis", "field 'world'"),
         ]
         for text, want in cases:
             with self.assertRaises(hc.CampaignError, msg=text) as e:
@@ -271,6 +272,18 @@ class GenerationCampaignTest(unittest.TestCase):
         with redirect_stdout(out), redirect_stderr(err):
             rc = hc.main(list(argv))
         return rc, out.getvalue() + err.getvalue()
+
+    def test_city_world(self):
+        # "world: city" reaches hameritt_generate; the default adds nothing to the plan.
+        self.assertNotIn("world", cfg_of())
+        cfg = os.path.join(self.d, "city.yaml")
+        wr(cfg, "name: c\nseed: 5\nclasses: [area_search]\ncount: 2\nworld: city\n")
+        cdir = os.path.join(self.d, "city")
+        self.assertEqual(self.run_main("plan", cfg, "--out", cdir)[0], 0)
+        self.assertEqual(hc.run_shard(cdir, 0), 0)
+        self.assertEqual(self.run_main("merge", cdir)[0], 0)
+        with open(os.path.join(cdir, "merged", "world.json")) as f:
+            self.assertEqual(json.load(f)["params"]["type"], "city")
 
     def test_sharded_equals_unsharded(self):
         text = "name: g\nseed: 5\nclasses: [pursuit, area_search]\ncount: 24\nshards: %d\n"

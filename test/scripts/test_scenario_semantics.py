@@ -36,7 +36,7 @@ MIN_CHECKS = 1000
 EVIDENCE_TOL = 2e-3
 # Slack for band containment: none. Targets start well inside their band, not on its edge.
 ROUND_EPS = 0.0
-SURFACES = ("street", "driveway")
+SURFACES = ("street", "driveway", "parking_lot", "alley")
 DIRECTIONAL = {"LEFT_OF": (90.0,), "IN_FRONT_OF": (180.0,), "RIGHT_OF": (270.0,),
                "ORTHOGONAL_TO": (90.0, 270.0)}
 BASE_OPS = ("NEXT_TO", "NOT_NEXT_TO", "ON_TOP_OF", "NOT_ON_TOP_OF", "LEFT_OF", "RIGHT_OF",
@@ -311,7 +311,7 @@ def occluder_boxes(e):
     if e.cls in SURFACES:
         return []
     b = e.box0
-    if e.cls == "tree":
+    if e.cls in ("tree", "street_tree"):
         h = b.h
         return [Box(b.x, b.y, b.z, b.yaw, 0.4, 0.4, h / 3.0),
                 Box(b.x, b.y, b.z + h / 3.0, b.yaw, b.l, b.w, h * 2.0 / 3.0)]
@@ -1076,7 +1076,8 @@ def load(path):
         return json.load(f)
 
 
-def main():
+def main(world="suburb", count=150, min_checks=MIN_CHECKS):
+    """Checks a batch of `count` scenarios generated with --world `world`."""
     start = time.time()
     bin_dir = env_dir("HAMERITT_BIN_DIR")
     src_dir = env_dir("HAMERITT_SOURCE_DIR")
@@ -1086,7 +1087,8 @@ def main():
     ck = Checker()
     tmp = tempfile.mkdtemp(prefix="hameritt_semantics_")
     try:
-        cmd = [exe, "--class", "all", "--count", "150", "--seed", "99", "--out", tmp, "--quiet"]
+        cmd = [exe, "--class", "all", "--count", str(count), "--seed", "99", "--out", tmp, "--quiet",
+               "--world", world]
         proc = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
         if proc.returncode != 0:
             print("test_scenario_semantics: %s failed (%d): %s" % (" ".join(cmd), proc.returncode, proc.stderr.strip()))
@@ -1122,8 +1124,8 @@ def main():
         self_checks(wctx, fingerprint, docs, ck)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    if real_checks < MIN_CHECKS:
-        print("FAIL [guard] only %d checks ran on the batch (want at least %d)" % (real_checks, MIN_CHECKS))
+    if real_checks < min_checks:
+        print("FAIL [guard] only %d checks ran on the batch (want at least %d)" % (real_checks, min_checks))
         ck.failed += 1
     print("(%d scenarios, %d checks on the batch, %.1f s)" % (len(docs), real_checks, time.time() - start))
     print("%d passed, %d failed" % (ck.passed, ck.failed))

@@ -21,7 +21,21 @@ enum class EntityClass {
   kTree,
   kCar,
   kPedestrian,
+  // City classes (the city world type).
+  kBuilding,       // a mid-rise building or tower on a city lot
+  kParkingGarage,  // a multi-storey car park
+  kParkingLot,     // a surface car park (a surface, like a driveway)
+  kAlley,          // a mid-block service alley (a surface, like a street)
+  kLampPost,
+  kTrafficLight,  // a signal mast at an arterial intersection
+  kBusStop,       // a bus shelter on an arterial sidewalk
+  kBench,
+  kStreetTree,  // a sidewalk tree in a pit at the kerb
 };
+
+// True for the classes that are driving or parking surfaces (street, driveway, parking_lot,
+// alley): they occlude nothing and relations treat them as ground to stand on.
+bool isSurfaceClass(EntityClass c);
 
 // Lower-case name used in JSON ("street", "driveway", "house", ...).
 const char* toString(EntityClass c);

@@ -15,8 +15,67 @@
 
 namespace hameritt::scenario {
 
+// Which kind of place generateWorld() builds.
+enum class WorldType {
+  kSuburb,  // 1-2 storey houses on large lots (the default)
+  kCity,    // a dense downtown grid: mid-rise blocks, towers, alleys, street furniture
+};
+
+// Parameters of the city world type (the "city" object of config/world.json); used only when
+// WorldParams::type is kCity. Lengths in metres. Every field has an allowed range, listed in
+// cityFieldTable(); validate() names the key and that range.
+struct CityParams {
+  double arterial_width = 24.0;     // right-of-way of the 4-lane arterials, [20, 30]
+  double arterial_every = 3.0;      // every n-th street of each direction is an arterial, [2, 6]
+  double local_width = 14.0;        // right-of-way of local streets, [12, 18]
+  double alley_width = 5.0;         // mid-block service alleys, [4, 6]
+  double sidewalk_width = 3.0;      // [1.8, 6]
+  double block_length_min = 120.0;  // spacing of north-south streets, within [60, 200]
+  double block_length_max = 170.0;
+  double block_depth_min = 85.0;  // spacing of east-west streets, within [60, 120]
+  double block_depth_max = 110.0;
+  double intersection_jitter = 2.0;  // [0, 5]
+  double lot_frontage_min = 12.0;    // within [10, 30]
+  double lot_frontage_max = 26.0;
+  double storey_height = 3.5;      // [2.8, 4.5]
+  double median_storeys = 7.0;     // median of the lognormal storey count, [6, 8]
+  double storeys_sigma = 0.35;     // log-space standard deviation, [0.1, 0.8]
+  double tower_share = 0.07;       // share of buildings that are towers, [0.05, 0.10]
+  double tower_height_min = 60.0;  // within [60, 150]
+  double tower_height_max = 150.0;
+  double downtown_radius = 300.0;  // towers stand within this distance of the centre, [100, 1000]
+  double parking_garage_share = 0.04;        // share of lots holding a parking garage, [0, 0.2]
+  double surface_lot_share = 0.04;           // share of lots holding a surface car park, [0, 0.2]
+  double street_parking_probability = 0.45;  // per kerb slot on local streets, [0, 1]
+  double lot_parking_probability = 0.6;      // per surface-lot stall, [0, 1]
+  double lamp_spacing = 30.0;                // lamp posts along each kerb, [15, 60]
+  double tree_spacing = 15.0;                // street trees along local-street kerbs, [6, 40]
+  double bench_probability = 0.3;            // per block side, [0, 1]
+  double bus_stop_probability = 0.6;         // per arterial block side, [0, 1]
+
+  // Throws ConfigError "world.city.KEY: expected LO to HI, got V" for the first bad field.
+  void validate() const;
+};
+
+// One row of the city parameter table: JSON key, member and allowed range.
+struct CityField {
+  const char* key;
+  double CityParams::*member;
+  double min;
+  double max;
+};
+// Every CityParams field with its allowed range, in JSON order.
+const std::vector<CityField>& cityFieldTable();
+
+// "suburb" or "city".
+const char* toString(WorldType t);
+// Parses "suburb" or "city"; returns false for anything else.
+bool parseWorldType(const std::string& s, WorldType* out);
+
 // World generation parameters (config/world.json). Lengths in metres.
 struct WorldParams {
+  WorldType type = WorldType::kSuburb;  // written only when not the default
+  CityParams city;                      // used (and written) only for kCity
   std::uint64_t seed = 1;
   double extent_x = 1000.0;  // east-west size, centred on the ENU origin
   double extent_y = 1000.0;  // north-south size
@@ -106,7 +165,13 @@ class World {
   // consumer that regenerates the world can check it got the same one.
   std::uint64_t fingerprint() const { return fingerprint_; }
 
+  // Sidewalk width of this world type (WorldParams::sidewalk_width or city.sidewalk_width).
+  double sidewalkWidth() const;
+  // Widest street right-of-way of the network.
+  double maxStreetWidth() const;
+
   friend World generateWorld(const WorldParams& params);
+  friend void buildCityWorld(const WorldParams& params, World* world);
 
  private:
   void finish();
@@ -127,8 +192,13 @@ class World {
   std::uint64_t fingerprint_ = 0;
 };
 
-// Generates the neighborhood for `params` (validated first).
+// Generates the neighborhood for `params` (validated first): the suburb, or the city of
+// src/scenario/city_world.cpp when params.type is kCity.
 World generateWorld(const WorldParams& params);
+
+// Fills `world` (fresh) with the city of params.city, on the tile extent_x by extent_y; called
+// by generateWorld().
+void buildCityWorld(const WorldParams& params, World* world);
 
 // Occluder boxes that stand for an entity in line-of-sight tests: a tree is a thin trunk under
 // a canopy box, every other solid object its own box; streets and driveways occlude nothing.
