@@ -11,8 +11,8 @@
 #include <string>
 #include <thread>
 
-#include "hameritt/scenario/batch.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/batch.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 
 using namespace hameritt::scenario;

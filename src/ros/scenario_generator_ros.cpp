@@ -2,7 +2,7 @@
 
 #include <thread>
 
-#include "hameritt/scenario/batch.h"
+#include "hameritt/generation/batch.h"
 #include "hameritt/scenario/error.h"
 
 namespace hameritt::ros_wrappers {
