@@ -15,6 +15,7 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/trajectory.h"
+#include "hameritt/generation/target_slots.h"
 
 namespace hameritt::scenario {
 
@@ -50,28 +51,6 @@ Polygon roundPolygon(const Polygon& p) {
 }
 
 double rangeDraw(Rng& rng, const Range& r) { return r.max > r.min ? rng.uniform(r.min, r.max) : r.min; }
-
-constexpr double kPullOut = 10.0;  // metres along the street for a pursuit target to reach its lane
-
-// True for points at least 20 m inside the neighborhood, where an AOI around them fits.
-bool insideBy20(const World& world, const Vec2& p) {
-  const auto b = world.bounds();
-  return p.x() > b.min.x() + 20 && p.x() < b.max.x() - 20 && p.y() > b.min.y() + 20 &&
-         p.y() < b.max.y() - 20;
-}
-
-// A pursuit target's kerb slot: in a block, well inside, with room ahead to pull out into the
-// lane before the corner.
-bool pursuitSlotFits(const World& world, const ParkingSlot& s) {
-  if (s.block < 0 || !insideBy20(world, s.position)) return false;
-  const auto& e = world.edges()[static_cast<std::size_t>(s.edge)];
-  const Vec2 a = world.nodes()[e.a].position, b = world.nodes()[e.b].position;
-  const Vec2 f(std::cos(s.yaw), std::sin(s.yaw));
-  const Vec2 from = (b - a).dot(f) > 0 ? a : b;
-  const double along = (s.position - from).dot(f);
-  const double corner_clearance = 0.5 * world.params().street_width + 1.0;
-  return along + kPullOut < (b - a).norm() - corner_clearance - 2.0;
-}
 
 class ScenarioBuilder {
  public:
@@ -1371,20 +1350,6 @@ class ScenarioBuilder {
 };
 
 }  // namespace
-
-bool targetSlotAllowed(const World& world, int slot, ScenarioClass cls) {
-  const ParkingSlot& s = world.slots()[static_cast<std::size_t>(slot)];
-  if (s.occupant >= 0) return false;
-  switch (cls) {
-    case ScenarioClass::kAreaSearch:
-      return insideBy20(world, s.position);
-    case ScenarioClass::kPursuit:
-      return !s.driveway && pursuitSlotFits(world, s);
-    case ScenarioClass::kRouteSearch:
-      return false;
-  }
-  return false;
-}
 
 Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
                           std::uint64_t seed, const ScenarioPlan* plan) {

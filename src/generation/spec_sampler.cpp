@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <numeric>
 
+#include "hameritt/generation/target_slots.h"
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/relations.h"
 #include "hameritt/scenario/rng.h"
@@ -360,7 +361,8 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
                                                   const scenario::GeneratorConfig& base,
                                                   const scenario::Mission& mission,
                                                   const scenario::SimConfig& sim,
-                                                  std::vector<RequirementCheck>* soft) {
+                                                  std::vector<RequirementCheck>* soft,
+                                                  bool require_listed) {
   std::vector<std::string> fails;
   auto fail = [&](const std::string& s) { fails.push_back(s); };
   if (sim.cls != spec.cls || mission.cls != spec.cls) {
@@ -465,7 +467,7 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
            " (recomputed from the scene)");
       continue;
     }
-    if (!r.negated && !r.eventually) {
+    if (require_listed && !r.negated && !r.eventually) {
       bool listed = false;
       for (const auto& rel : mission.relations) {
         listed = listed || (rel.target_id == t.entity.id && rel.op == r.op && !rel.eventually &&

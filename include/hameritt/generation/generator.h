@@ -32,10 +32,6 @@ struct ScenarioPlan {
   std::optional<SpecProvenance> provenance;
 };
 
-// True when parking slot `slot` can hold the target of a `cls` scenario (free, well inside the
-// neighborhood; for a pursuit, a kerb slot with room to pull out into the lane).
-bool targetSlotAllowed(const World& world, int slot, ScenarioClass cls);
-
 // Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give
 // the same scenario. Throws GenerationError when no placement satisfies the constraints.
 Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,

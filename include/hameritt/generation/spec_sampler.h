@@ -72,11 +72,14 @@ struct RequirementCheck {
 // Re-checks a finished scenario against the spec from the scene itself: target class, count
 // and look, relations recomputed with the relation code, and every drawn value inside its
 // distribution's support. Returns one message per violated hard requirement (empty: all hold);
-// `soft` receives whether each soft requirement held.
+// `soft` receives whether each soft requirement held. `require_listed`: a hard requirement must
+// also be listed in the mission's relations (false: the scene alone counts, as a rejection
+// sampler would judge an unconstrained scene).
 std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenario::World& world,
                                                   const scenario::GeneratorConfig& base,
                                                   const scenario::Mission& mission,
                                                   const scenario::SimConfig& sim,
-                                                  std::vector<RequirementCheck>* soft);
+                                                  std::vector<RequirementCheck>* soft,
+                                                  bool require_listed = true);
 
 }  // namespace hameritt::generation
