@@ -42,10 +42,12 @@ bool ScenarioGeneratorRos::generate(hameritt::GenerateScenario::Request& req,
     std::unique_ptr<generation::CompiledSpec> spec;
     if (!req.spec.empty()) {
       if (!req.scenario_class.empty()) {
-        throw scenario::ConfigError("scenario_class: a spec names its class; give one or the other");
+        throw scenario::ConfigError(
+            "scenario_class: a spec names its class; give one or the other");
       }
       if (!req.sampler.empty() && !generation::parseSampler(req.sampler, &batch.sampler)) {
-        throw scenario::ConfigError("sampler: expected random or halton, got '" + req.sampler + "'");
+        throw scenario::ConfigError("sampler: expected random or halton, got '" + req.sampler +
+                                    "'");
       }
       const scenario::World& world = worldFor(req.world_seed);
       spec = std::make_unique<generation::CompiledSpec>(

@@ -15,9 +15,9 @@
 #include <thread>
 
 #include "hameritt/generation/batch.h"
-#include "hameritt/scenario/error.h"
 #include "hameritt/generation/generator.h"
 #include "hameritt/generation/spec_sampler.h"
+#include "hameritt/scenario/error.h"
 
 using namespace hameritt::scenario;
 

@@ -30,8 +30,10 @@ const char* kUsage =
     "usage: hameritt_validate [--schema-dir DIR] FILE...\n"
     "  Validates mission.json, sim_config.json, world.json and manifest.json files (the kind\n"
     "  comes from each file's \"schema\" field). DIR defaults to the package's config/schema.\n"
-    "       hameritt_validate --spec FILE [--param NAME=VALUE ...] [--generator-config FILE] DIR...\n"
-    "  Re-checks every hard requirement of the spec on the scenarios in each DIR, from the scene.\n";
+    "       hameritt_validate --spec FILE [--param NAME=VALUE ...] [--generator-config FILE] "
+    "DIR...\n"
+    "  Re-checks every hard requirement of the spec on the scenarios in each DIR, from the "
+    "scene.\n";
 
 int usageError(const std::string& message) {
   std::fprintf(stderr, "hameritt_validate: error: %s\n%s", message.c_str(), kUsage);
@@ -91,7 +93,10 @@ int validateSpec(const std::string& spec_file, const std::vector<std::string>& p
       std::vector<gen::RequirementCheck> soft;
       const auto fails = gen::checkScenarioAgainstSpec(*spec, *w, base, mission, sim, &soft);
       for (std::size_t i = 0; i < soft.size(); ++i) {
-        if (soft_names.size() <= i) soft_names.push_back(soft[i].requirement), soft_held.push_back(0);
+        if (soft_names.size() <= i) {
+          soft_names.push_back(soft[i].requirement);
+          soft_held.push_back(0);
+        }
         soft_held[i] += soft[i].holds ? 1 : 0;
       }
       if (fails.empty()) {
@@ -138,9 +143,13 @@ int main(int argc, char** argv) {
     } else if (a == "--spec" || a == "--param" || a == "--generator-config") {
       if (i + 1 >= argc) return usageError(a + ": missing value");
       const std::string v = argv[++i];
-      if (a == "--spec") spec_file = v;
-      else if (a == "--param") params.push_back(v);
-      else gen_cfg = v;
+      if (a == "--spec") {
+        spec_file = v;
+      } else if (a == "--param") {
+        params.push_back(v);
+      } else {
+        gen_cfg = v;
+      }
     } else if (a == "-h" || a == "--help") {
       std::fputs(kUsage, stdout);
       return 0;

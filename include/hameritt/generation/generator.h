@@ -2,11 +2,10 @@
 // Random scenario generation: a seed and a class in, a complete, self-consistent scenario out.
 
 #include <cstdint>
-#include <string>
-#include <vector>
-
 #include <functional>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "hameritt/scenario/generator_config.h"
 
