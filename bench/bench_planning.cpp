@@ -11,7 +11,7 @@
 
 #include "hameritt/planning/uav_planner.h"
 #include "hameritt/planning/vehicle_routes.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/rng.h"
 
 using namespace hameritt;

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/share_dir.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/world.h"

@@ -3,7 +3,7 @@
 HAMERITT_ROOT="${HAMERITT_ROOT:-$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)}"
 FUZZ_BUILD_DIR="${HAMERITT_FUZZ_BUILD_DIR:-$HAMERITT_ROOT/build/fuzz}"
 # Slowest first, so that the side-by-side runs end together.
-FUZZ_TARGETS=(mesh manifest sim_config validator mission lod world path_csv)
+FUZZ_TARGETS=(mesh manifest sim_config validator mission lod world path_csv spec)
 # Any sanitizer report ends the run with a stack trace; leaks inside assimp are suppressed.
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:print_summary=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"

@@ -1,8 +1,10 @@
 #include "hameritt/ros/scenario_generator_ros.h"
 
+#include <memory>
 #include <thread>
 
-#include "hameritt/scenario/batch.h"
+#include "hameritt/generation/batch.h"
+#include "hameritt/generation/spec_sampler.h"
 #include "hameritt/scenario/error.h"
 
 namespace hameritt::ros_wrappers {
@@ -37,7 +39,26 @@ bool ScenarioGeneratorRos::generate(hameritt::GenerateScenario::Request& req,
   // No exception leaves the callback: every outcome is a response code.
   try {
     scenario::BatchRequest batch;
-    batch.classes = scenario::parseClassList(req.scenario_class);
+    std::unique_ptr<generation::CompiledSpec> spec;
+    if (!req.spec.empty()) {
+      if (!req.scenario_class.empty()) {
+        throw scenario::ConfigError(
+            "scenario_class: a spec names its class; give one or the other");
+      }
+      if (!req.sampler.empty() && !generation::parseSampler(req.sampler, &batch.sampler)) {
+        throw scenario::ConfigError("sampler: expected random or halton, got '" + req.sampler +
+                                    "'");
+      }
+      const scenario::World& world = worldFor(req.world_seed);
+      spec = std::make_unique<generation::CompiledSpec>(
+          generation::parseSpec(req.spec, req.params, world), world, generator_config_);
+      batch.spec = spec.get();
+    } else {
+      if (!req.params.empty() || !req.sampler.empty()) {
+        throw scenario::ConfigError("params, sampler: need a spec");
+      }
+      batch.classes = scenario::parseClassList(req.scenario_class);
+    }
     batch.count = static_cast<int>(req.count);
     if (req.count > 100000) throw scenario::ConfigError("count: expected at most 100000");
     batch.seed = req.seed;

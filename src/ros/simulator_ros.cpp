@@ -19,7 +19,7 @@
 #include "hameritt/ros/conversions.h"
 #include "hameritt/ros/log_throttle.h"
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/sim/quadrotor.h"

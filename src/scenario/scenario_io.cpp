@@ -188,7 +188,8 @@ void writeMission(JsonWriter& w, const Mission& m) {
     w.key("evidence").beginObject();
     if (r.op != RelationOp::kPartOf) {
       w.key("distance").value(roundMilli(r.distance));
-      w.key("bearing_deg").value(roundMilli(r.bearing_deg));
+      w.key("bearing_deg")
+          .value(roundMilli(r.bearing_deg) >= 360.0 ? 0.0 : roundMilli(r.bearing_deg));
       w.key("dz").value(roundMilli(r.dz));
       w.key("line_of_sight").value(r.line_of_sight);
     }
@@ -306,6 +307,20 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
   w.key("salt_pepper_probability").value(s.perturbations.salt_pepper_probability);
   w.key("motion_blur_px").value(s.perturbations.motion_blur_px);
   w.endObject().endObject();
+  if (s.spec) {
+    w.key("spec").beginObject();
+    w.key("file").value(s.spec->file).key("hash").value(hex64(s.spec->hash));
+    w.key("sampler").value(s.spec->sampler);
+    w.key("values").beginObject();
+    for (const auto& [name, v] : s.spec->values) {
+      w.key(name);
+      if (const bool* b = std::get_if<bool>(&v))
+        w.value(*b);
+      else
+        w.value(std::get<double>(v));
+    }
+    w.endObject().endObject();
+  }
   w.endObject();
 }
 

@@ -279,6 +279,33 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
     n.finish();
     p.finish();
   }
+  if (root.has("spec")) {
+    Obj sp = root.object("spec");
+    SpecProvenance prov;
+    prov.file = sp.string("file");
+    const std::string hash = sp.string("hash");
+    if (hash.size() != 16 || hash.find_first_not_of("0123456789abcdef") != std::string::npos) {
+      sp.error("hash", "expected 16 lower-case hex digits, got '" + hash + "'");
+    }
+    prov.hash = std::stoull(hash, nullptr, 16);
+    prov.sampler = sp.string("sampler");
+    if (prov.sampler != "random" && prov.sampler != "halton") {
+      sp.error("sampler", "expected random or halton, got '" + prov.sampler + "'");
+    }
+    const auto& values = sp.get("values");
+    if (!values.is_object()) sp.fail(sp.at("values"), "expected an object", values);
+    for (auto it = values.begin(); it != values.end(); ++it) {
+      if (it.value().is_boolean()) {
+        prov.values.emplace_back(it.key(), it.value().get<bool>());
+      } else if (it.value().is_number() && std::isfinite(it.value().get<double>())) {
+        prov.values.emplace_back(it.key(), it.value().get<double>());
+      } else {
+        sp.fail(sp.at("values." + it.key()), "expected a number or a boolean", it.value());
+      }
+    }
+    sp.finish();
+    s.spec = prov;
+  }
   root.finish();
   return s;
 }

@@ -129,7 +129,11 @@ Trajectory planDrive(const std::vector<Vec2>& path, const DriveSpec& spec) {
   auto heading = [&](std::size_t i) { return headings[i]; };
   Trajectory out;
   const double yaw0 = spec.from_kerb ? spec.from_kerb_yaw : heading(0);
-  if (spec.depart_delay > 0) out.push_back(rounded(spec.start_time, fine[0].p, yaw0));
+  // A waiting point only where the delay survives rounding to milliseconds (else two points
+  // would share t).
+  if (roundMilli(t[0]) > roundMilli(spec.start_time)) {
+    out.push_back(rounded(spec.start_time, fine[0].p, yaw0));
+  }
   out.push_back(rounded(t[0], fine[0].p, yaw0));
   for (std::size_t i = 1; i < n; ++i) {
     // Drop points where speed and heading do not change: interpolation is identical.

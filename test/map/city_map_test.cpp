@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "hameritt/map/scenario_map.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 
 namespace hameritt::map {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/params_table.h"
 #include "hameritt/scenario/scenario_io.h"
 

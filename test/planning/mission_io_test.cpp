@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "../scenario/test_util.h"
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "hameritt/geometry/line_of_sight.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"

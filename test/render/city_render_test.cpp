@@ -9,7 +9,7 @@
 #include <map>
 #include <set>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "render_test_util.h"
 
 namespace hameritt::render {

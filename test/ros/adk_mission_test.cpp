@@ -14,7 +14,7 @@
 #include "hameritt/MissionState.h"
 #include "hameritt/ros/adk_conversions.h"
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/scenario_io.h"
 

@@ -26,7 +26,7 @@
 #include "hameritt/Mission.h"
 #include "hameritt/MissionState.h"
 #include "hameritt/PlanPath.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "sim_test_client.h"
 

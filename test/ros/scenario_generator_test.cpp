@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hameritt/GenerateScenario.h"
+#include "hameritt/build_paths.h"
 
 namespace fs = std::filesystem;
 
@@ -78,6 +79,49 @@ TEST(ScenarioGeneratorService, RejectsBadRequestsWithCodes) {
   EXPECT_FALSE(unwritable.response.success);
   EXPECT_EQ(unwritable.response.code, 2);
   EXPECT_TRUE(unwritable.response.scenario_ids.empty());
+}
+
+TEST(ScenarioGeneratorService, GeneratesFromASpec) {
+  ASSERT_TRUE(ros::service::waitForService("/scenario_generator/generate", ros::Duration(60)));
+  const std::string out = tempDir("spec");
+  hameritt::GenerateScenario srv;
+  srv.request.spec = std::string(HAMERITT_SOURCE_DIR) + "/scenarios/specs/red_sedan_garage.hspec";
+  srv.request.count = 3;
+  srv.request.seed = 5;
+  srv.request.out_dir = out;
+  ASSERT_TRUE(ros::service::call("/scenario_generator/generate", srv));
+  EXPECT_EQ(srv.response.code, 0) << srv.response.message;
+  ASSERT_EQ(srv.response.scenario_ids.size(), 3u);
+  for (const auto& dir : srv.response.scenario_dirs) {
+    const auto sim = nlohmann::json::parse(std::ifstream(dir + "/sim_config.json"));
+    EXPECT_EQ(sim["spec"]["sampler"], "random");
+    const auto m = nlohmann::json::parse(std::ifstream(dir + "/mission.json"));
+    EXPECT_EQ(m["objective"]["targets"][0]["color"], "red");
+    int right_of_garage = 0;
+    for (const auto& r : m["scene_relations"]) {
+      right_of_garage += r["operator"] == "RIGHT_OF" && r["related"]["class"] == "garage";
+    }
+    EXPECT_EQ(right_of_garage, 1);
+  }
+  // Bad specs and parameters: code 2, nothing written.
+  const std::string bad = tempDir("bad_spec.hspec");
+  std::ofstream(bad) << "scenario area_search\ntarget car {color: scarlet}\n";
+  srv.request.spec = bad;
+  srv.request.out_dir = tempDir("spec_bad");
+  ASSERT_TRUE(ros::service::call("/scenario_generator/generate", srv));
+  EXPECT_EQ(srv.response.code, 2);
+  EXPECT_NE(srv.response.message.find("unknown color 'scarlet'"), std::string::npos)
+      << srv.response.message;
+  EXPECT_FALSE(fs::exists(srv.request.out_dir));
+  srv.request.spec = std::string(HAMERITT_SOURCE_DIR) + "/scenarios/specs/red_sedan_garage.hspec";
+  srv.request.params = {"snow=1"};
+  ASSERT_TRUE(ros::service::call("/scenario_generator/generate", srv));
+  EXPECT_EQ(srv.response.code, 2);
+  EXPECT_NE(srv.response.message.find("--param: unknown parameter 'snow'"), std::string::npos)
+      << srv.response.message;
+  EXPECT_FALSE(fs::exists(srv.request.out_dir));
+  fs::remove(bad);
+  fs::remove_all(out);
 }
 
 int main(int argc, char** argv) {

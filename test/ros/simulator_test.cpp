@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/world.h"
 #include "sim_test_client.h"

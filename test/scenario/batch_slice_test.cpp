@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "hameritt/scenario/batch.h"
+#include "hameritt/generation/batch.h"
 #include "hameritt/scenario/error.h"
 #include "test_util.h"
 

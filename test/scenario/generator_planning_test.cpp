@@ -7,7 +7,7 @@
 
 #include "hameritt/planning/look_at.h"
 #include "hameritt/planning/validity.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/trajectory.h"

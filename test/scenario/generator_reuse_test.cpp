@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "hameritt/planning/vehicle_routes.h"
-#include "hameritt/scenario/batch.h"
+#include "hameritt/generation/batch.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "test_util.h"
 

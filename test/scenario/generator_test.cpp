@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "hameritt/geometry/segment.h"
-#include "hameritt/scenario/batch.h"
+#include "hameritt/generation/batch.h"
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/params_table.h"

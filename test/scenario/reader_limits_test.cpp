@@ -12,7 +12,7 @@
 #include <string>
 
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/validation.h"

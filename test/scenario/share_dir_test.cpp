@@ -10,7 +10,7 @@
 #include <string>
 
 #include "hameritt/build_paths.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 
 using namespace hameritt::scenario;
 

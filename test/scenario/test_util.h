@@ -10,7 +10,7 @@
 #include <string>
 
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/world.h"
 
 namespace hameritt::scenario::testing {

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "hameritt/scenario/batch.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/batch.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 
 namespace hameritt::scenario {

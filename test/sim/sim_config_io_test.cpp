@@ -8,7 +8,7 @@
 #include <string>
 
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "sim_test_util.h"
 

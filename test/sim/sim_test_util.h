@@ -5,7 +5,7 @@
 #include "hameritt/build_paths.h"
 #include <string>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/world.h"

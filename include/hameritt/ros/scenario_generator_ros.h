@@ -8,7 +8,7 @@
 #include <ros/ros.h>
 
 #include "hameritt/GenerateScenario.h"
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 #include "hameritt/scenario/world.h"
 
 namespace hameritt::ros_wrappers {

@@ -5,7 +5,7 @@
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/scenario/generator_config.h"
 #include "hameritt/scenario/json_writer.h"
 #include "hameritt/scenario/world.h"
 

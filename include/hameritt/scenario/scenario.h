@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "hameritt/geometry/polygon.h"
@@ -203,6 +204,15 @@ struct Perturbations {
   double motion_blur_px = 0.0;
 };
 
+// Where a scenario generated from a spec came from: the spec file, the hash of its sources
+// (imports and --param overrides included), the sampler and the values drawn for it.
+struct SpecProvenance {
+  std::string file;
+  std::uint64_t hash = 0;
+  std::string sampler;  // random | halton
+  std::vector<std::pair<std::string, std::variant<double, bool>>> values;
+};
+
 struct SimConfig {
   std::string scenario_id;
   ScenarioClass cls = ScenarioClass::kAreaSearch;
@@ -215,6 +225,7 @@ struct SimConfig {
   Environment environment;
   UavSpec uav;
   Perturbations perturbations;
+  std::optional<SpecProvenance> spec;  // written only for scenarios generated from a spec
 };
 
 struct Scenario {

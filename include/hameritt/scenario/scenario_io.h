@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/scenario/generator_config.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
 

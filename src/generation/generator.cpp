@@ -1,4 +1,4 @@
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +15,7 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/trajectory.h"
+#include "hameritt/generation/target_slots.h"
 
 namespace hameritt::scenario {
 
@@ -58,8 +59,9 @@ double rangeDraw(Rng& rng, const Range& r) { return r.max > r.min ? rng.uniform(
 class ScenarioBuilder {
  public:
   ScenarioBuilder(const World& world, const GeneratorConfig& cfg, ScenarioClass cls,
-                  std::uint64_t seed)
-      : world_(world), cfg_(cfg), cls_(cls), seed_(seed), rng_(seed), eval_(world, cfg.relations) {
+                  std::uint64_t seed, const ScenarioPlan* plan)
+      : world_(world), cfg_(cfg), cls_(cls), seed_(seed), rng_(seed), eval_(world, cfg.relations),
+        plan_(plan) {
     slot_taken_.assign(world.slots().size(), 0);
     for (std::size_t i = 0; i < world.slots().size(); ++i) {
       if (world.slots()[i].occupant >= 0) slot_taken_[i] = 1;
@@ -104,6 +106,7 @@ class ScenarioBuilder {
     finalizeRelations();
     finishGroups();
     if (cfg_.perception_paths) planPerceptionPath();
+    if (plan_ && plan_->provenance) sc_.sim.spec = plan_->provenance;
     return std::move(sc_);
   }
 
@@ -205,11 +208,7 @@ class ScenarioBuilder {
   }
 
   // True for points at least 20 m inside the neighborhood, where an AOI around them fits.
-  bool wellInside(const Vec2& p) const {
-    const auto b = world_.bounds();
-    return p.x() > b.min.x() + 20 && p.x() < b.max.x() - 20 && p.y() > b.min.y() + 20 &&
-           p.y() < b.max.y() - 20;
-  }
+  bool wellInside(const Vec2& p) const { return insideBy20(world_, p); }
 
   int randomNode() {
     return static_cast<int>(rng_.uniformInt(0, static_cast<long>(world_.nodes().size()) - 1));
@@ -403,6 +402,30 @@ class ScenarioBuilder {
       out.push_back(std::move(r));
     }
     return out;
+  }
+
+  // The spec's hard requirements are listed in the description: each one missing from `rels`
+  // is taken from `all` (every true relation) and put first, within max_relations.
+  void ensureListed(std::vector<SceneRelation>* rels, const std::vector<SceneRelation>& all) {
+    if (!plan_) return;
+    std::vector<SceneRelation> forced;
+    for (const auto& pred : plan_->listed) {
+      bool have = false;
+      for (const auto& r : *rels) have = have || pred(r);
+      for (const auto& r : forced) have = have || pred(r);
+      if (have) continue;
+      for (const auto& r : all) {
+        if (pred(r)) {
+          forced.push_back(r);
+          break;
+        }
+      }
+    }
+    if (forced.empty()) return;
+    const std::size_t keep =
+        static_cast<std::size_t>(std::max<int>(0, cfg_.relations.max_relations - static_cast<int>(forced.size())));
+    if (rels->size() > keep) rels->resize(keep);
+    rels->insert(rels->begin(), forced.begin(), forced.end());
   }
 
   // EVENTUALLY_* relations of a moving target: the first sample time (on the eventually_dt
@@ -682,6 +705,13 @@ class ScenarioBuilder {
 
   // ------------------------------------------------------------------ classes
   void drawTargetLook(const catalog::CarModel** model, std::string* color) {
+    if (plan_) {
+      *model = plan_->models.empty()
+                   ? &catalog::pickModel(rng_)
+                   : &catalog::carModels()[static_cast<std::size_t>(rng_.pick(plan_->models))];
+      *color = catalog::pick(rng_, plan_->colors.empty() ? catalog::carColors() : plan_->colors);
+      return;
+    }
     *model = &catalog::pickModel(rng_);
     *color = catalog::pick(rng_, catalog::carColors());
   }
@@ -706,7 +736,16 @@ class ScenarioBuilder {
     const catalog::CarModel* model;
     std::string color;
     drawTargetLook(&model, &color);
-    const int slot = pickSlot([this](const ParkingSlot& s) { return wellInside(s.position); });
+    int slot;
+    if (plan_ && plan_->placements) {
+      // Constructive: one of the spec's feasible placements, drawn directly.
+      if (plan_->placements->empty()) throw GenerationError("no feasible placement for the target");
+      const auto& pl = rng_.pick(*plan_->placements);
+      slot = pl.first;
+      model = &catalog::carModels()[static_cast<std::size_t>(pl.second)];
+    } else {
+      slot = pickSlot([this](const ParkingSlot& s) { return wellInside(s.position); });
+    }
     if (slot < 0) throw GenerationError("no free parking slot for the target");
     Entity target = parkCar(slot, *model, color);
     const Vec2 tp = target.box.center2();
@@ -789,7 +828,7 @@ class ScenarioBuilder {
         const double kw = rng_.uniform(20, 50);
         const double kl = rng_.uniform(20, 50);
         KeepOutZone k = makeKoz(geometry::orientedRectangle(c, kl, kw, kyaw), "restricted");
-        if (rng_.bernoulli(0.5)) {
+        if (rng_.bernoulli(plan_ && plan_->koz_window_probability ? *plan_->koz_window_probability : 0.5)) {
           k.window.net = std::round(rng_.uniform(0.0, 0.5) * m.time_limit);
           k.window.nlt = std::round(*k.window.net + rng_.uniform(60.0, 0.5 * m.time_limit));
         }
@@ -808,6 +847,7 @@ class ScenarioBuilder {
     const auto all = eval_.allRelations(subjectOf(target), parkedSubjects(target.id),
                                         groupsOf(target.id, groups));
     std::vector<SceneRelation> rels = selectRelations(all);
+    ensureListed(&rels, all);
     addConfusers(target, rels, aois, keep_out_of, 40.0);
     for (auto& r : rels) sc_.mission.relations.push_back(r);
   }
@@ -872,7 +912,7 @@ class ScenarioBuilder {
     // 2.5 s later with the same seed and stops 12 m short of the lead car's stop, so it follows
     // the same streets (checked: else the scenario keeps one target).
     std::vector<Trajectory> trajs{lead.trajectory};
-    if (rng_.bernoulli(0.5)) {
+    if (plan_ && plan_->target_count > 0 ? plan_->target_count == 2 : rng_.bernoulli(0.5)) {
       const TrajectoryPoint& l0 = lead.trajectory.front();
       TrajectoryPoint start = l0;
       start.x = roundMilli(l0.x - 12.0 * lane_dir.x());
@@ -963,6 +1003,7 @@ class ScenarioBuilder {
     std::vector<SceneRelation> rels = selectRelations(at_start);
     const int n_ev = std::max(1, cfg_.relations.max_relations / 3);
     if (static_cast<int>(rels.size()) > cfg_.relations.max_relations - n_ev) rels.resize(static_cast<std::size_t>(cfg_.relations.max_relations - n_ev));
+    ensureListed(&rels, at_start);
     for (auto& r : eventuallyRelations(target, traj, at_start, n_ev)) rels.push_back(r);
     for (auto& r : rels) sc_.mission.relations.push_back(r);
   }
@@ -979,21 +1020,27 @@ class ScenarioBuilder {
     const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
     const planning::RouteSettings rs = routeSettings();
     const planning::SpeedProfile speed = speedProfile(rangeDraw(rng_, cfg_.car_speed));
-    constexpr double kPullOut = 10.0;      // metres along the street to reach the lane
     constexpr double kPullOutTime = 6.0;   // seconds, from rest to rest
     int slot = -1;
     Trajectory traj;
     std::vector<int> tried;  // slots without a route, skipped on later attempts
-    for (int attempt = 0; attempt < 20 && traj.empty(); ++attempt) {
-      slot = pickSlot([&](const ParkingSlot& s) {
-        if (s.block < 0 || !wellInside(s.position)) return false;
-        const auto& e = world_.edges()[static_cast<std::size_t>(s.edge)];
-        const Vec2 a = world_.nodes()[e.a].position, b = world_.nodes()[e.b].position;
-        const Vec2 f(std::cos(s.yaw), std::sin(s.yaw));
-        const Vec2 from = (b - a).dot(f) > 0 ? a : b;
-        const double along = (s.position - from).dot(f);
-        return along + kPullOut < (b - a).norm() - rs.corner_clearance - 2.0;
-      }, true);
+    std::vector<std::size_t> order;
+    int attempts = 20;
+    if (plan_ && plan_->placements) {
+      for (std::size_t i = 0; i < plan_->placements->size(); ++i) order.push_back(i);
+      rng_.shuffle(order);
+      attempts = static_cast<int>(std::min<std::size_t>(order.size(), 60));
+    }
+    for (int attempt = 0; attempt < attempts && traj.empty(); ++attempt) {
+      if (plan_ && plan_->placements) {
+        // Constructive: the next of the spec's feasible placements, in a seeded order.
+        if (attempt >= static_cast<int>(order.size())) break;
+        const auto& pl = (*plan_->placements)[order[static_cast<std::size_t>(attempt)]];
+        slot = pl.first;
+        model = &catalog::carModels()[static_cast<std::size_t>(pl.second)];
+      } else {
+        slot = pickSlot([&](const ParkingSlot& s) { return pursuitSlotFits(world_, s); }, true);
+      }
       if (slot < 0) break;
       slot_taken_[static_cast<std::size_t>(slot)] = 1;
       const ParkingSlot& s = world_.slots()[static_cast<std::size_t>(slot)];
@@ -1236,6 +1283,12 @@ class ScenarioBuilder {
     p.gaussian_noise_std = roundMilli(rangeDraw(rng_, cfg_.noise_std) * 1000.0) / 1000.0;
     p.salt_pepper_probability = std::round(rangeDraw(rng_, cfg_.salt_pepper) * 1e5) / 1e5;
     p.motion_blur_px = roundMilli(rangeDraw(rng_, cfg_.motion_blur_px));
+    if (plan_) {
+      if (plan_->snow) env.snow = roundMilli(*plan_->snow);
+      if (plan_->rain) env.rain = roundMilli(*plan_->rain);
+      if (plan_->dust) env.dust = roundMilli(*plan_->dust);
+      if (plan_->fog) env.fog = roundMilli(*plan_->fog);
+    }
   }
 
   void finishGroups() { sc_.sim.groups = currentGroups(); }
@@ -1310,14 +1363,15 @@ class ScenarioBuilder {
   std::vector<char> slot_taken_;
   std::vector<int> car_ids_, ped_ids_;
   std::vector<Group> extra_groups_;
+  const ScenarioPlan* plan_;
 };
 
 }  // namespace
 
 Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
-                          std::uint64_t seed) {
+                          std::uint64_t seed, const ScenarioPlan* plan) {
   try {
-    return ScenarioBuilder(world, config, cls, seed).build();
+    return ScenarioBuilder(world, config, cls, seed, plan).build();
   } catch (const GenerationError& e) {
     throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " + e.what());
   }

@@ -1,9 +1,8 @@
 #pragma once
-// Random scenario generation: a seed and a class in, a complete, self-consistent scenario out.
+// Scenario generator configuration (config/generator.json): the randomization ranges of the
+// generator and the loaders of config/world.json and config/generator.json.
 
-#include <cstdint>
 #include <string>
-#include <vector>
 
 #include "hameritt/scenario/relations.h"
 #include "hameritt/scenario/scenario.h"
@@ -79,16 +78,5 @@ GeneratorConfig loadGeneratorConfig(const std::string& path);
 // The shipped configuration directory: $HAMERITT_CONFIG_DIR, else the package's config/
 // (shareDir() in hameritt/scenario/share_dir.h).
 std::string defaultConfigDir();
-
-// "<class>-<16 hex digits of the seed>", e.g. "area_search-00000000000004d2".
-std::string scenarioId(ScenarioClass cls, std::uint64_t seed);
-
-// Generates one scenario. Deterministic: the same world, config, class and seed give the same
-// scenario. Throws GenerationError when no placement satisfies the constraints.
-Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
-                          std::uint64_t seed);
-
-// Seed of the i-th scenario of a batch with base seed `seed`.
-std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index);
 
 }  // namespace hameritt::scenario

@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "hameritt/scenario/generator.h"
+#include "hameritt/generation/generator.h"
+#include "hameritt/generation/spec_sampler.h"
 
 namespace hameritt::scenario {
 
@@ -23,6 +24,9 @@ struct BatchRequest {
   // Use `seed` itself as the scenario seed (count must be 1): regenerates a scenario from the
   // class and seed written in its files.
   bool exact_seed = false;
+  // Generate from this compiled spec (its class replaces `classes`), with this sampler.
+  const generation::CompiledSpec* spec = nullptr;
+  generation::SamplerKind sampler = generation::SamplerKind::kRandom;
 };
 
 struct ManifestEntry {

@@ -1,4 +1,4 @@
-#include "hameritt/scenario/batch.h"
+#include "hameritt/generation/batch.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -53,6 +53,7 @@ std::string manifestJson(const World& world, const BatchRequest& req,
   w.key("count").value(req.count);
   if (req.first != 0) w.key("first").value(req.first);
   w.key("classes").beginArray();
+  if (req.spec) w.value(toString(req.spec->spec().cls));
   for (auto c : req.classes) w.value(toString(c));
   w.endArray();
   w.key("world").beginObject();
@@ -75,7 +76,7 @@ std::string manifestJson(const World& world, const BatchRequest& req,
 
 std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConfig& config,
                                          const BatchRequest& req) {
-  if (req.classes.empty()) throw ConfigError("--class: at least one scenario class is required");
+  if (req.classes.empty() && !req.spec) throw ConfigError("--class: at least one scenario class is required");
   if (req.count < 1) throw ConfigError("--count: expected a positive number of scenarios, got " + std::to_string(req.count));
   if (req.jobs < 1) throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
   if (req.out_dir.empty()) throw ConfigError("--out: an output directory is required");
@@ -113,9 +114,17 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
         ManifestEntry& e = entries[static_cast<std::size_t>(i)];
         const int index = req.first + i;  // index in the whole batch
         e.index = index;
-        e.cls = req.classes[static_cast<std::size_t>(index) % req.classes.size()];
+        if (!req.spec) e.cls = req.classes[static_cast<std::size_t>(index) % req.classes.size()];
         e.seed = req.exact_seed ? req.seed : batchSeed(req.seed, static_cast<std::uint64_t>(index));
-        const Scenario s = generateScenario(world, config, e.cls, e.seed);
+        Scenario s;
+        if (req.spec) {
+          e.cls = req.spec->spec().cls;
+          const generation::ScenarioDraw d = req.spec->draw(
+              e.seed, static_cast<std::uint64_t>(index), req.seed, req.sampler);
+          s = generateScenario(world, d.config, e.cls, e.seed, &d.plan);
+        } else {
+          s = generateScenario(world, config, e.cls, e.seed);
+        }
         e.id = s.mission.scenario_id;
         writeScenarioDir(req.out_dir, s);
         written[static_cast<std::size_t>(i)] = 1;

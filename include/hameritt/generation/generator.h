@@ -1,0 +1,42 @@
+#pragma once
+// Random scenario generation: a seed and a class in, a complete, self-consistent scenario out.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hameritt/scenario/generator_config.h"
+
+namespace hameritt::scenario {
+
+// "<class>-<16 hex digits of the seed>", e.g. "area_search-00000000000004d2".
+std::string scenarioId(ScenarioClass cls, std::uint64_t seed);
+
+// What a spec fixes for one scenario beyond the generator's ranges (generation/spec_sampler.h
+// fills it): the target's feasible placements and looks, the relations the mission must list,
+// and environment values. Null members leave the random generator's choice.
+struct ScenarioPlan {
+  // Feasible (parking slot, catalog model index) pairs of a parked target; drawn from directly.
+  const std::vector<std::pair<int, int>>* placements = nullptr;
+  std::vector<int> models;          // allowed catalog models (moving targets); empty: any
+  std::vector<std::string> colors;  // allowed colours; empty: any
+  int target_count = 0;             // route_search: 1 or 2 cars; 0: the generator decides
+  // Each predicate names a relation that the mission's description must list (the hard
+  // requirements), picked among the true relations of the target.
+  std::vector<std::function<bool(const SceneRelation&)>> listed;
+  std::optional<double> koz_window_probability;
+  std::optional<double> snow, rain, dust, fog;
+  std::optional<SpecProvenance> provenance;
+};
+
+// Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give
+// the same scenario. Throws GenerationError when no placement satisfies the constraints.
+Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
+                          std::uint64_t seed, const ScenarioPlan* plan = nullptr);
+
+// Seed of the i-th scenario of a batch with base seed `seed`.
+std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index);
+
+}  // namespace hameritt::scenario

@@ -1,0 +1,308 @@
+// The scenario language: every error kind with its exact message, distributions, parameters,
+// imports, the compiler's narrowing and unsatisfiable specs, and the independent checker
+// (with negative controls: scenes that break a requirement must be reported).
+
+#include "hameritt/generation/spec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "../scenario/test_util.h"
+#include "hameritt/generation/spec_sampler.h"
+#include "hameritt/scenario/rng.h"
+#include "hameritt/scenario/scenario_io.h"
+
+namespace hameritt::generation {
+namespace {
+
+using scenario::testing::messageOf;
+using scenario::testing::shippedConfig;
+using scenario::testing::shippedWorld;
+
+Spec parse(const std::string& text, const std::vector<std::string>& params = {}) {
+  return parseSpecText(text, "t.hspec", params, shippedWorld());
+}
+
+std::string errorOf(const std::string& text, const std::vector<std::string>& params = {}) {
+  return messageOf([&] { parse(text, params); });
+}
+
+const char* kHead = "scenario area_search\n";
+
+TEST(SpecParse, SyntaxErrorGivesLineColumnCaretAndExpectation) {
+  EXPECT_EQ(errorOf(std::string(kHead) + "target car {color = red}\n"),
+            "t.hspec:2:19: error: expected ':' after the attribute name, got '='\n"
+            "  target car {color = red}\n"
+            "                    ^");
+  EXPECT_EQ(errorOf("scenario area_search\ntarget car {color: red\n"),
+            "t.hspec:3:1: error: expected ',' or '}' after the attribute value, got the end of "
+            "the file\n  \n  ^");
+  EXPECT_EQ(errorOf("scenario area_search $\n"),
+            "t.hspec:1:22: error: unexpected character '$'\n  scenario area_search $\n"
+            "                       ^");
+  EXPECT_EQ(errorOf("import \"never\n"),
+            "t.hspec:1:8: error: unterminated string: expected '\"'\n  import \"never\n"
+            "         ^");
+}
+
+TEST(SpecParse, UnknownNamesListTheNearestValidOnes) {
+  EXPECT_EQ(errorOf(std::string(kHead) + "target car {color: sliver}\n"),
+            "t.hspec:2:20: error: unknown color 'sliver' for target car; did you mean "
+            "'silver'?; color values of car in this world: black, blue, green, grey, red, "
+            "silver, white, yellow\n"
+            "  target car {color: sliver}\n"
+            "                     ^");
+  EXPECT_NE(errorOf(std::string(kHead) + "target car {color: scarlet}\n")
+                .find("t.hspec:2:20: error: unknown color 'scarlet' for target car; color values "
+                      "of car in this world: black, blue, green, grey, red"),
+            std::string::npos);
+  const std::string op = errorOf(std::string(kHead) + "require garage RIGHTOF target\n");
+  EXPECT_EQ(op.substr(0, op.find('?') + 1),
+            "t.hspec:2:16: error: unknown relation operator 'RIGHTOF'; did you mean 'RIGHT_OF'?");
+  const std::string stmt = errorOf(std::string(kHead) + "targte car\n");
+  EXPECT_EQ(stmt.substr(0, stmt.find('?') + 1),
+            "t.hspec:2:1: error: unknown statement 'targte'; did you mean 'target'?");
+  const std::string key = errorOf(std::string(kHead) + "environment { snoww: 1 }\n");
+  EXPECT_EQ(key.substr(0, key.find('\n')),
+            "t.hspec:2:15: error: unknown setting 'snoww' in environment; did you mean 'snow'?; "
+            "settings of environment: dust, fog, foliage, gusts, rain, snow, time, wind");
+  const std::string attr =
+      errorOf(std::string(kHead) + "require garage RIGHT_OF target {door: 1}\n");
+  EXPECT_EQ(attr.substr(0, attr.find('\n')),
+            "t.hspec:2:33: error: unknown attribute 'door' of garage; did you mean 'doors'?; "
+            "attributes of garage in this world: color, doors");
+  const std::string cls = errorOf("scenario area_serch\n");
+  EXPECT_EQ(cls.substr(0, cls.find('\n')),
+            "t.hspec:1:10: error: unknown mission class 'area_serch'; did you mean "
+            "'area_search'?; classes: area_search, route_search, pursuit");
+}
+
+TEST(SpecParse, TypeErrors) {
+  const std::string range = errorOf(std::string(kHead) + "environment { snow: 1.5 }\n");
+  EXPECT_EQ(range.substr(0, range.find('\n')),
+            "t.hspec:2:21: error: environment.snow: expected values within [0, 1], got 1.5");
+  const std::string whole = errorOf(std::string(kHead) + "confusers { count: 1.5 }\n");
+  EXPECT_EQ(whole.substr(0, whole.find('\n')),
+            "t.hspec:2:20: error: confusers.count: expected a whole number or a range of whole "
+            "numbers, got 1.5");
+  const std::string op = errorOf(std::string(kHead) + "require fence RIGHT_OF target\n");
+  EXPECT_EQ(op.substr(0, op.find('\n')),
+            "t.hspec:2:9: error: RIGHT_OF does not apply to a fence; it relates: house, garage, "
+            "tree, car, pedestrian");
+  const std::string prob = errorOf(std::string(kHead) + "prefer 1.5 tree NEXT_TO target\n");
+  EXPECT_EQ(prob.substr(0, prob.find('\n')),
+            "t.hspec:2:8: error: expected a probability strictly between 0 and 1, got 1.5");
+  const std::string name = errorOf(std::string(kHead) + "environment { time: dusky }\n");
+  EXPECT_EQ(name.substr(0, name.find('\n')),
+            "t.hspec:2:21: error: unknown name 'dusky'; did you mean 'dusk'?; periods of the "
+            "day: dawn, day, dusk, night");
+  EXPECT_EQ(messageOf([] { parse("target car\n"); }),
+            "t.hspec:1:1: error: missing 'scenario' statement: expected 'scenario area_search', "
+            "'scenario route_search' or 'scenario pursuit'");
+  const std::string moving = errorOf("scenario area_search\ntarget car moving\n");
+  EXPECT_EQ(moving.substr(0, moving.find('\n')),
+            "t.hspec:2:1: error: an area_search target is parked; expected 'parked'");
+  const std::string ev = errorOf(std::string(kHead) + "require tree EVENTUALLY_NEXT_TO target\n");
+  EXPECT_NE(ev.find("t.hspec:2:1: error: EVENTUALLY_* requirements"), std::string::npos) << ev;
+}
+
+TEST(SpecParse, DistributionsDrawInsideTheirSupport) {
+  const Spec s = parse(std::string(kHead) +
+                       "environment { time: dusk, snow: normal(0.5, 0.2, 0.3, 0.6), "
+                       "fog: choice(0: 3, 0.5: 1) }\nconfusers { count: 2..4 }\n");
+  const Distribution* time = s.setting("environment.time");
+  const Distribution* snow = s.setting("environment.snow");
+  const Distribution* fog = s.setting("environment.fog");
+  const Distribution* count = s.setting("confusers.count");
+  ASSERT_TRUE(time && snow && fog && count);
+  EXPECT_EQ(time->text(), "range(17.5, 19.5)");
+  EXPECT_EQ(snow->text(), "normal(0.5, 0.2, 0.3, 0.6)");
+  EXPECT_EQ(fog->text(), "choice(0: 3, 0.5: 1)");
+  EXPECT_EQ(count->text(), "2..4");
+  int fog_half = 0, counts[5] = {0, 0, 0, 0, 0};
+  double snow_sum = 0;
+  constexpr int kN = 4000;
+  scenario::Rng rng(7);
+  for (int i = 0; i < kN; ++i) {
+    const double t = time->draw(rng.unit()), sn = snow->draw(rng.unit());
+    EXPECT_TRUE(t >= 17.5 && t <= 19.5);
+    EXPECT_TRUE(sn >= 0.3 && sn <= 0.6);
+    snow_sum += sn;
+    fog_half += fog->draw(rng.unit()) == 0.5;
+    const double c = count->draw(rng.unit());
+    ASSERT_TRUE(c == 2 || c == 3 || c == 4) << c;
+    ++counts[static_cast<int>(c)];
+  }
+  // Weighted choice: P(0.5) = 1/4, within 3 sigma.
+  EXPECT_NEAR(fog_half, kN / 4.0, 3 * std::sqrt(kN * 0.25 * 0.75));
+  for (int c = 2; c <= 4; ++c) EXPECT_NEAR(counts[c], kN / 3.0, 3 * std::sqrt(kN * 2.0 / 9));
+  // Truncated normal N(0.5, 0.2) on [0.3, 0.6]: its mean is below 0.5 (more mass left of it).
+  EXPECT_LT(snow_sum / kN, 0.5);
+  EXPECT_GT(snow_sum / kN, 0.4);
+  EXPECT_FALSE(time->contains(19.6));
+  EXPECT_TRUE(fog->contains(0.5));
+  EXPECT_FALSE(fog->contains(0.25));  // negative control: between the choices
+}
+
+TEST(SpecParse, ParamsAndOverrides) {
+  const std::string text = std::string(kHead) + "param snow = 0.2\nenvironment { snow: snow }\n";
+  EXPECT_EQ(parse(text).setting("environment.snow")->text(), "0.2");
+  EXPECT_EQ(parse(text, {"snow=0.8"}).setting("environment.snow")->text(), "0.8");
+  EXPECT_EQ(parse(text, {"snow=range(0.1, 0.3)"}).setting("environment.snow")->text(),
+            "range(0.1, 0.3)");
+  EXPECT_NE(parse(text).hash, parse(text, {"snow=0.8"}).hash);
+  EXPECT_EQ(errorOf(text, {"snwo=0.8"}),
+            "--param: unknown parameter 'snwo'; did you mean 'snow'?; parameters of this spec: "
+            "snow");
+  EXPECT_EQ(errorOf(text, {"snow=0.8", "snow=0.9"}),
+            "--param: parameter 'snow' given more than once");
+  EXPECT_EQ(errorOf(text, {"snow"}), "--param: expected NAME=VALUE, got 'snow'");
+  const std::string bad = errorOf(text, {"snow=1.5"});
+  EXPECT_EQ(bad.substr(0, bad.find('\n')),
+            "t.hspec:3:21: error: environment.snow: expected values within [0, 1], got 1.5 (from "
+            "param 'snow')");
+}
+
+TEST(SpecParse, ImportsComposeAndOverride) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("spec_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream(dir / "base.hspec")
+        << "param snow = 0.5\nenvironment { time: dusk, snow: snow }\n"
+           "require garage NEXT_TO target\n";
+    std::ofstream(dir / "top.hspec")
+        << "import \"base.hspec\"\nscenario area_search\n"
+           "environment { time: 12 }\nrequire not tree NEXT_TO target\n";
+    std::ofstream(dir / "loop.hspec") << "import \"loop.hspec\"\n";
+  }
+  const Spec s = parseSpec((dir / "top.hspec").string(), {"snow=0.7"}, shippedWorld());
+  EXPECT_EQ(s.setting("environment.time")->text(), "12");   // overridden by the importer
+  EXPECT_EQ(s.setting("environment.snow")->text(), "0.7");  // the import's param, overridden
+  ASSERT_EQ(s.requirements.size(), 2u);
+  EXPECT_EQ(s.requirements[0].text, "garage NEXT_TO target");
+  EXPECT_EQ(s.requirements[1].text, "not tree NEXT_TO target");
+  const std::string loop =
+      messageOf([&] { parseSpec((dir / "loop.hspec").string(), {}, shippedWorld()); });
+  EXPECT_NE(loop.find("loop.hspec:1:8: error: import cycle"), std::string::npos) << loop;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SpecCompile, UnsatisfiableNamesTheRequirementAndTheNarrowing) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car {vehicle_class: sedan, color: red} parked\n"
+                       "require street ON_TOP_OF target\nrequire driveway ON_TOP_OF target\n");
+  const std::string m = messageOf([&] { CompiledSpec(s, shippedWorld(), shippedConfig()); });
+  const std::regex re(
+      "t\\.hspec:4:1: error: unsatisfiable in this world: driveway ON_TOP_OF target: 0 of "
+      "([0-9]+) candidates \\(parking places x looks: ([0-9]+) -> vehicle_class sedan: ([0-9]+) "
+      "-> color red: ([0-9]+) -> street ON_TOP_OF target: ([0-9]+)\\)");
+  std::smatch mm;
+  ASSERT_TRUE(std::regex_match(m, mm, re)) << m;
+  // "0 of N": N is what the previous requirement left; each step narrows.
+  EXPECT_EQ(mm[1], mm[5]);
+  const long all = std::stol(mm[2]), sedan = std::stol(mm[3]), red = std::stol(mm[4]);
+  EXPECT_EQ(sedan * 10, all * 3);  // 3 of the 10 catalog models are sedans
+  EXPECT_EQ(red * 8, sedan);       // 1 of 8 colours
+  EXPECT_GT(std::stol(mm[5]), 0);
+  EXPECT_LT(std::stol(mm[5]), red);
+}
+
+TEST(SpecCompile, SoftRequirementsHoldWithTheirProbability) {
+  const Spec s = parse(std::string(kHead) + "target car parked\nprefer 0.3 tree NEXT_TO target\n");
+  const CompiledSpec c(s, shippedWorld(), shippedConfig());
+  constexpr int kN = 3000;
+  int held = 0;
+  for (int i = 0; i < kN; ++i) {
+    const ScenarioDraw d = c.draw(scenario::batchSeed(5, i), i, 5, SamplerKind::kRandom);
+    ASSERT_TRUE(d.plan.provenance);
+    const auto& v = d.plan.provenance->values.back();
+    ASSERT_EQ(v.first, "prefer tree NEXT_TO target");
+    held += std::get<bool>(v.second);
+  }
+  EXPECT_NEAR(held, 0.3 * kN, 3 * std::sqrt(kN * 0.3 * 0.7));
+}
+
+TEST(SpecCompile, HaltonCoversARangeEvenly) {
+  const Spec s = parse(std::string(kHead) + "environment { fog: range(0, 1) }\n");
+  const CompiledSpec c(s, shippedWorld(), shippedConfig());
+  int bins[10] = {0};
+  for (int i = 0; i < 200; ++i) {
+    const ScenarioDraw d = c.draw(scenario::batchSeed(3, i), i, 3, SamplerKind::kHalton);
+    const double fog = std::get<double>(d.plan.provenance->values.front().second);
+    ++bins[std::min(9, static_cast<int>(fog * 10))];
+  }
+  // Low discrepancy: every tenth of the range gets 20 +- 1 points (random: +- 13 at 3 sigma).
+  for (int b : bins) EXPECT_NEAR(b, 20, 1);
+}
+
+TEST(SpecCheck, GeneratedScenarioMeetsTheSpecAndBrokenOnesAreReported) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car {vehicle_class: sedan, color: red} parked\n"
+                       "require garage RIGHT_OF target\nenvironment { snow: 0.6 }\n");
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+    const scenario::Scenario sc =
+        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
+    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
+    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    ASSERT_TRUE(sc.sim.spec);
+    EXPECT_EQ(sc.sim.environment.snow, 0.6);
+    // Negative controls: a blue target, a target moved away from its garage, other snow.
+    scenario::SimConfig blue = sc.sim;
+    for (auto& se : blue.entities) {
+      if (se.role == "target") se.entity.attributes.set("color", std::string("blue"));
+    }
+    const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, blue, nullptr);
+    ASSERT_EQ(f1.size(), 1u);
+    EXPECT_NE(f1[0].find("color 'blue' is not one of red"), std::string::npos) << f1[0];
+    scenario::SimConfig moved = sc.sim;
+    for (auto& se : moved.entities) {
+      if (se.role == "target")
+        se.entity.box.yaw = geometry::wrapPi(se.entity.box.yaw + geometry::kPi);
+    }
+    const auto f2 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, moved, nullptr);
+    ASSERT_FALSE(f2.empty());
+    EXPECT_NE(f2[0].find("requirement 'garage RIGHT_OF target' does not hold"), std::string::npos)
+        << f2[0];
+    scenario::SimConfig snow = sc.sim;
+    snow.environment.snow = 0.2;
+    const auto f3 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, snow, nullptr);
+    ASSERT_EQ(f3.size(), 1u);
+    EXPECT_EQ(f3[0], "environment.snow: 0.2 is outside 0.6");
+  }
+}
+
+TEST(SpecCheck, SameSpecAndSeedGiveTheSameScenario) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car {color: red} parked\n"
+                       "require garage RIGHT_OF target\nenvironment { fog: range(0, 1) }\n");
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  auto json = [&](std::uint64_t seed) {
+    const ScenarioDraw d = c.draw(seed, 0, 9, SamplerKind::kRandom);
+    const auto sc = scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
+    return scenario::missionJson(sc.mission) + scenario::simConfigJson(sc.sim);
+  };
+  EXPECT_EQ(json(11), json(11));
+  EXPECT_NE(json(11), json(12));
+}
+
+TEST(SpecNames, EditDistance) {
+  EXPECT_EQ(editDistance("kitten", "sitting"), 3);
+  EXPECT_EQ(editDistance("", "abc"), 3);
+  EXPECT_EQ(editDistance("snwo", "snow"), 1);  // a swap of two neighbours
+  EXPECT_EQ(nearestNames("gren", {"green", "grey", "red", "blue"}),
+            (std::vector<std::string>{"green", "grey"}));
+}
+
+}  // namespace
+}  // namespace hameritt::generation

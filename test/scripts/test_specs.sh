@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# The scenario language end to end: every example spec in scenarios/specs/ generates 1,000
+# scenarios, and hameritt_validate --spec re-checks every hard requirement from the scenes
+# (relations recomputed by the relation code), with soft-requirement frequencies within 3 sigma
+# of their probabilities; outputs pass the JSON schemas (python3-jsonschema); the same spec and
+# seed give the same bytes on any --jobs; malformed, unsatisfiable and bad-parameter runs exit 2
+# with nothing written; and the validator fails on scenes that do not meet a spec (negative
+# controls).
+source "$(dirname "$0")/cli_lib.sh" specs
+
+G="$BIN/hameritt_generate"
+V="$BIN/hameritt_validate"
+S="$SRC/scenarios/specs"
+N=1000
+OUT="$T"
+[[ -d /dev/shm && -w /dev/shm ]] && OUT="$(mktemp -d /dev/shm/hameritt_specs.XXXXXX)" && trap 'rm -rf "$T" "$OUT"' EXIT
+
+# soft_ok VALIDATE_OUTPUT SPEC: every "soft 'R': held in K of N" line is within 3 sigma of the
+# probability that SPEC gives R ("prefer P R"); prints how many were checked.
+soft_check() {
+  /usr/bin/python3 - "$1" "$2" <<'EOF'
+import math, re, sys
+out, spec = open(sys.argv[1]).read(), open(sys.argv[2]).read()
+probs = {m.group(2).strip(): float(m.group(1))
+         for m in re.finditer(r"^prefer\s+([0-9.]+)\s+(.*?)\s*(#.*)?$", spec, re.M)}
+lines = re.findall(r"^soft '(.*)': held in (\d+) of (\d+) scenarios$", out, re.M)
+if len(lines) != len(probs):
+    print(f"expected {len(probs)} soft lines, got {len(lines)}"); sys.exit(1)
+for req, k, n in lines:
+    p, k, n = probs[req], int(k), int(n)
+    sigma = math.sqrt(n * p * (1 - p))
+    if abs(k - n * p) > 3 * sigma:
+        print(f"soft '{req}': {k} of {n}, expected {n * p:.0f} +- {3 * sigma:.0f}"); sys.exit(1)
+print(len(lines))
+EOF
+}
+
+specs=("$S"/*.hspec)
+[[ ${#specs[@]} -ge 8 ]] && ok || bad "expected at least 8 example specs, got ${#specs[@]}"
+soft_total=0
+for spec in "${specs[@]}"; do
+  name="$(basename "$spec" .hspec)"
+  "$G" --spec "$spec" --count $N --seed 2026 --out "$OUT/$name" --jobs 2 --quiet &&
+    ok || bad "$name: generation failed"
+  n=$(find "$OUT/$name" -mindepth 1 -maxdepth 1 -type d | wc -l)
+  [[ $n -eq $N ]] && ok || bad "$name: expected $N scenario directories, got $n"
+  "$V" --spec "$spec" "$OUT/$name" >"$T/$name.out" 2>"$T/$name.err" && ok ||
+    bad "$name: validation failed: $(head -3 "$T/$name.err")"
+  grep -qx "$N scenarios, $N meet the spec, 0 fail" "$T/$name.out" && ok ||
+    bad "$name: $(tail -1 "$T/$name.out")"
+  k=$(soft_check "$T/$name.out" "$spec") && ok || bad "$name: $k"
+  soft_total=$((soft_total + ${k:-0}))
+done
+# Three examples carry a soft requirement: all were checked.
+[[ $soft_total -eq 3 ]] && ok || bad "expected 3 soft requirements checked, got $soft_total"
+
+# --- outside judge: the JSON schemas (sim_config's spec block included)
+/usr/bin/python3 - "$SRC/config/schema" "$OUT" <<'EOF' && ok || bad "jsonschema"
+import glob, json, sys
+import jsonschema
+schema_dir, out = sys.argv[1:]
+checked = 0
+for kind in ("mission", "sim_config"):
+    schema = json.load(open(f"{schema_dir}/{kind}.schema.json"))
+    for f in sorted(glob.glob(f"{out}/*/*/{kind}.json"))[::97]:
+        doc = json.load(open(f))
+        jsonschema.validate(doc, schema)
+        if kind == "sim_config":
+            assert "spec" in doc and len(doc["spec"]["hash"]) == 16, f
+        checked += 1
+# Negative control: a spec block with a bad hash fails the schema.
+doc["spec"]["hash"] = "XYZ"
+try:
+    jsonschema.validate(doc, schema)
+    sys.exit("a bad spec.hash passed the schema")
+except jsonschema.ValidationError:
+    pass
+assert checked > 100, checked
+EOF
+
+# --- same spec and seed, same bytes on any --jobs; Halton too
+red="$S/red_sedan_garage.hspec"
+"$G" --spec "$red" --count 40 --seed 9 --out "$T/j1" --jobs 1 --quiet && ok || bad "jobs 1"
+"$G" --spec "$red" --count 40 --seed 9 --out "$T/j3" --jobs 3 --quiet && ok || bad "jobs 3"
+diff -r "$T/j1" "$T/j3" >/dev/null && ok || bad "--spec outputs differ between --jobs 1 and 3"
+"$G" --spec "$S/halton_sweep.hspec" --sampler halton --count 40 --seed 9 --out "$T/h1" --jobs 1 --quiet && ok || bad "halton jobs 1"
+"$G" --spec "$S/halton_sweep.hspec" --sampler halton --count 40 --seed 9 --out "$T/h2" --jobs 2 --quiet && ok || bad "halton jobs 2"
+diff -r "$T/h1" "$T/h2" >/dev/null && ok || bad "halton outputs differ between --jobs 1 and 2"
+"$V" --spec "$S/halton_sweep.hspec" "$T/h1" >/dev/null 2>&1 && ok || bad "halton outputs fail the spec"
+grep -q '"sampler": "halton"' "$T/h1"/*/sim_config.json && ok || bad "no halton provenance"
+
+# --- --param overrides reach the scenes
+"$G" --spec "$S/snowy_dusk_search.hspec" --param snow=0.9 --count 20 --seed 4 --out "$T/p" --quiet && ok || bad "--param run"
+n=$(grep -l '"snow": 0.9' "$T/p"/*/sim_config.json | wc -l)
+[[ $n -eq 20 ]] && ok || bad "--param snow=0.9: $n of 20 scenarios have snow 0.9"
+"$V" --spec "$S/snowy_dusk_search.hspec" --param snow=0.9 "$T/p" >/dev/null 2>&1 && ok || bad "--param outputs fail the spec"
+# Negative control: the same scenes against the spec's own range(0.5, 1) pass, against 0.6 fail.
+expect 2 "environment.snow: 0.9 is outside 0.6" "$V" --spec "$S/snowy_dusk_search.hspec" --param snow=0.6 "$T/p"
+
+# --- bad input: exit 2, a message naming the place, nothing written
+printf 'scenario area_search\ntarget car {colour: red}\n' >"$T/bad.hspec"
+expect 2 "bad.hspec:2:13: error: unknown attribute 'colour' of car; did you mean 'color'" "$G" --spec "$T/bad.hspec" --count 3 --seed 1 --out "$T/x1"
+printf 'scenario area_search\ntarget car {color: red}\nrequire street ON_TOP_OF target\nrequire driveway ON_TOP_OF target\n' >"$T/unsat.hspec"
+expect 2 "unsat.hspec:4:1: error: unsatisfiable in this world: driveway ON_TOP_OF target: 0 of [0-9]+ candidates \(parking places x looks: [0-9]+ -> color red: [0-9]+ -> street ON_TOP_OF target: [0-9]+\)" "$G" --spec "$T/unsat.hspec" --count 3 --seed 1 --out "$T/x2"
+expect 2 "--param: unknown parameter 'snwo'; did you mean 'snow'" "$G" --spec "$S/snowy_dusk_search.hspec" --param snwo=1 --count 3 --seed 1 --out "$T/x3"
+expect 2 "--param: parameter 'snow' given more than once" "$G" --spec "$S/snowy_dusk_search.hspec" --param snow=1 --param snow=0.7 --count 3 --seed 1 --out "$T/x4"
+expect 2 "--sampler: expected random or halton, got 'sobol'" "$G" --spec "$red" --sampler sobol --count 3 --seed 1 --out "$T/x5"
+expect 2 "a spec names its class" "$G" --spec "$red" --class pursuit --count 3 --seed 1 --out "$T/x6"
+expect 2 "cannot read spec file" "$G" --spec "$T/missing.hspec" --count 3 --seed 1 --out "$T/x7"
+for x in x1 x2 x3 x4 x5 x6 x7; do
+  [[ ! -e "$T/$x" ]] && ok || bad "a refused run wrote $T/$x"
+done
+
+# --- negative controls: the validator fails scenes that do not meet the spec
+expect 2 "requirement 'garage LEFT_OF target \{color: white\}' does not hold|model 'Accord' is not one of Impala|make '.*' is not one of Chevrolet" "$V" --spec "$S/impala_lookalikes.hspec" "$T/j1"
+out=$("$V" --spec "$S/impala_lookalikes.hspec" "$T/j1" 2>/dev/null | tail -1)
+[[ "$out" == "40 scenarios, 0 meet the spec, 40 fail" ]] && ok || bad "impala spec on red-sedan scenes: $out"
+one="$(ls -d "$T/j1"/*/ | head -1)"
+sed -i 's/"color": "red"/"color": "green"/' "$one/sim_config.json"
+out=$("$V" --spec "$red" "$T/j1" 2>"$T/neg.err" | tail -1)
+[[ "$out" == "40 scenarios, 39 meet the spec, 1 fail" ]] && ok || bad "edited target colour: $out"
+grep -q "color 'green' is not one of red" "$T/neg.err" && ok || bad "no colour message: $(cat "$T/neg.err")"
+
+echo "$pass passed, $fail failed"
+[[ $fail -eq 0 ]]
