@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "hameritt/scenario/error.h"
+#include "hameritt/sitl/counters_json.h"
 
 namespace hameritt::sitl {
 
@@ -31,22 +32,16 @@ std::string vec(const Vec3& v) {
 }  // namespace
 
 std::string toJson(const ArduPilotCounters& c) {
-  const std::pair<const char*, std::uint64_t> fields[] = {{"packets", c.packets},
-                                                          {"bad_size", c.bad_size},
-                                                          {"bad_magic", c.bad_magic},
-                                                          {"duplicates", c.duplicates},
-                                                          {"resets", c.resets},
-                                                          {"missed_frames", c.missed_frames},
-                                                          {"out_of_range_pwm", c.out_of_range_pwm},
-                                                          {"stalls", c.stalls},
-                                                          {"lockstep_steps", c.lockstep_steps},
-                                                          {"state_messages", c.state_messages}};
-  std::string out = "{";
-  for (const auto& [k, v] : fields) {
-    if (out.size() > 1) out += ", ";
-    out += std::string("\"") + k + "\": " + std::to_string(v);
-  }
-  return out + "}";
+  return countersJson({{"packets", c.packets},
+                       {"bad_size", c.bad_size},
+                       {"bad_magic", c.bad_magic},
+                       {"duplicates", c.duplicates},
+                       {"resets", c.resets},
+                       {"missed_frames", c.missed_frames},
+                       {"out_of_range_pwm", c.out_of_range_pwm},
+                       {"stalls", c.stalls},
+                       {"lockstep_steps", c.lockstep_steps},
+                       {"state_messages", c.state_messages}});
 }
 
 std::string ardupilotStateJson(const sim::UavState& s, const ImuSample& imu) {

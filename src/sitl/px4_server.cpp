@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "hameritt/scenario/error.h"
+#include "hameritt/sitl/counters_json.h"
 
 namespace hameritt::sitl {
 
@@ -40,31 +41,24 @@ std::string num(double v) {
 }  // namespace
 
 std::string toJson(const Px4Counters& c) {
-  const std::pair<const char*, std::uint64_t> fields[] = {
-      {"connections", c.connections},
-      {"disconnects", c.disconnects},
-      {"refused_connections", c.refused_connections},
-      {"stalls", c.stalls},
-      {"silent_clients", c.silent_clients},
-      {"overflows", c.overflows},
-      {"stray_bytes", c.stray_bytes},
-      {"bad_crc", c.bad_crc},
-      {"unknown_messages", c.unknown_messages},
-      {"bad_length", c.bad_length},
-      {"truncated", c.truncated},
-      {"nan_actuators", c.nan_actuators},
-      {"out_of_range_actuators", c.out_of_range_actuators},
-      {"actuator_messages", c.actuator_messages},
-      {"lockstep_steps", c.lockstep_steps},
-      {"sensor_messages", c.sensor_messages},
-      {"gps_messages", c.gps_messages},
-      {"state_messages", c.state_messages}};
-  std::string out = "{";
-  for (const auto& [k, v] : fields) {
-    if (out.size() > 1) out += ", ";
-    out += std::string("\"") + k + "\": " + std::to_string(v);
-  }
-  return out + "}";
+  return countersJson({{"connections", c.connections},
+                       {"disconnects", c.disconnects},
+                       {"refused_connections", c.refused_connections},
+                       {"stalls", c.stalls},
+                       {"silent_clients", c.silent_clients},
+                       {"overflows", c.overflows},
+                       {"stray_bytes", c.stray_bytes},
+                       {"bad_crc", c.bad_crc},
+                       {"unknown_messages", c.unknown_messages},
+                       {"bad_length", c.bad_length},
+                       {"truncated", c.truncated},
+                       {"nan_actuators", c.nan_actuators},
+                       {"out_of_range_actuators", c.out_of_range_actuators},
+                       {"actuator_messages", c.actuator_messages},
+                       {"lockstep_steps", c.lockstep_steps},
+                       {"sensor_messages", c.sensor_messages},
+                       {"gps_messages", c.gps_messages},
+                       {"state_messages", c.state_messages}});
 }
 
 void Px4Config::validate(double physics_rate_hz) const {

@@ -50,11 +50,19 @@ def start_master(port, seconds=30):
     return core
 
 
-def stop_master(core):
-    """Stops a master from start_master(): SIGINT, then SIGKILL if it has not exited in 30 s."""
-    core.send_signal(signal.SIGINT)
+def stop_process(proc, seconds=30):
+    """Stops a node, launch or master process: SIGINT (a node's or roslaunch's orderly
+    shutdown), then SIGKILL if it has not exited in `seconds`. None or an exited one is left."""
+    if proc is None or proc.poll() is not None:
+        return
+    proc.send_signal(signal.SIGINT)
     try:
-        core.wait(30)
+        proc.wait(seconds)
     except subprocess.TimeoutExpired:
-        core.kill()
-        core.wait()
+        proc.kill()
+        proc.wait()
+
+
+def stop_master(core):
+    """Stops a master from start_master()."""
+    stop_process(core)

@@ -17,6 +17,7 @@ fi
 CHECKOUT_TOOLS="bench/bench_mission.py
 scripts/common.sh
 scripts/fuzz.sh
+scripts/make_city_images.sh
 scripts/make_default_scenario.sh
 scripts/make_meshes.py
 scripts/make_render_images.sh

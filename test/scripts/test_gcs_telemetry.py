@@ -13,14 +13,12 @@ independent decoder (mavlink_judge.py, python3-crcmod) and compared with /uav/od
 """
 import math
 import os
-import signal
 import socket
 import subprocess
 import sys
 import threading
 import time
 
-import rosgraph
 import rospy
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
@@ -28,10 +26,10 @@ from nav_msgs.msg import Odometry
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mavlink_judge as mj  # noqa: E402
 from fault_util import BIN, SCENARIO, Checks  # noqa: E402
-from graph_util import wait_for  # noqa: E402
+from graph_util import (private_master_port, start_master, stop_master,  # noqa: E402
+                        stop_process)
 
-PORT = 30000 + os.getpid() % 2000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
+PORT = private_master_port(30000)
 ORIGIN = (42.4851, -71.1873, 40.0)
 check = Checks()
 
@@ -41,11 +39,9 @@ def main():
     gcs.bind(("127.0.0.1", 0))
     gcs.settimeout(0.2)
     gcs_port = gcs.getsockname()[1]
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     sim = None
     try:
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         sim = subprocess.Popen(
             [os.path.join(BIN, "simulator"), "__name:=simulator",
              "_sim_config:=%s/sim_config.json" % SCENARIO, "_cameras:=false",
@@ -130,14 +126,8 @@ def main():
         check(worst_pos <= 0.1, "lat/lon differ by %.3f m" % worst_pos)
         check(top > 4.0, "the UAV did not climb (top %.2f m)" % top)
     finally:
-        if sim is not None:
-            sim.send_signal(signal.SIGINT)
-            try:
-                sim.wait(30)
-            except subprocess.TimeoutExpired:
-                sim.kill()
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_process(sim)
+        stop_master(core)
     return check.summary("(nothing kept)")
 
 

@@ -16,14 +16,12 @@ Negative control run here: the hold check rejects a trace that leaves the band.
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
 import threading
 import time
 
-import rosgraph
 import rospy
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
@@ -32,11 +30,11 @@ from std_msgs.msg import String
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ardupilot_standin as ast  # noqa: E402
 from fault_util import BIN, SCENARIO, Checks  # noqa: E402
-from graph_util import wait_for  # noqa: E402
+from graph_util import (private_master_port, start_master, stop_master,  # noqa: E402
+                        stop_process, wait_for)
 
-PORT = 28000 + os.getpid() % 2000
+PORT = private_master_port(28000)
 UDP_PORT = 39002 + (os.getpid() % 500) * 10
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
 check = Checks()
 
 
@@ -72,12 +70,10 @@ def holds(trace, start, span, target, tol):
 
 def main():
     tmp = tempfile.mkdtemp(prefix="hameritt_sitl_ardupilot.")
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     sim = None
     log = os.path.join(tmp, "simulator.log")
     try:
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         sim = subprocess.Popen(
             [os.path.join(BIN, "simulator"), "__name:=simulator",
              "_sim_config:=%s/sim_config.json" % SCENARIO, "_cameras:=false",
@@ -176,14 +172,8 @@ def main():
         check(c.get("state_messages") == valid, "state_messages %s" % c.get("state_messages"))
         check(c.get("out_of_range_pwm") == 0, "out_of_range_pwm %s" % c.get("out_of_range_pwm"))
     finally:
-        if sim is not None:
-            sim.send_signal(signal.SIGINT)
-            try:
-                sim.wait(30)
-            except subprocess.TimeoutExpired:
-                sim.kill()
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_process(sim)
+        stop_master(core)
         if not check.fails:
             shutil.rmtree(tmp, ignore_errors=True)
     return check.summary(tmp)

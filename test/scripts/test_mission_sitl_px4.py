@@ -23,7 +23,6 @@ trace that leaves the band.
 import json
 import os
 import shutil
-import signal
 import socket
 import subprocess
 import sys
@@ -31,7 +30,6 @@ import tempfile
 import threading
 import time
 
-import rosgraph
 import rospy
 from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
@@ -41,12 +39,12 @@ from std_msgs.msg import String
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mavlink_judge as mj  # noqa: E402
 import px4_standin  # noqa: E402
-from fault_util import BIN, SCENARIO, SRC, Checks  # noqa: E402
-from graph_util import wait_for  # noqa: E402
+from fault_util import BIN, SCENARIO, Checks  # noqa: E402
+from graph_util import (private_master_port, start_master, stop_master,  # noqa: E402
+                        stop_process, wait_for)
 
-PORT = 26000 + os.getpid() % 2000
+PORT = private_master_port(26000)
 SIM_PORT = 34560 + os.getpid() % 1000
-os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % PORT
 check = Checks()
 
 
@@ -122,12 +120,10 @@ def bad_input(ap, hooks):
 
 def main():
     tmp = tempfile.mkdtemp(prefix="hameritt_sitl_px4.")
-    core = subprocess.Popen(["roscore", "-p", str(PORT)], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    core = start_master(PORT)
     sim = None
     log = os.path.join(tmp, "simulator.log")
     try:
-        wait_for(lambda: rosgraph.is_master_online(), 30, "the master")
         assert mj.self_check() == 10
         dump_params(tmp)
         sim = subprocess.Popen(
@@ -322,14 +318,8 @@ def main():
         check(not neg.feed(bytes(frame)) and neg.bad_crc == 1,
               "negative control: the judge accepts a corrupted HIL_SENSOR")
     finally:
-        if sim is not None:
-            sim.send_signal(signal.SIGINT)
-            try:
-                sim.wait(30)
-            except subprocess.TimeoutExpired:
-                sim.kill()
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_process(sim)
+        stop_master(core)
         if not check.fails:
             shutil.rmtree(tmp, ignore_errors=True)
     return check.summary(tmp)

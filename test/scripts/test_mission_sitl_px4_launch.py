@@ -15,7 +15,6 @@ Negative control, here: the same height check on the recorded trace cut at 5 m m
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -26,7 +25,8 @@ import rosbag
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import px4_standin  # noqa: E402
 from fault_util import Checks, metrics_validator  # noqa: E402
-from graph_util import private_master_port, start_master, stop_master  # noqa: E402
+from graph_util import (private_master_port, start_master, stop_master,  # noqa: E402
+                        stop_process)
 
 PORT = private_master_port(29000)
 SIM_PORT = 36560 + os.getpid() % 1000  # px4_port; instance 1 adds one
@@ -114,12 +114,7 @@ def main():
         cut = [(t, min(z, z0 + 5.0)) for t, z in trace]
         check(not flew(cut, z0)[0], "negative control: a flight cut at 5 m passes the check")
     finally:
-        if launch is not None and launch.poll() is None:
-            launch.send_signal(signal.SIGINT)
-            try:
-                launch.wait(60)
-            except subprocess.TimeoutExpired:
-                launch.kill()
+        stop_process(launch, 60)
         stop_master(core)
         if not check.fails:
             shutil.rmtree(tmp, ignore_errors=True)
