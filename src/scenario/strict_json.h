@@ -44,7 +44,7 @@ inline json parseText(const std::string& text, const std::string& file) {
   checkJsonText(text, file);
   try {
     return json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number beyond a double
     throw ConfigError(file + ": malformed JSON: " + e.what());
   }
 }

@@ -151,6 +151,9 @@ bool parseJsonText(const std::string& text, const std::string& file, json* out,
               "malformed JSON at line " + std::to_string(line) + ", column " + std::to_string(col) +
                   ": " + what};
     return false;
+  } catch (const json::exception& e) {  // e.g. out_of_range 406: a number beyond a double
+    *issue = {file, "", "json", std::string("malformed JSON: ") + e.what()};
+    return false;
   }
   if (!duplicate.empty()) {
     *issue = {file, duplicate, "json", "duplicate object key (a reader would keep only one value)"};
