@@ -47,4 +47,7 @@ else
   grep -E "FAIL|$SANITIZER_REPORT_RE" "$work/golden.log" | head -20
   failed=1
 fi
+# rosrun searches the whole package directory: a second hameritt_generate below build/ would make
+# `rosrun hameritt hameritt_generate` ask which one to run (the docs test failed on it).
+rm -f "$bin/hameritt_generate"
 exit "$failed"
