@@ -246,7 +246,7 @@ def check_tools(root, bin_dir):
                 problems.append("%s: exit %d, no usage: %s" % (" ".join(cmd[1:]), r.returncode,
                                                              r.stdout[:200]))
             helps.append(r.stdout)
-        for flag in sorted(set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", sec))):
+        for flag in sorted(set(re.findall(r"(?<![\w-])--[a-z][a-z0-9-]*", sec))):
             if not any(re.search(re.escape(flag) + r"(?![\w-])", h) for h in helps):
                 problems.append("%s: docs name %s, its --help does not" % (tool, flag))
     return checked, problems
