@@ -13,23 +13,13 @@
 #include <thread>
 
 #include "hameritt/scenario/world.h"
+#include "sitl_test_util.h"
 
 namespace hameritt::sitl {
 namespace {
 
-const sim::QuadrotorParams& sentinel() {
-  static const sim::QuadrotorParams p = sim::loadQuadrotorUrdf(sim::defaultQuadrotorUrdf());
-  return p;
-}
-
-scenario::SimConfig calm() {
-  scenario::SimConfig c;
-  c.seed = 3;
-  c.duration = 600;
-  c.uav.start = {0, 0, 0, 0, 0};
-  c.uav.max_speed = 12;
-  return c;
-}
+using test::calm;
+using test::sentinel;
 
 std::vector<std::uint8_t> packet(std::uint32_t frame, std::uint16_t pwm,
                                  std::uint16_t magic = kServoMagic16) {

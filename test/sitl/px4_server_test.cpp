@@ -14,6 +14,7 @@
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/world.h"
+#include "sitl_test_util.h"
 #include "hameritt/sim/quadrotor.h"
 
 namespace hameritt::sitl {
@@ -23,19 +24,8 @@ namespace ml = mavlink;
 
 int testPort() { return 21000 + static_cast<int>(::getpid() % 20000); }
 
-const sim::QuadrotorParams& sentinel() {
-  static const sim::QuadrotorParams p = sim::loadQuadrotorUrdf(sim::defaultQuadrotorUrdf());
-  return p;
-}
-
-scenario::SimConfig calm() {
-  scenario::SimConfig c;
-  c.seed = 3;
-  c.duration = 600;
-  c.uav.start = {0, 0, 0, 0, 0};
-  c.uav.max_speed = 12;
-  return c;
-}
+using test::calm;
+using test::sentinel;
 
 // A minimal autopilot side: a socket and the codec's parser.
 struct Client {
