@@ -352,9 +352,14 @@ TEST(SpecCompile, AoiOffsetAndUavStartAreMetAndChecked) {
         scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
     const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
     EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
-    // Negative controls: the UAV moved 300 m away; the AOI moved 12 m.
+    // Negative controls: the UAV 400 m from the target; the AOI moved 12 m.
     scenario::SimConfig far = sc.sim;
-    far.uav.start.x += 300.0;
+    for (const auto& se : sc.sim.entities) {
+      if (se.role == "target") {
+        far.uav.start.x = se.entity.box.center2().x() + 400.0;
+        far.uav.start.y = se.entity.box.center2().y();
+      }
+    }
     const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, far, nullptr);
     ASSERT_EQ(f1.size(), 1u);
     EXPECT_NE(f1[0].find("uav.start_within: the UAV starts"), std::string::npos) << f1[0];
