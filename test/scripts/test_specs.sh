@@ -122,12 +122,12 @@ out=$("$V" --spec "$red" "$T/j1" 2>"$T/neg.err" | tail -1)
 grep -q "color 'green' is not one of red" "$T/neg.err" && ok || bad "no colour message: $(cat "$T/neg.err")"
 
 # The UAV start and the AOI around the target, recomputed from the scene: one kerbside scene
-# with its UAV moved 400 m, one impala scene with its AOI moved 25 m, each fails (exit 2).
+# with its UAV moved 1 km, one impala scene with its AOI moved 25 m, each fails (exit 2).
 k1="$(ls -d "$OUT/kerbside_suv"/*/ | head -1)"
 /usr/bin/python3 - "$k1/sim_config.json" <<'EOF2'
 import json, sys
 d = json.load(open(sys.argv[1]))
-d["uav"]["start"]["x"] += 400.0
+d["uav"]["start"]["x"] += 1000.0  # at least 700 m from the target
 json.dump(d, open(sys.argv[1], "w"), indent=2)
 EOF2
 expect 2 "uav.start_within: the UAV starts" "$V" --spec "$S/kerbside_suv.hspec" "$k1"
