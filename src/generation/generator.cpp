@@ -761,7 +761,15 @@ class ScenarioBuilder {
       const std::string id = "aoi_" + std::to_string(i + 1);
       const double len = rangeDraw(rng_, cfg_.aoi_length), wid = rangeDraw(rng_, cfg_.aoi_width);
       AreaOfInterest a;
-      if (i == 0) {
+      if (i == 0 && plan_ && plan_->aoi_target_offset) {
+        // The target at this distance from the AOI's centre, in a random direction.
+        const double phi = rng_.uniform(-geometry::kPi, geometry::kPi);
+        const Vec2 c = tp - *plan_->aoi_target_offset * Vec2(std::cos(phi), std::sin(phi));
+        a.id = id;
+        a.polygon = roundPolygon(geometry::orientedRectangle(c, len, wid, yaw0));
+        if (!a.polygon.contains(tp))
+          throw GenerationError("target AOI does not contain the target");
+      } else if (i == 0) {
         a = makeAoi(id, tp, yaw0, len, wid);
         if (!a.polygon.contains(tp)) throw GenerationError("target AOI does not contain the target");
       } else {
@@ -1216,13 +1224,34 @@ class ScenarioBuilder {
         break;
       }
     }
+    auto allowed = [&](const Vec2& p, double far) {
+      const double d = (p - first_target).norm();
+      if (d < std::min(120.0, 0.5 * far) || d > far) return false;
+      for (const auto& k : sc_.mission.kozs) {
+        if (k.polygon.distance(p) < 5.0) return false;
+      }
+      return true;
+    };
+    if (plan_ && plan_->uav_start_within) {
+      // A spec's band: drawn from every intersection in it (constructive, no retries).
+      std::vector<Vec2> feasible;
+      for (const auto& n : world_.nodes()) {
+        if (allowed(n.position, *plan_->uav_start_within)) feasible.push_back(n.position);
+      }
+      if (feasible.empty()) {
+        throw GenerationError(
+            "no intersection within uav.start_within of the target outside "
+            "the keep-out zones");
+      }
+      const Vec2 p = rng_.pick(feasible);
+      uav_.start = {0.0, p.x(), p.y(), 0.0,
+                    roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
+      sc_.sim.uav = uav_;
+      return;
+    }
     for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
       const Vec2 p = world_.nodes()[static_cast<std::size_t>(randomNode())].position;
-      const double d = (p - first_target).norm();
-      if (d < 120.0 || d > 600.0) continue;
-      bool in_koz = false;
-      for (const auto& k : sc_.mission.kozs) in_koz = in_koz || k.polygon.distance(p) < 5.0;
-      if (in_koz) continue;
+      if (!allowed(p, 600.0)) continue;
       uav_.start = {0.0, p.x(), p.y(), 0.0, roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
       sc_.sim.uav = uav_;
       return;

@@ -238,6 +238,7 @@ const std::map<std::string, KeyLimits>& keyLimits() {
       {"aois.length", {40, 800, false}},
       {"aois.width", {40, 800, false}},
       {"aois.window_probability", {0, 1, false}},
+      {"aois.target_offset", {0, 300, false}},
       {"prior.depth", {1, 3, true}},
       {"kozs.count", {1, 5, true}},
       {"kozs.window_probability", {0, 1, false}},
@@ -262,6 +263,7 @@ const std::map<std::string, KeyLimits>& keyLimits() {
       {"camera.motion_blur", {0, 20, false}},
       {"uav.altitude_min", {2, 300, false}},
       {"uav.altitude_max", {5, 400, false}},
+      {"uav.start_within", {200, 600, false}},
   };
   return k;
 }
@@ -895,6 +897,11 @@ class Parser {
         errorAt(r.pos, requirement_src_[i],
                 "relations to cars and pedestrians change with the scene: requirements relate "
                 "the target to the neighborhood (street, driveway, house, garage, fence, tree)");
+      }
+    }
+    for (const auto& kv : settings_) {
+      if (kv.first == "aois.target_offset" && spec_.cls != scenario::ScenarioClass::kAreaSearch) {
+        errorAt(kv.second.pos, kv.second.src, kv.first + " applies to area_search only");
       }
     }
     const std::string route_keys[] = {"route.edges", "route.band"};

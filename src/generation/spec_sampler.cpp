@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
+#include <variant>
 
 #include "hameritt/generation/target_slots.h"
 #include "hameritt/scenario/catalog.h"
@@ -50,10 +52,74 @@ OrientedBox parkedBox(const scenario::ParkingSlot& sl, const scenario::catalog::
       scenario::roundMilli(geometry::wrapPi(sl.yaw)), Vec3(m.length, m.width, m.height));
 }
 
-// True when some world entity matching the requirement's related class and attributes stands
-// in its relation to a target with this box (the negation is applied by the caller).
-bool worldRelationHolds(const scenario::RelationEvaluator& eval, const scenario::World& world,
-                        const Requirement& r, const OrientedBox& box) {
+// The world entities within `reach` of a place that could be the requirement's related entity
+// (its class, look and an operator that applies): computed once per parking place, for every
+// car model parked there.
+std::vector<int> relatedNear(const scenario::World& world, const Requirement& r, const Vec2& centre,
+                             double reach) {
+  std::vector<int> out;
+  for (int i : world.footprints().near(centre, reach)) {
+    const scenario::Entity& e = world.entities()[static_cast<std::size_t>(i)];
+    if (scenario::operatorApplies(r.op, e.cls) && r.matchesRelated(e.cls, e.attributes))
+      out.push_back(i);
+  }
+  return out;
+}
+
+// True when one of `candidates` (a superset of the related entities near the box) stands in the
+// requirement's relation to a target with this box (the negation is applied by the caller). The
+// same answer as holds(measure()) over nearbyWorldDistances(), but line of sight (the costly
+// part) is traced only where the distance and bearing leave the relation possible.
+bool holdsAmong(const scenario::RelationEvaluator& eval, const scenario::World& world,
+                const Requirement& r, const OrientedBox& box, const std::vector<int>& candidates) {
+  static const scenario::Attributes kNone;
+  const scenario::RelationConfig& cfg = eval.config();
+  scenario::Subject target;
+  target.id = "__spec_target__";
+  target.cls = EntityClass::kCar;
+  target.attributes = &kNone;
+  target.box = box;
+  double nominal = -1;  // the directional operators' bearing; ORTHOGONAL_TO: 90 or 270
+  if (r.op == scenario::RelationOp::kLeftOf || r.op == scenario::RelationOp::kOrthogonalTo)
+    nominal = 90.0;
+  if (r.op == scenario::RelationOp::kRightOf) nominal = 270.0;
+  if (r.op == scenario::RelationOp::kInFrontOf) nominal = 180.0;
+  for (int i : candidates) {
+    const scenario::Entity& e = world.entities()[static_cast<std::size_t>(i)];
+    const auto& [c, s] = world.footprints().trig(i);
+    const double d = geometry::footprintDistance(box, e.box, c, s);
+    if (d > cfg.radius) continue;  // not nearby: never considered
+    // Margins of 1 mm and 1e-6 deg over the thresholds keep the pruning on the safe side of
+    // measure()'s own rounding.
+    if (r.op == scenario::RelationOp::kNextTo && d >= cfg.next_to_distance + 1e-3) continue;
+    if (nominal >= 0) {
+      const Vec2 dv = e.box.center2() - box.center2();
+      const double bearing =
+          geometry::wrapDeg360(geometry::radToDeg(std::atan2(dv.y(), dv.x()) - box.yaw));
+      const double tol = cfg.bearing_tolerance_deg + 1e-6;
+      const bool could = geometry::angleDiffDeg(bearing, nominal) <= tol ||
+                         (r.op == scenario::RelationOp::kOrthogonalTo &&
+                          geometry::angleDiffDeg(bearing, 270.0) <= tol);
+      if (!could) continue;
+    }
+    const scenario::RelationFacts f = eval.measure(target, scenario::worldSubject(world, i));
+    if (eval.holds(r.op, f, e.cls)) return true;
+  }
+  return false;
+}
+
+bool worldRelationHoldsPruned(const scenario::RelationEvaluator& eval, const scenario::World& world,
+                              const Requirement& r, const OrientedBox& box) {
+  const double reach = eval.config().radius + 0.5 * box.size.head<2>().norm();
+  return holdsAmong(eval, world, r, box, relatedNear(world, r, box.center2(), reach));
+}
+
+// The checker's reference: holds(measure()) on every nearby entity of the related class and
+// look, with no pruning. The compiler's worldRelationHolds() must agree with it (the spec tests
+// validate every generated scene with this one).
+bool worldRelationHoldsReference(const scenario::RelationEvaluator& eval,
+                                 const scenario::World& world, const Requirement& r,
+                                 const OrientedBox& box) {
   static const scenario::Attributes kNone;
   scenario::Subject target;
   target.id = "__spec_target__";
@@ -152,10 +218,20 @@ void applySetting(const std::string& key, double v, ScenarioClass cls, scenario:
     c->uav_altitude_min = fixed(v);
   } else if (key == "uav.altitude_max") {
     c->uav_altitude_max = fixed(v);
+  } else if (key == "uav.start_within") {
+    plan->uav_start_within = v;
+  } else if (key == "aois.target_offset") {
+    plan->aoi_target_offset = v;
   }
 }
 
 }  // namespace
+
+bool worldRelationHolds(const scenario::RelationEvaluator& eval, const scenario::World& world,
+                        const Requirement& r, const geometry::OrientedBox& box, bool pruned) {
+  return pruned ? worldRelationHoldsPruned(eval, world, r, box)
+                : worldRelationHoldsReference(eval, world, r, box);
+}
 
 bool parseSampler(const std::string& s, SamplerKind* out) {
   if (s == "random")
@@ -213,6 +289,21 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     if (now == 0) refuse(a.pos, "target car {" + a.key + ": " + values(a) + "}", before);
     steps_.push_back({a.key + " " + values(a), now});
   }
+  if (const Distribution* off = spec_.setting("aois.target_offset")) {
+    // The target must stay inside its AOI, 5 m from the edge, whatever sides are drawn.
+    const Distribution* len = spec_.setting("aois.length");
+    const Distribution* wid = spec_.setting("aois.width");
+    const double side = std::min(len ? len->minValue() : base_.aoi_length.min,
+                                 wid ? wid->minValue() : base_.aoi_width.min);
+    if (off->maxValue() > 0.5 * side - 5.0) {
+      char buf[200];
+      std::snprintf(buf, sizeof(buf),
+                    "%s: error: aois.target_offset: up to %.3g m, but the target must lie 5 m "
+                    "inside an AOI whose shortest side may be %.3g m (at most %.3g m)",
+                    spec_.file.c_str(), off->maxValue(), side, 0.5 * side - 5.0);
+      throw SpecError(buf);
+    }
+  }
   if (!placed_) return;
   // Where: a block or a street.
   if (!spec_.target.block.empty() || !spec_.target.street.empty()) {
@@ -240,6 +331,13 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   for (int s : slots) {
     for (int m : models_) pairs.emplace_back(s, m);
   }
+  // The longest footprint diagonal of the models left: one neighbourhood query per place
+  // serves them all.
+  double max_diagonal = 0;
+  for (int m : models_) {
+    const auto& cm = models[static_cast<std::size_t>(m)];
+    max_diagonal = std::max(max_diagonal, std::hypot(cm.length, cm.width));
+  }
   // Requirements, hard ones first narrowing the set, soft ones split it.
   const scenario::RelationEvaluator eval(world, base.relations);
   std::vector<std::vector<char>> soft_masks;
@@ -247,10 +345,16 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     const Requirement& r = spec_.requirements[ri];
     if (r.eventually) continue;  // constructed by the pursuit's vignette
     std::vector<char> mask(pairs.size());
+    std::vector<int> candidates;  // per parking place: the pairs run place by place
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       const auto& sl = world.slots()[static_cast<std::size_t>(pairs[k].first)];
-      const bool holds = worldRelationHolds(
-          eval, world, r, parkedBox(sl, models[static_cast<std::size_t>(pairs[k].second)]));
+      if (k == 0 || pairs[k].first != pairs[k - 1].first) {
+        candidates = relatedNear(world, r, parkedBox(sl, models[0]).center2(),
+                                 base.relations.radius + 0.5 * max_diagonal);
+      }
+      const bool holds =
+          holdsAmong(eval, world, r,
+                     parkedBox(sl, models[static_cast<std::size_t>(pairs[k].second)]), candidates);
       mask[k] = holds != r.negated;
     }
     if (r.probability < 1.0) {
@@ -445,7 +549,7 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
         }
       }
     } else {
-      exists = worldRelationHolds(eval, world, r, box);
+      exists = worldRelationHoldsReference(eval, world, r, box);
     }
     const bool holds = exists != r.negated;
     if (r.probability < 1.0) {
@@ -539,6 +643,49 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
   inSupport("camera.noise", sim.perturbations.gaussian_noise_std, 1e-3);
   inSupport("camera.salt_pepper", sim.perturbations.salt_pepper_probability, 1e-5);
   inSupport("camera.motion_blur", sim.perturbations.motion_blur_px, 1e-3);
+  // The value the sampler recorded for a setting, if any (a scene value must agree with it).
+  auto drawn = [&](const std::string& key) -> std::optional<double> {
+    if (!sim.spec) return std::nullopt;
+    for (const auto& [name, v] : sim.spec->values) {
+      if (name == key && std::holds_alternative<double>(v)) return std::get<double>(v);
+    }
+    return std::nullopt;
+  };
+  auto printed = [](double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.3f", v);
+    return std::string(buf);
+  };
+  if (spec.setting("aois.target_offset") && spec.cls == ScenarioClass::kAreaSearch) {
+    // Measured from the scene: the target's distance from the centre of the AOI holding it.
+    const scenario::AreaOfInterest* held = nullptr;
+    for (const auto& a : mission.aois) {
+      if (!held && a.polygon.contains(box.center2())) held = &a;
+    }
+    if (!held || held->polygon.vertices().empty()) {
+      fail("aois.target_offset: no AOI holds target " + t.entity.id);
+    } else {
+      Vec2 c(0, 0);
+      for (const auto& v : held->polygon.vertices()) c += v;
+      c /= static_cast<double>(held->polygon.vertices().size());
+      const double off = (box.center2() - c).norm();
+      inSupport("aois.target_offset", off, 0.01);
+      const auto want = drawn("aois.target_offset");
+      if (want && std::abs(off - *want) > 0.01) {
+        fail("aois.target_offset: target " + t.entity.id + " is " + printed(off) +
+             " m from the centre of " + held->id + ", drawn " + printed(*want));
+      }
+    }
+  }
+  if (const Distribution* d = spec.setting("uav.start_within")) {
+    const double far = (Vec2(sim.uav.start.x, sim.uav.start.y) - box.center2()).norm();
+    const auto want = drawn("uav.start_within");
+    const double limit = want ? std::min(*want, d->maxValue()) : d->maxValue();
+    if (far > limit + 1e-3 || far < std::min(120.0, 0.5 * d->minValue()) - 1e-3) {
+      fail("uav.start_within: the UAV starts " + printed(far) + " m from target " + t.entity.id +
+           ", expected " + printed(std::min(120.0, 0.5 * d->minValue())) + " to " + printed(limit));
+    }
+  }
   inSupport("uav.altitude_min", sim.uav.altitude_min, 0.5);
   if (const Distribution* d = spec.setting("uav.altitude_max")) {
     const double v = sim.uav.altitude_max;

@@ -29,6 +29,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 
 SCHEMA_PLAN = "hameritt/campaign_plan"
@@ -145,7 +146,8 @@ def parse_config(text, path="campaign.yaml"):
     except yaml.YAMLError as e:
         raise CampaignError("%s: not valid YAML: %s" % (path, str(e).replace("\n", " ")))
     _expect(isinstance(raw, dict), path, "(top level)", "a mapping", raw)
-    known = {"name", "seed", "classes", "count", "shards", "world", "generate", "missions", "slurm"}
+    known = {"name", "seed", "classes", "count", "shards", "world", "generate", "missions", "slurm",
+             "spec", "spec_params", "sampler"}
     for k in raw:
         _expect(k in known, path, k, "one of " + ", ".join(sorted(known)), "unknown field")
     name = raw.get("name", "campaign")
@@ -158,6 +160,28 @@ def parse_config(text, path="campaign.yaml"):
         "count": _int_field(raw, path, "count", None, 1, 10000000),
         "shards": _int_field(raw, path, "shards", 1, 1, 10000),
     }
+    # A scenario-language spec instead of classes (hameritt_generate --spec): its path relative
+    # to the config file; the class comes from the spec (make_plan asks the generator).
+    if "spec" in raw:
+        _expect("classes" not in raw, path, "classes", "no classes with spec (a spec names its "
+                "class)", raw.get("classes"))
+        spec = raw["spec"]
+        _expect(isinstance(spec, str) and spec, path, "spec", "a .hspec file", spec)
+        spec = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(path)), spec))
+        _expect(os.path.isfile(spec), path, "spec", "a readable .hspec file", raw["spec"])
+        params = raw.get("spec_params", {}) or {}
+        _expect(isinstance(params, dict) and all(
+            isinstance(k, str) and isinstance(v, (int, float, str)) and not isinstance(v, bool)
+            for k, v in params.items()), path, "spec_params",
+            "a mapping of parameter names to values", params)
+        sampler = raw.get("sampler", "random")
+        _expect(sampler in ("random", "halton"), path, "sampler", "random or halton", sampler)
+        cfg["spec"] = {"file": spec, "sampler": sampler,
+                       "params": ["%s=%s" % (k, params[k]) for k in sorted(params)]}
+        cfg["classes"] = []
+    else:
+        for k in ("spec_params", "sampler"):
+            _expect(k not in raw, path, k, "only with spec", raw.get(k))
     # The world type (hameritt_generate --world); kept out of the plan when it is the default.
     world = raw.get("world", "suburb")
     _expect(world in ("suburb", "city"), path, "world", "suburb or city", world)
@@ -252,8 +276,39 @@ def unit_cost(unit):
     return 15.0 + unit["time_limit"] * 2.0
 
 
+def source_args(cfg):
+    """hameritt_generate's flags that say what to generate: the classes or the spec."""
+    if "spec" not in cfg:
+        return ["--class", ",".join(cfg["classes"])]
+    args = ["--spec", cfg["spec"]["file"], "--sampler", cfg["spec"]["sampler"]]
+    for p in cfg["spec"]["params"]:
+        args += ["--param", p]
+    return args
+
+
+def spec_class(cfg):
+    """The class of a spec campaign's scenarios: the generator compiles the spec (a bad or
+    unsatisfiable spec is a CampaignError naming the generator's message) and writes scenario 0,
+    whose mission.json names the class."""
+    tmp = tempfile.mkdtemp(prefix="hameritt_campaign_spec_")
+    try:
+        cmd = [os.path.join(tool_dir(), "hameritt_generate")] + source_args(cfg) + [
+            "--seed", str(cfg["seed"]), "--into", os.path.join(tmp, "s"), "--quiet"] + \
+            world_args(cfg)
+        r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           universal_newlines=True)
+        if r.returncode != 0:
+            raise CampaignError("spec %s: %s" % (cfg["spec"]["file"],
+                                                 r.stderr.strip().split("\n")[0]))
+        return load_json(os.path.join(tmp, "s", "mission.json"))["class"]
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
 def make_plan(cfg):
     """The deterministic list of work units and their shards for a config."""
+    if "spec" in cfg and not cfg["classes"]:
+        cfg["classes"] = [spec_class(cfg)]
     units = []
     size = cfg["generate"]["unit_size"]
     for k, first in enumerate(range(0, cfg["count"], size)):
@@ -414,7 +469,7 @@ def world_args(cfg):
 
 
 def run_generate_unit(cfg, unit, work, log):
-    cmd = [os.path.join(tool_dir(), "hameritt_generate"), "--class", ",".join(cfg["classes"]),
+    cmd = [os.path.join(tool_dir(), "hameritt_generate")] + source_args(cfg) + [
            "--count", str(unit["count"]), "--first", str(unit["first"]), "--seed",
            str(cfg["seed"]), "--out", os.path.join(work, "scenarios"), "--jobs",
            str(cfg["generate"]["jobs"]), "--quiet"] + world_args(cfg)
@@ -480,7 +535,7 @@ def run_mission_unit(cfg, unit, work, log, task_id, slot):
     scen_dir = os.path.join(work, "scenario")
     gen = os.path.join(work, "gen")
     # The scenario alone (--first INDEX --count 1): byte-identical to the batch's, no shared state.
-    cmd = [os.path.join(tool_dir(), "hameritt_generate"), "--class", ",".join(cfg["classes"]),
+    cmd = [os.path.join(tool_dir(), "hameritt_generate")] + source_args(cfg) + [
            "--count", "1", "--first", str(unit["scenario_index"]), "--seed", str(cfg["seed"]),
            "--out", gen, "--jobs", "1", "--quiet"] + world_args(cfg)
     r = subprocess.run(cmd, stdout=log, stderr=log)
@@ -915,7 +970,7 @@ def merge(cdir):
                                 % (e["unit"], e["scenario_id"], e["scenario_index"],
                                    by_index[e["scenario_index"]]))
     missions.sort(key=lambda e: (e["scenario_index"], MODES.index(e["mode"])))
-    campaign = {k: cfg[k] for k in ("name", "seed", "classes", "count")}
+    campaign = {k: cfg[k] for k in ("name", "seed", "classes", "count", "spec") if k in cfg}
     campaign["missions"] = {k: v for k, v in cfg["missions"].items()}
     manifest = {
         "schema": SCHEMA_MANIFEST, "schema_version": SCHEMA_VERSION, "campaign": campaign,

@@ -5,12 +5,17 @@
 //   hameritt_generate --class CLASS --scenario-seed S --out DIR   (regenerates one scenario)
 //   hameritt_generate --spec FILE [--param NAME=VALUE ...] [--sampler random|halton] --count N
 //                     --seed S --out DIR [--jobs J]       (scenarios from a scenario-language spec)
+//   hameritt_generate ... --seed S --into DIR   (one scenario: DIR/mission.json,
+//   DIR/sim_config.json)
 // Exit codes: 0 success, 2 bad input (a malformed or unsatisfiable spec, an unknown or repeated
 // --param) or unwritable output, 1 generation failure. On exit 2 nothing is written.
+
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
@@ -31,6 +36,9 @@ const char* kUsage =
     "       hameritt_generate --class CLASS --scenario-seed S --out DIR   (one scenario, seed S)\n"
     "       hameritt_generate --spec FILE [--param NAME=VALUE ...] [--sampler random|halton]\n"
     "                         --count N --seed S --out DIR [--jobs J]\n"
+    "       hameritt_generate (--class CLASS | --spec FILE ...) --seed S --into DIR\n"
+    "  --into DIR: scenario 0 of the batch, its mission.json and sim_config.json written into\n"
+    "  DIR itself (replacing those files; no manifest), e.g. for mission.launch spec:=FILE.\n"
     "  CLASS: area_search, route_search, pursuit, all, or a comma-separated list\n"
     "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n"
     "  --first K: write only indices K..K+N-1 of the batch (a shard), byte-identical to them.\n"
@@ -59,7 +67,7 @@ long parseCount(const std::string& flag, const std::string& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string cls, out, world_type, world_cfg = defaultConfigDir() + "/world.json";
+  std::string cls, out, into, world_type, world_cfg = defaultConfigDir() + "/world.json";
   std::string gen_cfg = defaultConfigDir() + "/generator.json";
   long count = -1, first = 0;
   std::uint64_t seed = 0;
@@ -85,6 +93,8 @@ int main(int argc, char** argv) {
         }
         first = static_cast<long>(k);
       } else if (a == "--out") out = next();
+      else if (a == "--into")
+        into = next();
       else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
       else if (a == "--world-config") world_cfg = next();
       else if (a == "--world")
@@ -109,6 +119,17 @@ int main(int argc, char** argv) {
     hameritt::generation::SamplerKind sampler;
     if (!hameritt::generation::parseSampler(sampler_name, &sampler)) {
       throw ConfigError("--sampler: expected random or halton, got '" + sampler_name + "'");
+    }
+    if (!into.empty()) {
+      if (!out.empty()) throw ConfigError("--into: give --out or --into, not both");
+      if (count > 1) throw ConfigError("--into: writes one scenario; --count must be 1");
+      if (first != 0) throw ConfigError("--into: cannot be combined with --first");
+      count = 1;
+      // Generated beside DIR, then moved into it file by file (each rename atomic): a failed
+      // run leaves DIR as it was.
+      std::filesystem::path dir(into);
+      out = (dir.has_filename() ? dir : dir.parent_path()).string() + ".tmp." +
+            std::to_string(::getpid());
     }
     if (count < 0 && exact) count = 1;
     if (count < 0) throw ConfigError("--count is required");
@@ -141,7 +162,35 @@ int main(int argc, char** argv) {
       req.spec = compiled.get();
       req.sampler = sampler;
     }
-    const auto entries = generateBatch(world, gc, req);
+    if (!into.empty()) req.write_world = false;
+    std::vector<hameritt::scenario::ManifestEntry> entries;
+    try {
+      entries = generateBatch(world, gc, req);
+    } catch (...) {
+      std::error_code ec;
+      if (!into.empty()) std::filesystem::remove_all(out, ec);
+      throw;
+    }
+    if (!into.empty()) {
+      namespace fs = std::filesystem;
+      std::error_code ec;
+      const std::string from = out + "/" + entries.at(0).id;
+      fs::create_directories(into, ec);
+      if (ec || !fs::is_directory(into)) {
+        fs::remove_all(out, ec);
+        throw OutputError(into + ": cannot create directory");
+      }
+      for (const char* f : {"sim_config.json", "mission.json"}) {
+        fs::rename(from + "/" + f, into + "/" + f, ec);
+        if (ec) {
+          const std::string why = ec.message();
+          fs::remove_all(out, ec);
+          throw OutputError(into + "/" + f + ": cannot write: " + why);
+        }
+      }
+      fs::remove_all(out, ec);
+      out = into;
+    }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!quiet) {
       for (const auto& e : entries) std::printf("%s\n", e.id.c_str());

@@ -13,8 +13,11 @@
 
 #include "../scenario/test_util.h"
 #include "hameritt/generation/spec_sampler.h"
+#include "hameritt/scenario/catalog.h"
+#include "hameritt/scenario/relations.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/trajectory.h"
 
 namespace hameritt::generation {
 namespace {
@@ -294,6 +297,90 @@ TEST(SpecCheck, SameSpecAndSeedGiveTheSameScenario) {
   };
   EXPECT_EQ(json(11), json(11));
   EXPECT_NE(json(11), json(12));
+}
+
+// The compiler's pruned relation evaluation agrees with the checker's reference on every
+// parking place x model of the shipped world, for every relation requirement of the examples.
+TEST(SpecCompile, PrunedRelationsAgreeWithTheReference) {
+  const auto& world = shippedWorld();
+  const scenario::RelationEvaluator eval(world, shippedConfig().relations);
+  const auto& models = scenario::catalog::carModels();
+  const std::string dir = scenario::defaultConfigDir() + "/../scenarios/specs";
+  long compared = 0, held = 0, differ = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (e.path().extension() != ".hspec") continue;
+    const Spec s = parseSpec(e.path().string(), {}, world);
+    for (const auto& r : s.requirements) {
+      if (r.eventually) continue;
+      Requirement flipped = r;  // the negative control: another operator
+      flipped.op = r.op == scenario::RelationOp::kRightOf ? scenario::RelationOp::kLeftOf
+                                                          : scenario::RelationOp::kRightOf;
+      for (std::size_t i = 0; i < world.slots().size(); i += 3) {
+        const auto& sl = world.slots()[i];
+        for (const auto& m : models) {
+          const geometry::OrientedBox box =
+              scenario::boxFromPose(geometry::Vec3(scenario::roundMilli(sl.position.x()),
+                                                   scenario::roundMilli(sl.position.y()),
+                                                   scenario::roundMilli(sl.ground_z)),
+                                    scenario::roundMilli(geometry::wrapPi(sl.yaw)),
+                                    geometry::Vec3(m.length, m.width, m.height));
+          const bool fast = worldRelationHolds(eval, world, r, box, true);
+          ASSERT_EQ(fast, worldRelationHolds(eval, world, r, box, false))
+              << e.path() << ": " << r.text << " at slot " << i << ", " << m.model;
+          ++compared;
+          held += fast;
+          differ += fast != worldRelationHolds(eval, world, flipped, box, false);
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 20000);
+  EXPECT_GT(held, 1000);
+  EXPECT_GT(differ, 100);  // the comparison can fail: another operator gives other answers
+}
+
+TEST(SpecCompile, AoiOffsetAndUavStartAreMetAndChecked) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car parked\naois { count: 1, target_offset: range(5, 30) }\n"
+                       "uav { start_within: range(200, 250) }\n");
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+    const scenario::Scenario sc =
+        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
+    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
+    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    // Negative controls: the UAV 400 m from the target; the AOI moved 12 m.
+    scenario::SimConfig far = sc.sim;
+    for (const auto& se : sc.sim.entities) {
+      if (se.role == "target") {
+        far.uav.start.x = se.entity.box.center2().x() + 400.0;
+        far.uav.start.y = se.entity.box.center2().y();
+      }
+    }
+    const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, far, nullptr);
+    ASSERT_EQ(f1.size(), 1u);
+    EXPECT_NE(f1[0].find("uav.start_within: the UAV starts"), std::string::npos) << f1[0];
+    scenario::Mission moved = sc.mission;
+    std::vector<geometry::Vec2> v = moved.aois.front().polygon.vertices();
+    for (auto& p : v) p += geometry::Vec2(0.0, 12.0);
+    moved.aois.front().polygon = geometry::Polygon(v);
+    const auto f2 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, moved, sc.sim, nullptr);
+    ASSERT_FALSE(f2.empty()) << seed;
+    EXPECT_NE(f2[0].find("aois.target_offset"), std::string::npos) << f2[0];
+  }
+  // Refused at compile time: an offset that can put the target outside its AOI, and an offset
+  // in a pursuit.
+  EXPECT_NE(messageOf([&] {
+              CompiledSpec(parse(std::string(kHead) + "aois { target_offset: 100 }\n"),
+                           shippedWorld(), cfg);
+            }).find("aois.target_offset: up to 100 m"),
+            std::string::npos);
+  EXPECT_NE(errorOf("scenario pursuit\ntarget car\naois { target_offset: 10 }\n")
+                .find("aois.target_offset applies to area_search only"),
+            std::string::npos);
 }
 
 TEST(SpecNames, EditDistance) {

@@ -343,6 +343,64 @@ class GenerationCampaignTest(unittest.TestCase):
         self.assertEqual(s0["sha256"]["mission.json"],
                          hc.sha256_file(os.path.join(a, s0["path"], "mission.json")))
 
+    def test_spec_campaign(self):
+        # spec: a scenario-language spec instead of classes; the scenarios are byte for byte
+        # those of hameritt_generate --spec, and hameritt_validate --spec accepts each one.
+        spec = os.path.join(SRC, "scenarios", "specs", "red_sedan_garage.hspec")
+        binp = os.environ["HAMERITT_BIN_DIR"]
+        cfg = os.path.join(self.d, "spec.yaml")
+        wr(cfg, "name: s\nseed: 5\ncount: 6\nshards: 2\nspec: %s\n"
+           % os.path.relpath(spec, self.d))
+        cdir = os.path.join(self.d, "spec")
+        self.assertEqual(self.run_main("plan", cfg, "--out", cdir)[0], 0)
+        for k in (0, 1):
+            self.assertEqual(hc.run_shard(cdir, k), 0)
+        self.assertEqual(self.run_main("merge", cdir)[0], 0)
+        man = json.loads(rd(os.path.join(cdir, "merged", "manifest.json")))
+        self.assertEqual(man["campaign"]["classes"], ["area_search"])
+        self.assertEqual(man["campaign"]["spec"]["file"], spec)
+        names = sorted(os.listdir(os.path.join(cdir, "merged", "scenarios")))
+        self.assertEqual(len(names), 6)
+        whole = os.path.join(self.d, "whole")
+        subprocess.run([os.path.join(binp, "hameritt_generate"), "--spec", spec, "--count", "6",
+                        "--seed", "5", "--out", whole, "--quiet"], check=True)
+        for n in names:
+            for f in ("mission.json", "sim_config.json"):
+                self.assertTrue(filecmp.cmp(os.path.join(cdir, "merged", "scenarios", n, f),
+                                            os.path.join(whole, n, f), shallow=False))
+            self.assertIn("spec", json.loads(rd(os.path.join(whole, n, "sim_config.json"))))
+        r = subprocess.run([os.path.join(binp, "hameritt_validate"), "--spec", spec,
+                            os.path.join(cdir, "merged", "scenarios")], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("6 scenarios, 6 meet the spec, 0 fail", r.stdout)
+        # Negative control: the same scenes fail another spec.
+        other = os.path.join(SRC, "scenarios", "specs", "impala_lookalikes.hspec")
+        r = subprocess.run([os.path.join(binp, "hameritt_validate"), "--spec", other,
+                            os.path.join(cdir, "merged", "scenarios")], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, universal_newlines=True)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("6 scenarios, 0 meet the spec, 6 fail", r.stdout)
+        # Bad spec campaigns are refused at plan time, naming the field or the requirement.
+        unsat = os.path.join(self.d, "unsat.hspec")
+        wr(unsat, "scenario area_search\ntarget car parked\nrequire street ON_TOP_OF target\n"
+           "require driveway ON_TOP_OF target\n")
+        for text, want in (
+                ("seed: 1\ncount: 2\nclasses: all\nspec: %s\n" % spec, "field 'classes'"),
+                ("seed: 1\ncount: 2\nspec: %s\nsampler: sobol\n" % spec, "field 'sampler'"),
+                ("seed: 1\ncount: 2\nsampler: halton\n", "field 'sampler': expected only with"),
+                ("seed: 1\ncount: 2\nspec: nope.hspec\n", "field 'spec'"),
+                ("seed: 1\ncount: 2\nspec: %s\nspec_params: {snwo: 1}\n"
+                 % os.path.join(SRC, "scenarios", "specs", "snowy_dusk_search.hspec"),
+                 "unknown parameter 'snwo'"),
+                ("seed: 1\ncount: 2\nspec: %s\n" % unsat, "unsatisfiable in this world")):
+            wr(cfg, text)
+            out = os.path.join(self.d, "bad_plan")
+            rc, msg = self.run_main("plan", cfg, "--out", out)
+            self.assertEqual(rc, 2, text)
+            self.assertIn(want, msg, text)
+            self.assertFalse(os.path.exists(os.path.join(out, "plan.json")), text)
+
     def test_cli_errors(self):
         bad = os.path.join(self.d, "bad.yaml")
         wr(bad, "seed: 1\ncount: 2\nmissions: {modes: [hover]}\n")

@@ -121,5 +121,28 @@ out=$("$V" --spec "$red" "$T/j1" 2>"$T/neg.err" | tail -1)
 [[ "$out" == "40 scenarios, 39 meet the spec, 1 fail" ]] && ok || bad "edited target colour: $out"
 grep -q "color 'green' is not one of red" "$T/neg.err" && ok || bad "no colour message: $(cat "$T/neg.err")"
 
+# The UAV start and the AOI around the target, recomputed from the scene: one kerbside scene
+# with its UAV moved 1 km, one impala scene with its AOI moved 25 m, each fails (exit 2).
+k1="$(ls -d "$OUT/kerbside_suv"/*/ | head -1)"
+/usr/bin/python3 - "$k1/sim_config.json" <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["uav"]["start"]["x"] += 1000.0  # at least 700 m from the target
+json.dump(d, open(sys.argv[1], "w"), indent=2)
+EOF2
+expect 2 "uav.start_within: the UAV starts" "$V" --spec "$S/kerbside_suv.hspec" "$k1"
+i1="$(ls -d "$OUT/impala_lookalikes"/*/ | head -1)"
+/usr/bin/python3 - "$i1/mission.json" <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+for v in d["areas_of_interest"][0]["polygon"]:
+    v[1] += 25.0
+json.dump(d, open(sys.argv[1], "w"), indent=2)
+EOF2
+expect 2 "aois.target_offset" "$V" --spec "$S/impala_lookalikes.hspec" "$i1"
+printf 'scenario area_search\ntarget car parked\naois { target_offset: 100 }\n' >"$T/off.hspec"
+expect 2 "aois.target_offset: up to 100 m" "$G" --spec "$T/off.hspec" --count 3 --seed 1 --out "$T/x8"
+[[ ! -e "$T/x8" ]] && ok || bad "a refused run wrote $T/x8"
+
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

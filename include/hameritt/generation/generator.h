@@ -28,6 +28,11 @@ struct ScenarioPlan {
   std::vector<std::function<bool(const SceneRelation&)>> listed;
   std::optional<double> koz_window_probability;
   std::optional<double> snow, rain, dust, fog;
+  // area_search: the target's distance from the centre of the AOI that holds it (m).
+  std::optional<double> aoi_target_offset;
+  // The UAV starts at an intersection at most this far from the first target (m) and at least
+  // min(120, this / 2) from it.
+  std::optional<double> uav_start_within;
   std::optional<SpecProvenance> provenance;
 };
 

@@ -13,6 +13,7 @@
 
 #include "hameritt/generation/generator.h"
 #include "hameritt/generation/spec.h"
+#include "hameritt/scenario/relations.h"
 
 namespace hameritt::generation {
 
@@ -61,6 +62,14 @@ class CompiledSpec {
   std::vector<NarrowingStep> steps_;
   bool placed_ = false;  // the target is parked (area_search, pursuit)
 };
+
+// Whether some world entity of the requirement's related class and look stands in its relation
+// (negation not applied) to a target with this box. `pruned`: the compiler's evaluation, which
+// skips other classes and looks before measuring and traces line of sight only where distance
+// and bearing leave the relation possible; false: the checker's reference, holds(measure()) on
+// every nearby entity. Both give the same answer.
+bool worldRelationHolds(const scenario::RelationEvaluator& eval, const scenario::World& world,
+                        const Requirement& r, const geometry::OrientedBox& box, bool pruned);
 
 // The facts a hard requirement is checked on, recomputed from the finished scene.
 struct RequirementCheck {
