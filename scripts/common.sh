@@ -45,6 +45,8 @@ HAMERITT_PACKAGES=(
   catkin-lint ninja-build strace
   # The TAK bridge's TLS (OpenSSL); its test makes certificates with the openssl tool.
   libssl-dev openssl
+  # The tracking scores' independent reference (TrackEval's formulas): scipy's assignment.
+  python3-scipy
 )
 
 install_deps() {

@@ -217,6 +217,78 @@ SceneRelation readRelation(const json& j, const std::string& path, const std::st
   return r;
 }
 
+MissionPhase readPhase(const json& j, const std::string& path, const std::string& file) {
+  Obj o(j, path, file);
+  MissionPhase p;
+  p.id = o.string("id");
+  const std::string type = o.string("type");
+  if (!parsePhaseType(type, &p.type)) {
+    o.error("type",
+            "expected \"search\", \"follow\", \"track\" or \"avoid\", got \"" + type + "\"");
+  }
+  const json& targets = o.array("targets");
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    if (!targets[i].is_string()) {
+      throw ConfigError(file + ": " + idx(o.at("targets"), i) + ": expected a string, got " +
+                        targets[i].type_name());
+    }
+    p.targets.push_back(targets[i].get<std::string>());
+  }
+  const bool timed = p.type == PhaseType::kFollow || p.type == PhaseType::kTrack;
+  if (timed) {
+    p.duration = o.number("duration");
+    if (!(*p.duration > 0))
+      o.error("duration", "expected a positive number, got " + fmt(*p.duration));
+  } else if (o.has("duration")) {
+    o.error("duration", "unexpected for a " + type + " phase (it ends when its goal is met)");
+  }
+  auto positive = [](Obj& c, const char* key) {
+    const double v = c.number(key);
+    if (!(v > 0)) c.error(key, "expected a positive number, got " + fmt(v));
+    return v;
+  };
+  auto nonNegative = [](Obj& c, const char* key) {
+    const double v = c.number(key);
+    if (!(v >= 0)) c.error(key, "expected a number >= 0, got " + fmt(v));
+    return v;
+  };
+  if (p.type == PhaseType::kFollow) {
+    Obj e = o.object("envelope");
+    p.follow.distance = nonNegative(e, "distance");
+    p.follow.distance_tolerance = positive(e, "distance_tolerance");
+    p.follow.height = e.number("height");
+    p.follow.height_tolerance = positive(e, "height_tolerance");
+    e.finish();
+    Obj c = o.object("criteria");
+    p.follow.min_inside_fraction = c.numberIn("min_inside_fraction", 0, 1);
+    p.follow.max_outside_s = nonNegative(c, "max_outside_s");
+    c.finish();
+  } else if (p.type == PhaseType::kTrack) {
+    Obj c = o.object("criteria");
+    p.track.min_visible_fraction = c.numberIn("min_visible_fraction", 0, 1);
+    p.track.min_box_area = nonNegative(c, "min_box_area");
+    p.track.min_tracked_fraction = c.numberIn("min_tracked_fraction", 0, 1);
+    p.track.max_reacquire_s = nonNegative(c, "max_reacquire_s");
+    c.finish();
+  } else if (p.type == PhaseType::kAvoid) {
+    const json& g = o.get("goal");
+    if (!g.is_array() || g.size() != 3 || !g[0].is_number() || !g[1].is_number() ||
+        !g[2].is_number()) {
+      o.error("goal", "expected a point [x, y, z] of 3 numbers");
+    }
+    p.avoid.goal = geometry::Vec3(g[0].get<double>(), g[1].get<double>(), g[2].get<double>());
+    if (!p.avoid.goal.allFinite()) o.error("goal", "expected finite coordinates");
+    p.avoid.goal_radius = positive(o, "goal_radius");
+    p.avoid.shortest_path_m = positive(o, "shortest_path_m");
+    Obj c = o.object("criteria");
+    p.avoid.min_horizontal_separation = positive(c, "min_horizontal_separation");
+    p.avoid.min_vertical_separation = positive(c, "min_vertical_separation");
+    c.finish();
+  }
+  o.finish();
+  return p;
+}
+
 }  // namespace
 
 Mission missionFromJson(const json& j, const std::string& file) {
@@ -286,6 +358,13 @@ Mission missionFromJson(const json& j, const std::string& file) {
   const json& rels = root.array("scene_relations");
   for (std::size_t i = 0; i < rels.size(); ++i) {
     m.relations.push_back(readRelation(rels[i], idx("scene_relations", i), file));
+  }
+  if (root.has("phases")) {
+    const json& phases = root.array("phases");
+    if (phases.empty()) root.error("phases", "expected at least one phase (or no key)");
+    for (std::size_t i = 0; i < phases.size(); ++i) {
+      m.phases.push_back(readPhase(phases[i], idx("phases", i), file));
+    }
   }
   root.finish();
   return m;

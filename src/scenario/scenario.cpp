@@ -1,5 +1,7 @@
 #include "hameritt/scenario/scenario.h"
 
+#include <utility>
+
 namespace hameritt::scenario {
 
 namespace {
@@ -29,6 +31,30 @@ const char* toString(ScenarioClass c) {
     if (k.cls == c) return k.name;
   }
   return "unknown";
+}
+
+namespace {
+constexpr std::pair<PhaseType, const char*> kPhaseTypes[] = {{PhaseType::kSearch, "search"},
+                                                             {PhaseType::kFollow, "follow"},
+                                                             {PhaseType::kTrack, "track"},
+                                                             {PhaseType::kAvoid, "avoid"}};
+}  // namespace
+
+const char* toString(PhaseType t) {
+  for (const auto& [type, name] : kPhaseTypes) {
+    if (type == t) return name;
+  }
+  return "unknown";
+}
+
+bool parsePhaseType(const std::string& s, PhaseType* out) {
+  for (const auto& [type, name] : kPhaseTypes) {
+    if (s == name) {
+      *out = type;
+      return true;
+    }
+  }
+  return false;
 }
 
 bool parseScenarioClass(const std::string& s, ScenarioClass* out) {

@@ -92,6 +92,51 @@ std::string relationText(const SceneRelation& r) {
 
 namespace {
 
+void writePhase(JsonWriter& w, const MissionPhase& p) {
+  w.beginObject();
+  w.key("id").value(p.id).key("type").value(toString(p.type));
+  w.key("targets").beginArray();
+  for (const auto& t : p.targets) w.value(t);
+  w.endArray();
+  if (p.duration) w.key("duration").value(*p.duration);
+  switch (p.type) {
+    case PhaseType::kSearch:
+      break;
+    case PhaseType::kFollow:
+      w.key("envelope").beginObject();
+      w.key("distance").value(p.follow.distance);
+      w.key("distance_tolerance").value(p.follow.distance_tolerance);
+      w.key("height").value(p.follow.height);
+      w.key("height_tolerance").value(p.follow.height_tolerance);
+      w.endObject();
+      w.key("criteria").beginObject();
+      w.key("min_inside_fraction").value(p.follow.min_inside_fraction);
+      w.key("max_outside_s").value(p.follow.max_outside_s);
+      w.endObject();
+      break;
+    case PhaseType::kTrack:
+      w.key("criteria").beginObject();
+      w.key("min_visible_fraction").value(p.track.min_visible_fraction);
+      w.key("min_box_area").value(p.track.min_box_area);
+      w.key("min_tracked_fraction").value(p.track.min_tracked_fraction);
+      w.key("max_reacquire_s").value(p.track.max_reacquire_s);
+      w.endObject();
+      break;
+    case PhaseType::kAvoid:
+      w.key("goal").beginArray();
+      w.value(p.avoid.goal.x()).value(p.avoid.goal.y()).value(p.avoid.goal.z());
+      w.endArray();
+      w.key("goal_radius").value(p.avoid.goal_radius);
+      w.key("shortest_path_m").value(p.avoid.shortest_path_m);
+      w.key("criteria").beginObject();
+      w.key("min_horizontal_separation").value(p.avoid.min_horizontal_separation);
+      w.key("min_vertical_separation").value(p.avoid.min_vertical_separation);
+      w.endObject();
+      break;
+  }
+  w.endObject();
+}
+
 // mission.json into w (emptied first).
 void writeMission(JsonWriter& w, const Mission& m) {
   w.clear();
@@ -199,6 +244,12 @@ void writeMission(JsonWriter& w, const Mission& m) {
     w.endObject();
   }
   w.endArray();
+  // Only missions with phases carry the key: single-phase missions read as they always did.
+  if (!m.phases.empty()) {
+    w.key("phases").beginArray();
+    for (const auto& p : m.phases) writePhase(w, p);
+    w.endArray();
+  }
   w.endObject();
 }
 

@@ -55,6 +55,24 @@ void Semantics::mission() {
   }
 
   relations(targets);
+
+  // Phases: unique ids, targets that the objective names, a search only as the first phase.
+  IdSet phase_ids(this, "phase id");
+  const json& phases = arrayOrEmpty(doc_, "phases");
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    const std::string p = jsonPointerAppend("/phases", i);
+    phase_ids.note(phases[i], p);
+    const json& ts = arrayOrEmpty(phases[i], "targets");
+    for (std::size_t k = 0; k < ts.size(); ++k) {
+      if (ts[k].is_string() && !targets.has(ts[k].get<std::string>())) {
+        add(jsonPointerAppend(p + "/targets", k), "phase_target",
+            "'" + ts[k].get<std::string>() + "' is not an objective target id");
+      }
+    }
+    if (i > 0 && stringAt(phases[i], "type") == std::optional<std::string>("search")) {
+      add(p + "/type", "phase_order", "a search phase can only be the first phase");
+    }
+  }
 }
 
 void Semantics::priors(const IdSet& aoi_ids, const std::map<std::string, Polygon>& aois) {

@@ -18,6 +18,7 @@
 
 #include "hameritt/generation/batch.h"
 #include "hameritt/generation/generator.h"
+#include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/scenario_io.h"
 
 namespace hameritt::scenario {
@@ -574,6 +575,110 @@ TEST(JsonSchemaTest, ShippedSchemasCompile) {
     const JsonSchema s = JsonSchema::load(schemaFile(schemaDir(), k));
     EXPECT_EQ(s.root().at("properties").at("schema").at("const"), schemaName(k));
   }
+}
+
+// ------------------------------------------------------------------ mission phases
+
+// A chain of one phase of each type about the mission's first target.
+std::vector<MissionPhase> everyPhase(const std::string& target) {
+  std::vector<MissionPhase> ph(4);
+  ph[0].id = "find";
+  ph[0].type = PhaseType::kSearch;
+  ph[0].targets = {target};
+  ph[1].id = "keep_behind";
+  ph[1].type = PhaseType::kFollow;
+  ph[1].targets = {target};
+  ph[1].duration = 120.0;
+  ph[1].follow.distance = 12.5;
+  ph[1].follow.height_tolerance = 4.0;
+  ph[2].id = "watch";
+  ph[2].type = PhaseType::kTrack;
+  ph[2].targets = {target};
+  ph[2].duration = 60.0;
+  ph[2].track.min_box_area = 900.0;
+  ph[3].id = "home";
+  ph[3].type = PhaseType::kAvoid;
+  ph[3].avoid.goal = geometry::Vec3(10.0, -20.5, 30.0);
+  ph[3].avoid.shortest_path_m = 412.25;
+  ph[3].avoid.min_vertical_separation = 2.5;
+  return ph;
+}
+
+TEST_F(ValidationTest, PhasesRoundTripAndValidate) {
+  Mission m = scenario(ScenarioClass::kPursuit, 1).mission;
+  // Without phases the document has no "phases" key (missions of every class read as before).
+  EXPECT_EQ(json::parse(missionJson(m)).count("phases"), 0u);
+  m.phases = everyPhase(m.objective.targets.at(0).id);
+  const std::string text = missionJson(m);
+  const auto issues = check(json::parse(text));
+  EXPECT_TRUE(issues.empty()) << describe(issues);
+  const Mission back = parseMission(text, "mission.json");
+  ASSERT_EQ(back.phases.size(), 4u);
+  EXPECT_EQ(back.phases[1].type, PhaseType::kFollow);
+  EXPECT_EQ(back.phases[1].targets, m.phases[1].targets);
+  EXPECT_EQ(*back.phases[1].duration, 120.0);
+  EXPECT_EQ(back.phases[1].follow.distance, 12.5);
+  EXPECT_EQ(back.phases[1].follow.height_tolerance, 4.0);
+  EXPECT_EQ(back.phases[2].track.min_box_area, 900.0);
+  EXPECT_FALSE(back.phases[3].duration.has_value());
+  EXPECT_EQ(back.phases[3].avoid.goal, geometry::Vec3(10.0, -20.5, 30.0));
+  EXPECT_EQ(back.phases[3].avoid.shortest_path_m, 412.25);
+  EXPECT_EQ(back.phases[3].avoid.min_vertical_separation, 2.5);
+  EXPECT_EQ(missionJson(back), text);  // byte-identical round trip
+}
+
+TEST_F(ValidationTest, PhaseRulesAreChecked) {
+  Mission m = scenario(ScenarioClass::kPursuit, 1).mission;
+  m.phases = everyPhase(m.objective.targets.at(0).id);
+  json d = json::parse(missionJson(m));
+  d["phases"][1]["targets"] = json::array({"car_nobody"});  // not an objective target
+  d["phases"][2]["id"] = "find";                            // repeats phase 0's id
+  d["phases"].push_back(d["phases"][0]);                    // a search after other phases
+  d["phases"][4]["id"] = "again";
+  auto issues = check(d);
+  EXPECT_ISSUE(issues, "phase_target", "/phases/1/targets/0");
+  EXPECT_ISSUE(issues, "unique_id", "/phases/2/id");
+  EXPECT_ISSUE(issues, "phase_order", "/phases/4/type");
+  EXPECT_EQ(issues.size(), 3u) << describe(issues);
+  // The schema: a follow phase about two targets, a track fraction above 1, an avoid phase
+  // without its goal.
+  json s = json::parse(missionJson(m));
+  s["phases"][1]["targets"].push_back(s["phases"][1]["targets"][0]);
+  s["phases"][2]["criteria"]["min_tracked_fraction"] = 1.5;
+  s["phases"][3].erase("goal");
+  issues = check(s);
+  for (const char* p : {"/phases/1", "/phases/2", "/phases/3"}) {
+    bool found = false;
+    for (const auto& i : issues) found = found || i.path.rfind(p, 0) == 0;
+    EXPECT_TRUE(found) << "no issue at " << p << ":\n" << describe(issues);
+  }
+  // The reader rejects what the schema rejects, naming the field.
+  auto reject = [&](const nlohmann::ordered_json& doc, const std::string& field) {
+    try {
+      missionFromJson(doc, "m.json");
+      ADD_FAILURE() << "accepted; expected an error at " << field;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("m.json: " + field), std::string::npos) << e.what();
+    }
+  };
+  auto r = nlohmann::ordered_json::parse(missionJson(m));
+  r["phases"][3]["duration"] = 5.0;
+  reject(r, "phases[3].duration");
+  r = nlohmann::ordered_json::parse(missionJson(m));
+  r["phases"][0]["type"] = "hover";
+  reject(r, "phases[0].type");
+  r = nlohmann::ordered_json::parse(missionJson(m));
+  r["phases"][1]["envelope"]["distance_tolerance"] = 0.0;
+  reject(r, "phases[1].envelope.distance_tolerance");
+  r = nlohmann::ordered_json::parse(missionJson(m));
+  r["phases"][2]["criteria"]["colour"] = "red";
+  reject(r, "phases[2].criteria");
+  r = nlohmann::ordered_json::parse(missionJson(m));
+  r["phases"] = nlohmann::ordered_json::array();
+  reject(r, "phases");
+  // Negative control: the untouched document passes both.
+  EXPECT_TRUE(check(json::parse(missionJson(m))).empty());
+  EXPECT_NO_THROW(parseMission(missionJson(m), "m.json"));
 }
 
 }  // namespace

@@ -171,6 +171,40 @@ def main():
                                     "time_window": {}}]
             expect_rejected(validators, "two-point polygon", m, ["keep_out_zones", 0, "polygon"])
 
+            # Mission phases: a chain of every phase type validates; a broken phase is
+            # rejected at its item.
+            m = copy.deepcopy(mission)
+            tid = m["objective"]["targets"][0]["id"]
+            m["phases"] = [
+                {"id": "find", "type": "search", "targets": [tid]},
+                {"id": "keep_behind", "type": "follow", "targets": [tid], "duration": 120.0,
+                 "envelope": {"distance": 15.0, "distance_tolerance": 5.0, "height": 20.0,
+                              "height_tolerance": 5.0},
+                 "criteria": {"min_inside_fraction": 0.8, "max_outside_s": 10.0}},
+                {"id": "watch", "type": "track", "targets": [tid], "duration": 60.0,
+                 "criteria": {"min_visible_fraction": 0.5, "min_box_area": 400.0,
+                              "min_tracked_fraction": 0.7, "max_reacquire_s": 10.0}},
+                {"id": "home", "type": "avoid", "targets": [], "goal": [10.0, -20.0, 30.0],
+                 "goal_radius": 5.0, "shortest_path_m": 412.0,
+                 "criteria": {"min_horizontal_separation": 5.0, "min_vertical_separation": 3.0}}]
+            errs = errors_of(validators, m)
+            if errs:
+                fail("mission with phases", errs)
+            else:
+                ok("mission with phases")
+            b = copy.deepcopy(m)
+            b["phases"][1]["targets"] = [tid, tid]
+            expect_rejected(validators, "follow phase with two targets", b, ["phases", 1])
+            b = copy.deepcopy(m)
+            b["phases"][2]["criteria"]["min_tracked_fraction"] = 1.5
+            expect_rejected(validators, "track fraction above 1", b, ["phases", 2])
+            b = copy.deepcopy(m)
+            del b["phases"][3]["goal"]
+            expect_rejected(validators, "avoid phase without a goal", b, ["phases", 3])
+            b = copy.deepcopy(m)
+            b["phases"][0]["duration"] = 30.0
+            expect_rejected(validators, "search phase with a duration", b, ["phases", 0])
+
             s = copy.deepcopy(sim)
             s["entities"][0]["trajectory"] = [[0, 1, 2, 0]]
             expect_rejected(validators, "4-number trajectory sample", s,

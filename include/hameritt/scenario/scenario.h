@@ -130,6 +130,59 @@ struct GeoOrigin {
   double altitude = 40.0;
 };
 
+// A mission's phases run one after another; the mission succeeds only when every phase does.
+// search: ends when the targets are found. follow: keep one moving target inside an envelope
+// behind and above it for `duration` seconds. track: keep the targets in a camera's view for
+// `duration` seconds. avoid: reach a goal among other aircraft without losing separation.
+enum class PhaseType { kSearch, kFollow, kTrack, kAvoid };
+// "search", "follow", "track", "avoid".
+const char* toString(PhaseType t);
+bool parsePhaseType(const std::string& s, PhaseType* out);
+
+// The follow envelope in the target's frame (x along its heading, z up) and the phase's
+// success test: inside at least min_inside_fraction of the phase, never outside longer than
+// max_outside_s.
+struct FollowPhaseSpec {
+  double distance = 15.0;            // d*, metres behind the target
+  double distance_tolerance = 5.0;   // D, horizontal radius around that point
+  double height = 20.0;              // h*, metres above the target
+  double height_tolerance = 5.0;     // H
+  double min_inside_fraction = 0.8;  // of the phase
+  double max_outside_s = 10.0;
+};
+
+// When a target counts as tracked in a frame, and the phase's success test: tracked at least
+// min_tracked_fraction of the phase and every loss reacquired within max_reacquire_s.
+struct TrackPhaseSpec {
+  double min_visible_fraction = 0.5;
+  double min_box_area = 400.0;  // px^2
+  double min_tracked_fraction = 0.7;
+  double max_reacquire_s = 10.0;
+};
+
+// The goal of an avoid phase, the shortest 3D path to it from the phase's start (the
+// generator's, for SPL), and the separation to keep from every other aircraft: a loss is
+// closer than min_horizontal_separation horizontally while closer than
+// min_vertical_separation vertically.
+struct AvoidPhaseSpec {
+  geometry::Vec3 goal{0, 0, 0};
+  double goal_radius = 5.0;
+  double shortest_path_m = 0.0;
+  double min_horizontal_separation = 5.0;
+  double min_vertical_separation = 3.0;
+};
+
+// One phase; only the spec of its type is read and written.
+struct MissionPhase {
+  std::string id;
+  PhaseType type = PhaseType::kSearch;
+  std::vector<std::string> targets;  // objective target ids (none for avoid)
+  std::optional<double> duration;    // follow and track: seconds from the phase's start
+  FollowPhaseSpec follow;
+  TrackPhaseSpec track;
+  AvoidPhaseSpec avoid;
+};
+
 struct Mission {
   std::string scenario_id;
   ScenarioClass cls = ScenarioClass::kAreaSearch;
@@ -142,6 +195,8 @@ struct Mission {
   std::vector<AreaPrior> priors;
   std::vector<RouteOfInterest> routes;
   std::vector<SceneRelation> relations;
+  // Empty: the class's one phase (search, or pursuit's find-then-keep-in-view).
+  std::vector<MissionPhase> phases;
 };
 
 // An entity added by the scenario (targets, confusers, traffic, pedestrians), with its timed

@@ -1,0 +1,199 @@
+#include "hameritt/adk/navigation_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "hameritt/scenario/error.h"
+
+namespace hameritt::adk {
+namespace {
+
+using geometry::Vec3;
+
+std::string num(double v) { return scenario::formatNumber(v); }
+
+void requireFinite(const Vec3& v, const std::string& field) {
+  if (!v.allFinite()) throw InputError(field + ": expected finite coordinates");
+}
+
+void requireIncreasing(double t, double prev, std::size_t i) {
+  if (!std::isfinite(t)) throw InputError("sample " + std::to_string(i) + ": t is not finite");
+  if (i > 0 && !(t > prev)) {
+    throw InputError("sample " + std::to_string(i) + ": t = " + num(t) +
+                     " does not come after the previous sample's " + num(prev));
+  }
+}
+
+void requirePositive(double v, const std::string& field) {
+  if (!(v > 0.0 && std::isfinite(v))) {
+    throw scenario::ConfigError(field + ": expected a finite number > 0, got " + num(v));
+  }
+}
+
+void requireNonNegative(double v, const std::string& field) {
+  if (!(v >= 0.0 && std::isfinite(v))) {
+    throw scenario::ConfigError(field + ": expected a finite number >= 0, got " + num(v));
+  }
+}
+
+}  // namespace
+
+double splOf(const NavigationEpisode& e) {
+  if (!(e.shortest_path_m > 0.0 && std::isfinite(e.shortest_path_m))) {
+    throw InputError("shortest_path_m: expected a finite number > 0, got " +
+                     num(e.shortest_path_m));
+  }
+  if (!(e.path_length_m >= 0.0 && std::isfinite(e.path_length_m))) {
+    throw InputError("path_length_m: expected a finite number >= 0, got " + num(e.path_length_m));
+  }
+  if (!e.success) return 0.0;
+  return e.shortest_path_m / std::max(e.path_length_m, e.shortest_path_m);
+}
+
+double spl(const std::vector<NavigationEpisode>& episodes) {
+  if (episodes.empty()) throw InputError("spl: no episodes");
+  double sum = 0.0;
+  for (const auto& e : episodes) sum += splOf(e);
+  return sum / episodes.size();
+}
+
+double pathLength(const std::vector<Vec3>& points) {
+  double l = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) l += (points[i] - points[i - 1]).norm();
+  return l;
+}
+
+void SeparationMinimum::validate() const {
+  requirePositive(horizontal, "separation.horizontal");
+  requirePositive(vertical, "separation.vertical");
+  requireNonNegative(collision_radius, "separation.collision_radius");
+}
+
+double timeToCollision(const Vec3& p, const Vec3& v, double radius) {
+  const double c = p.squaredNorm() - radius * radius;
+  if (c <= 0.0) return 0.0;
+  const double a = v.squaredNorm();
+  const double b = p.dot(v);
+  if (a <= 0.0 || b >= 0.0) return kNever;  // still, or not closing
+  const double disc = b * b - a * c;
+  if (disc < 0.0) return kNever;  // passes wide
+  return (-b - std::sqrt(disc)) / a;
+}
+
+SeparationScore scoreSeparation(const std::vector<TrafficSample>& samples,
+                                const SeparationMinimum& minimum) {
+  minimum.validate();
+  SeparationScore s;
+  bool was_lost = false;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const auto& x = samples[i];
+    requireIncreasing(x.t, i ? samples[i - 1].t : 0.0, i);
+    const std::string at = "sample " + std::to_string(i);
+    requireFinite(x.position, at + ": position");
+    requireFinite(x.velocity, at + ": velocity");
+    std::set<std::string> ids;
+    bool lost = false;
+    for (const auto& a : x.aircraft) {
+      if (!ids.insert(a.id).second) throw InputError(at + ": aircraft " + a.id + " occurs twice");
+      requireFinite(a.position, at + ": aircraft " + a.id + " position");
+      requireFinite(a.velocity, at + ": aircraft " + a.id + " velocity");
+      const Vec3 p = a.position - x.position;
+      const double d = p.norm();
+      if (d < s.min_distance_m) {
+        s.min_distance_m = d;
+        s.closest_aircraft = a.id;
+        s.min_distance_t = x.t;
+      }
+      if (d < minimum.collision_radius) s.contact = true;
+      if (p.head<2>().norm() < minimum.horizontal && std::fabs(p.z()) < minimum.vertical) {
+        lost = true;
+      }
+      const double ttc = timeToCollision(p, a.velocity - x.velocity, minimum.collision_radius);
+      if (ttc < s.min_time_to_collision_s) {
+        s.min_time_to_collision_s = ttc;
+        s.time_to_collision_aircraft = a.id;
+      }
+    }
+    if (lost && !was_lost) ++s.losses;
+    if (lost && i + 1 < samples.size()) s.seconds_below_minimum += samples[i + 1].t - x.t;
+    was_lost = lost;
+  }
+  return s;
+}
+
+void FollowEnvelope::validate() const {
+  requireNonNegative(distance, "envelope.distance");
+  requirePositive(distance_tolerance, "envelope.distance_tolerance");
+  if (!std::isfinite(height)) {
+    throw scenario::ConfigError("envelope.height: expected a finite number, got " + num(height));
+  }
+  requirePositive(height_tolerance, "envelope.height_tolerance");
+}
+
+namespace {
+
+// Horizontal distance from the point d* behind the target, and the height error.
+std::pair<double, double> envelopeErrors(const FollowSample& s, const FollowEnvelope& e) {
+  const geometry::Vec2 forward(std::cos(s.target_yaw), std::sin(s.target_yaw));
+  const geometry::Vec2 desired = s.target.head<2>() - e.distance * forward;
+  return {(s.vehicle.head<2>() - desired).norm(), s.vehicle.z() - s.target.z() - e.height};
+}
+
+}  // namespace
+
+bool insideEnvelope(const FollowSample& s, const FollowEnvelope& e) {
+  const auto [d, h] = envelopeErrors(s, e);
+  return d <= e.distance_tolerance && std::fabs(h) <= e.height_tolerance;
+}
+
+FollowScore scoreFollow(const std::vector<FollowSample>& samples, const FollowEnvelope& e) {
+  e.validate();
+  FollowScore r;
+  r.samples = samples.size();
+  if (samples.empty()) return r;
+  std::vector<double> dist;
+  double sum_d2 = 0.0, sum_h2 = 0.0, inside_s = 0.0, los_s = 0.0;
+  bool outside = false;
+  double outside_since = 0.0;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const auto& s = samples[i];
+    requireIncreasing(s.t, i ? samples[i - 1].t : 0.0, i);
+    const std::string at = "sample " + std::to_string(i);
+    requireFinite(s.vehicle, at + ": vehicle");
+    requireFinite(s.target, at + ": target");
+    if (!std::isfinite(s.target_yaw)) throw InputError(at + ": target_yaw is not finite");
+    const auto [d, h] = envelopeErrors(s, e);
+    dist.push_back(d);
+    sum_d2 += d * d;
+    sum_h2 += h * h;
+    const bool in = d <= e.distance_tolerance && std::fabs(h) <= e.height_tolerance;
+    const double dt = i + 1 < samples.size() ? samples[i + 1].t - s.t : 0.0;
+    if (in) inside_s += dt;
+    if (s.line_of_sight) los_s += dt;
+    if (!in && !outside) {
+      outside = true;
+      outside_since = s.t;
+    } else if (in && outside) {
+      outside = false;
+      r.longest_outside_s = std::max(r.longest_outside_s, s.t - outside_since);
+    }
+  }
+  if (outside) {
+    r.longest_outside_s = std::max(r.longest_outside_s, samples.back().t - outside_since);
+  }
+  r.duration_s = samples.back().t - samples.front().t;
+  if (r.duration_s > 0.0) {
+    r.inside_fraction = inside_s / r.duration_s;
+    r.line_of_sight_fraction = los_s / r.duration_s;
+  }
+  const double n = static_cast<double>(samples.size());
+  r.rms_distance_error_m = std::sqrt(sum_d2 / n);
+  r.rms_height_error_m = std::sqrt(sum_h2 / n);
+  std::sort(dist.begin(), dist.end());
+  const std::size_t rank = (95 * samples.size() + 99) / 100;  // ceil(0.95 n), in integers
+  r.p95_distance_error_m = dist[rank - 1];
+  return r;
+}
+
+}  // namespace hameritt::adk
