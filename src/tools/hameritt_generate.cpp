@@ -29,6 +29,12 @@ using namespace hameritt::scenario;
 
 namespace {
 
+// A command-line mistake: reported with the usage. A bad configuration file is a ConfigError
+// naming the file and field, reported without it.
+struct UsageError : ConfigError {
+  using ConfigError::ConfigError;
+};
+
 const char* kUsage =
     "usage: hameritt_generate --class CLASS --count N --seed S --out DIR [--first K] [--jobs J]\n"
     "                         [--world-config FILE] [--world suburb|city]\n"
@@ -46,21 +52,21 @@ const char* kUsage =
 
 std::uint64_t parseUnsigned(const std::string& flag, const std::string& v) {
   if (v.empty() || v[0] == '-' || v.find_first_not_of("0123456789") != std::string::npos) {
-    throw ConfigError(flag + ": expected a non-negative integer, got '" + v + "'");
+    throw UsageError(flag + ": expected a non-negative integer, got '" + v + "'");
   }
   try {
     return std::stoull(v);
   } catch (...) {
-    throw ConfigError(flag + ": number out of range: '" + v + "'");
+    throw UsageError(flag + ": number out of range: '" + v + "'");
   }
 }
 
 long parseCount(const std::string& flag, const std::string& v) {
   if (!v.empty() && v[0] == '-') {
-    throw ConfigError(flag + ": expected a positive integer, got '" + v + "'");
+    throw UsageError(flag + ": expected a positive integer, got '" + v + "'");
   }
   const std::uint64_t n = parseUnsigned(flag, v);
-  if (n == 0 || n > 10000000) throw ConfigError(flag + ": expected 1 to 10000000, got " + v);
+  if (n == 0 || n > 10000000) throw UsageError(flag + ": expected 1 to 10000000, got " + v);
   return static_cast<long>(n);
 }
 
@@ -79,51 +85,63 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
       auto next = [&]() -> std::string {
-        if (i + 1 >= argc) throw ConfigError(a + ": missing value");
+        if (i + 1 >= argc) throw UsageError(a + ": missing value");
         return argv[++i];
       };
-      if (a == "--class") cls = next();
-      else if (a == "--count") count = parseCount(a, next());
-      else if (a == "--seed") seed = parseUnsigned(a, next()), have_seed = true;
-      else if (a == "--scenario-seed") seed = parseUnsigned(a, next()), have_seed = exact = true;
+      if (a == "--class")
+        cls = next();
+      else if (a == "--count")
+        count = parseCount(a, next());
+      else if (a == "--seed")
+        seed = parseUnsigned(a, next()), have_seed = true;
+      else if (a == "--scenario-seed")
+        seed = parseUnsigned(a, next()), have_seed = exact = true;
       else if (a == "--first") {
         const std::uint64_t k = parseUnsigned(a, next());
         if (k > 10000000) {
-          throw ConfigError("--first: expected 0 to 10000000, got " + std::to_string(k));
+          throw UsageError("--first: expected 0 to 10000000, got " + std::to_string(k));
         }
         first = static_cast<long>(k);
-      } else if (a == "--out") out = next();
+      } else if (a == "--out")
+        out = next();
       else if (a == "--into")
         into = next();
-      else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
-      else if (a == "--world-config") world_cfg = next();
+      else if (a == "--jobs")
+        jobs = static_cast<int>(parseCount(a, next()));
+      else if (a == "--world-config")
+        world_cfg = next();
       else if (a == "--world")
         world_type = next();
-      else if (a == "--generator-config") gen_cfg = next();
-      else if (a == "--quiet") quiet = true;
-      else if (a == "--spec") spec_file = next();
-      else if (a == "--param") params.push_back(next());
-      else if (a == "--sampler") sampler_name = next();
+      else if (a == "--generator-config")
+        gen_cfg = next();
+      else if (a == "--quiet")
+        quiet = true;
+      else if (a == "--spec")
+        spec_file = next();
+      else if (a == "--param")
+        params.push_back(next());
+      else if (a == "--sampler")
+        sampler_name = next();
       else if (a == "-h" || a == "--help") {
         std::fputs(kUsage, stdout);
         return 0;
       } else {
-        throw ConfigError("unknown argument '" + a + "'");
+        throw UsageError("unknown argument '" + a + "'");
       }
     }
-    if (cls.empty() && spec_file.empty()) throw ConfigError("--class is required (or --spec FILE)");
+    if (cls.empty() && spec_file.empty()) throw UsageError("--class is required (or --spec FILE)");
     if (!cls.empty() && !spec_file.empty()) {
-      throw ConfigError("--class: a spec names its class; give --class or --spec, not both");
+      throw UsageError("--class: a spec names its class; give --class or --spec, not both");
     }
-    if (spec_file.empty() && !params.empty()) throw ConfigError("--param: needs --spec");
+    if (spec_file.empty() && !params.empty()) throw UsageError("--param: needs --spec");
     hameritt::generation::SamplerKind sampler;
     if (!hameritt::generation::parseSampler(sampler_name, &sampler)) {
-      throw ConfigError("--sampler: expected random or halton, got '" + sampler_name + "'");
+      throw UsageError("--sampler: expected random or halton, got '" + sampler_name + "'");
     }
     if (!into.empty()) {
-      if (!out.empty()) throw ConfigError("--into: give --out or --into, not both");
-      if (count > 1) throw ConfigError("--into: writes one scenario; --count must be 1");
-      if (first != 0) throw ConfigError("--into: cannot be combined with --first");
+      if (!out.empty()) throw UsageError("--into: give --out or --into, not both");
+      if (count > 1) throw UsageError("--into: writes one scenario; --count must be 1");
+      if (first != 0) throw UsageError("--into: cannot be combined with --first");
       count = 1;
       // Generated beside DIR, then moved into it file by file (each rename atomic): a failed
       // run leaves DIR as it was.
@@ -132,9 +150,9 @@ int main(int argc, char** argv) {
             std::to_string(::getpid());
     }
     if (count < 0 && exact) count = 1;
-    if (count < 0) throw ConfigError("--count is required");
-    if (!have_seed) throw ConfigError("--seed (or --scenario-seed) is required");
-    if (out.empty()) throw ConfigError("--out is required");
+    if (count < 0) throw UsageError("--count is required");
+    if (!have_seed) throw UsageError("--seed (or --scenario-seed) is required");
+    if (out.empty()) throw UsageError("--out is required");
 
     BatchRequest req;
     if (!cls.empty()) req.classes = parseClassList(cls);
@@ -147,7 +165,7 @@ int main(int argc, char** argv) {
     WorldParams wp = loadWorldParams(world_cfg);
     if (!world_type.empty()) {
       if (!parseWorldType(world_type, &wp.type)) {
-        throw ConfigError("--world: expected suburb or city, got '" + world_type + "'");
+        throw UsageError("--world: expected suburb or city, got '" + world_type + "'");
       }
       wp.validate();
     }
@@ -191,7 +209,8 @@ int main(int argc, char** argv) {
       fs::remove_all(out, ec);
       out = into;
     }
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!quiet) {
       for (const auto& e : entries) std::printf("%s\n", e.id.c_str());
       std::fprintf(stderr, "hameritt_generate: %zu scenarios in %s (%.3f s, %d jobs)\n",
@@ -201,8 +220,11 @@ int main(int argc, char** argv) {
   } catch (const hameritt::generation::SpecError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
-  } catch (const ConfigError& e) {
+  } catch (const UsageError& e) {
     std::fprintf(stderr, "hameritt_generate: error: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "hameritt_generate: error: %s\n", e.what());
     return 2;
   } catch (const OutputError& e) {
     std::fprintf(stderr, "hameritt_generate: error: %s\n", e.what());

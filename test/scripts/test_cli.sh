@@ -24,6 +24,11 @@ expect 2 "$T/wrongtype.json: world.street_width: expected a number, got string" 
 sed 's/"confuser_count_min": 1/"confuser_count_min": -2/' "$SRC/config/generator.json" >"$T/neg.json"
 expect 2 "$T/neg.json: generator.confuser_count_min" "$G" --class all --count 1 --seed 1 --out "$T/b" --generator-config "$T/neg.json"
 [[ ! -e "$T/b" ]] && ok || bad "bad configuration created output"
+# a command-line mistake is shown with the usage; a bad file is not (the usage would bury the
+# message naming the file and field)
+expect 2 "unknown argument.*usage: hameritt_generate" "$G" --class all --count 1 --seed 1 --out "$T/a" --colour red
+err="$("$G" --class all --count 1 --seed 1 --out "$T/b" --world-config "$T/wrongtype.json" 2>&1 >/dev/null)"
+[[ "$err" != *usage:* ]] && ok || bad "a configuration-file error printed the usage: $err"
 
 # --- unwritable output: clear error, nothing written
 touch "$T/file"
