@@ -10,7 +10,6 @@ REAL_TIME_FACTOR 0 (default) runs unpaced; a positive value paces the node, to s
 (Python) subscriber keeps up at that factor.
 """
 import os
-import socket
 import subprocess
 import sys
 import time
@@ -19,25 +18,17 @@ import rospy
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test", "scripts"))
+from graph_util import free_port, start_master, stop_master, stop_process  # noqa: E402
 
 
 def main():
     window = float(sys.argv[1]) if len(sys.argv) > 1 else 120.0
     pace = float(sys.argv[2]) if len(sys.argv) > 2 else 0.0
+    master = free_port()
+    os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % master
     env = dict(os.environ)
-    env["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % free_port()
-    os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
-    launch = subprocess.Popen(
-        ["roscore", "-p", env["ROS_MASTER_URI"].rsplit(":", 1)[1]],
-        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(2.0)
+    core = start_master(master)
     sim = subprocess.Popen(
         ["roslaunch", "hameritt", "simulator.launch", "real_time_factor:=%g" % pace, "start_paused:=true",
          "duration:=%g" % (window + 10.0)],
@@ -83,13 +74,8 @@ def main():
               % (n1 - n0, expected, rate, max(0, expected - (n1 - n0))))
         return 0
     finally:
-        for p in (sim, launch):
-            p.terminate()
-        for p in (sim, launch):
-            try:
-                p.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                p.kill()
+        stop_process(sim)
+        stop_master(core)
 
 
 if __name__ == "__main__":

@@ -11,8 +11,6 @@ Run after sourcing build/devel/setup.bash:
 """
 import os
 import resource
-import signal
-import socket
 import subprocess
 import sys
 import time
@@ -20,25 +18,17 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "test", "scripts"))
 import px4_standin  # noqa: E402
-
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
+from graph_util import free_port, start_master, stop_master, stop_process  # noqa: E402
 
 
 def main():
     hold = float(sys.argv[1]) if len(sys.argv) > 1 else 60.0
-    os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % free_port()
-    core = subprocess.Popen(["roscore", "-p", os.environ["ROS_MASTER_URI"].rsplit(":", 1)[1]],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    master = free_port()
+    os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % master
+    core = start_master(master)
     port = free_port()
     log = "/tmp/bench_sitl_simulator.log"
     scenario = os.path.join(HERE, "..", "scenarios", "default", "sim_config.json")
-    time.sleep(2)
     sim = subprocess.Popen(
         ["rosrun", "hameritt", "simulator", "_sim_config:=" + scenario, "_cameras:=false",
          "_autopilot:=px4", "_px4_port:=%d" % port, "_real_time_factor:=0",
@@ -64,10 +54,8 @@ def main():
                                                    1e6 * wall / ap.sensors))
         print("stand-in CPU: %.2f s (%.0f us per exchange)" % (cpu, 1e6 * cpu / ap.sensors))
     finally:
-        sim.send_signal(signal.SIGINT)
-        sim.wait(30)
-        core.send_signal(signal.SIGINT)
-        core.wait(30)
+        stop_process(sim)
+        stop_master(core)
     ru = resource.getrusage(resource.RUSAGE_CHILDREN)
     print("simulator + roscore CPU: %.2f s user, %.2f s sys" % (ru.ru_utime, ru.ru_stime))
 

@@ -1,6 +1,7 @@
 """Helpers shared by the Python tests that drive a ROS graph (not a test: no test_ prefix)."""
 import os
 import signal
+import socket
 import subprocess
 import time
 
@@ -31,6 +32,15 @@ def private_master_port(base):
     node, roslaunch and rospy call of the test uses it; tests pick distinct bases."""
     port = base + os.getpid() % 2000
     os.environ["ROS_MASTER_URI"] = "http://localhost:%d" % port
+    return port
+
+
+def free_port():
+    """A TCP port free on localhost now (the benchmarks' masters and autopilot ports)."""
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
     return port
 
 
