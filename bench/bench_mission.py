@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Benchmark of a whole mission: simulator with both payload cameras rendering every modality,
-ADK, planner, baseline clients and rosbag recording, on the default scenario.
+ADK, planner, baseline clients and rosbag recording, on the default scenario (or --scenario DIR).
 
 Runs `roslaunch hameritt mission.launch` for --sim-seconds of sim time (the ADK's time limit),
 measures the wall time from the first to the last message in the bag, and checks the bag:
 every camera topic must hold one message per camera period (no drops) and rosbag must not have
-reported a dropped message. Prints the real-time factor and per-topic counts.
+reported a dropped message. Prints the real-time factor, per-topic counts and the simulator's
+peak resident memory.
 
   /usr/bin/python3 bench/bench_mission.py [--sim-seconds 60] [--real-time-factor 0]
       [--record-all] [--record-png] [--record-depth 16UC1|32FC1] [--record-rgb-noise]
@@ -48,6 +49,24 @@ def sample_recorder_cpu(seen, out):
             pass
 
 
+def sample_simulator_rss(peak):
+    """The simulator node's peak resident set so far (VmHWM, MB) into peak[0], by pid."""
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open("/proc/%s/cmdline" % pid, "rb") as f:
+                argv = f.read().split(b"\0")
+            if not argv[0].endswith(b"hameritt/simulator"):
+                continue
+            with open("/proc/%s/status" % pid) as f:
+                for line in f:
+                    if line.startswith("VmHWM:"):
+                        peak[0] = max(peak[0], int(line.split()[1]) / 1024.0)
+        except (OSError, IndexError, ValueError):
+            pass
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenario", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenarios", "default"))
@@ -82,10 +101,12 @@ def main():
     log_path = os.path.join(out, "roslaunch.log")
     t0 = time.time()
     recorder = {}
+    sim_rss = [0.0]
     with open(log_path, "w") as log:
         proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env)
         while proc.poll() is None and time.time() - t0 < max(600.0, 20 * args.sim_seconds):
             sample_recorder_cpu(recorder, out)
+            sample_simulator_rss(sim_rss)
             time.sleep(0.5)
         if proc.poll() is None:
             proc.kill()
@@ -148,6 +169,7 @@ def main():
     print("rosbag drops:  %d 'Dropping' warnings" % dropped_log)
     rec_cpu = sum(recorder.values())
     print("recorder CPU:  %.1f s (%.0f%% of one core over the simulator's %.1f wall s; last sample)" % (rec_cpu, 100.0 * rec_cpu / max(rt_wall, 1e-9), rt_wall))
+    print("simulator RSS: %.0f MB peak (VmHWM, last sample)" % sim_rss[0])
     raw_total = sum(group_bytes.values())
     print("uncompressed:  %.1f MB (%.2f MB per sim second); on disk %.0f%% of it" % (raw_total / 1e6, raw_total / 1e6 / max(sim_seconds, 1e-9), 100.0 * size_mb * 1e6 / max(raw_total, 1)))
     for g in sorted(group_bytes, key=lambda g: -group_bytes[g]):
