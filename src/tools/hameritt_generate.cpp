@@ -82,28 +82,40 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw ConfigError(a + ": missing value");
         return argv[++i];
       };
-      if (a == "--class") cls = next();
-      else if (a == "--count") count = parseCount(a, next());
-      else if (a == "--seed") seed = parseUnsigned(a, next()), have_seed = true;
-      else if (a == "--scenario-seed") seed = parseUnsigned(a, next()), have_seed = exact = true;
+      if (a == "--class")
+        cls = next();
+      else if (a == "--count")
+        count = parseCount(a, next());
+      else if (a == "--seed")
+        seed = parseUnsigned(a, next()), have_seed = true;
+      else if (a == "--scenario-seed")
+        seed = parseUnsigned(a, next()), have_seed = exact = true;
       else if (a == "--first") {
         const std::uint64_t k = parseUnsigned(a, next());
         if (k > 10000000) {
           throw ConfigError("--first: expected 0 to 10000000, got " + std::to_string(k));
         }
         first = static_cast<long>(k);
-      } else if (a == "--out") out = next();
+      } else if (a == "--out")
+        out = next();
       else if (a == "--into")
         into = next();
-      else if (a == "--jobs") jobs = static_cast<int>(parseCount(a, next()));
-      else if (a == "--world-config") world_cfg = next();
+      else if (a == "--jobs")
+        jobs = static_cast<int>(parseCount(a, next()));
+      else if (a == "--world-config")
+        world_cfg = next();
       else if (a == "--world")
         world_type = next();
-      else if (a == "--generator-config") gen_cfg = next();
-      else if (a == "--quiet") quiet = true;
-      else if (a == "--spec") spec_file = next();
-      else if (a == "--param") params.push_back(next());
-      else if (a == "--sampler") sampler_name = next();
+      else if (a == "--generator-config")
+        gen_cfg = next();
+      else if (a == "--quiet")
+        quiet = true;
+      else if (a == "--spec")
+        spec_file = next();
+      else if (a == "--param")
+        params.push_back(next());
+      else if (a == "--sampler")
+        sampler_name = next();
       else if (a == "-h" || a == "--help") {
         std::fputs(kUsage, stdout);
         return 0;
@@ -145,6 +157,13 @@ int main(int argc, char** argv) {
     req.jobs = jobs;
     req.exact_seed = exact;
     WorldParams wp = loadWorldParams(world_cfg);
+    // A spec's `world suburb|city` picks the world unless --world does (an unknown name is
+    // reported by the parse, with its place).
+    if (world_type.empty() && !spec_file.empty()) {
+      const std::string w = hameritt::generation::specWorld(spec_file);
+      hameritt::scenario::WorldType t;
+      if (parseWorldType(w, &t)) world_type = w;
+    }
     if (!world_type.empty()) {
       if (!parseWorldType(world_type, &wp.type)) {
         throw ConfigError("--world: expected suburb or city, got '" + world_type + "'");
@@ -191,7 +210,8 @@ int main(int argc, char** argv) {
       fs::remove_all(out, ec);
       out = into;
     }
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!quiet) {
       for (const auto& e : entries) std::printf("%s\n", e.id.c_str());
       std::fprintf(stderr, "hameritt_generate: %zu scenarios in %s (%.3f s, %d jobs)\n",
