@@ -764,7 +764,7 @@ class Parser {
     ConfuserSpec& c = spec_.confusers;
     if (k.text == "told_apart_by") {
       const Token t = peek();
-      if (t.kind != Tok::kString)
+      if (t.kind != Tok::kString || t.text.empty())
         error(
             "expected a requirement of this spec as a \"string\" after 'told_apart_by' (e.g. "
             "\"garage LEFT_OF target\"), got " +
