@@ -424,6 +424,16 @@ class ScenarioBuilder {
     if (forced.empty()) return;
     const std::size_t keep =
         static_cast<std::size_t>(std::max<int>(0, cfg_.relations.max_relations - static_cast<int>(forced.size())));
+    // Drop from the end, sparing the relations that another requirement listed.
+    auto listed = [&](const SceneRelation& r) {
+      for (const auto& pred : plan_->listed) {
+        if (pred(r)) return true;
+      }
+      return false;
+    };
+    for (std::size_t i = rels->size(); i-- > 0 && rels->size() > keep;) {
+      if (!listed((*rels)[i])) rels->erase(rels->begin() + static_cast<std::ptrdiff_t>(i));
+    }
     if (rels->size() > keep) rels->resize(keep);
     rels->insert(rels->begin(), forced.begin(), forced.end());
   }
@@ -674,14 +684,36 @@ class ScenarioBuilder {
       return disambiguated(c, rels, target_aois);
     };
     const auto* model = catalog::findCarModel(target.attributes.str("make"), target.attributes.str("model"));
-    const std::string color = target.attributes.str("color");
+    std::string color = target.attributes.str("color");
+    // A spec's share: the looks that share those attributes with the target and differ in the
+    // others.
+    std::vector<const catalog::CarModel*> share_models;
+    std::vector<std::string> share_colors;
+    const bool shared = plan_ && plan_->confuser_share;
+    if (shared) {
+      auto has = [&](const char* k) {
+        return std::find(plan_->confuser_share->begin(), plan_->confuser_share->end(), k) !=
+               plan_->confuser_share->end();
+      };
+      for (const auto& cm : catalog::carModels()) {
+        const bool vc = cm.vehicle_class == target.attributes.str("vehicle_class");
+        const bool mk = cm.make == target.attributes.str("make");
+        const bool md = cm.model == target.attributes.str("model");
+        if (vc == has("vehicle_class") && mk == has("make") && md == has("model"))
+          share_models.push_back(&cm);
+      }
+      for (const auto& c : catalog::carColors()) {
+        if ((c == color) == has("color")) share_colors.push_back(c);
+      }
+      if (share_models.empty() || share_colors.empty()) return;  // no such look-alike
+    }
     const int n = static_cast<int>(rng_.uniformInt(cfg_.confuser_count_min, cfg_.confuser_count_max));
     for (int k = 0; k < n; ++k) {
       // Alternate: outside the AOI first, then inside it but without the described context.
       const bool want_inside = !target_aois.empty() && (k % 2 == 1);
       bool placed = false;
       for (int attempt = 0; attempt < 60 && !placed; ++attempt) {
-        const int slot = pickSlot([&](const ParkingSlot& sl) {
+        auto fits = [&](const ParkingSlot& sl) {
           if ((sl.position - target.box.center2()).norm() < min_separation) return false;
           if (keep_out_of && keep_out_of->distance(sl.position) < 8.0) return false;
           if (!target_aois.empty()) {
@@ -689,10 +721,30 @@ class ScenarioBuilder {
             if (inside != want_inside) return false;
           }
           return true;
-        });
+        };
+        int slot;
+        if (plan_ && plan_->confuser_within) {
+          // A spec's distance: drawn among every free place that close (no retries).
+          std::vector<int> near;
+          for (int i = 0; i < static_cast<int>(world_.slots().size()); ++i) {
+            const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(i)];
+            if (!slot_taken_[static_cast<std::size_t>(i)] &&
+                (sl.position - target.box.center2()).norm() <= *plan_->confuser_within && fits(sl))
+              near.push_back(i);
+          }
+          slot = near.empty() ? -1 : rng_.pick(near);
+        } else {
+          slot = pickSlot(fits);
+        }
         if (slot < 0) break;
+        if (shared) {
+          model = rng_.pick(share_models);
+          color = rng_.pick(share_colors);
+        }
         Entity c = parkCar(slot, *model, color);
-        if (resolves(c)) {
+        const bool told_apart =
+            !plan_ || !plan_->confuser_told_apart || plan_->confuser_told_apart(c.box);
+        if (told_apart && resolves(c)) {
           add(std::move(c), "confuser");
           placed = true;
         } else {
@@ -700,6 +752,29 @@ class ScenarioBuilder {
           car_ids_.push_back(std::stoi(c.id.substr(4)));
         }
       }
+    }
+  }
+
+  // The spec's related car or pedestrian beside a parked target (a parked traffic car or a
+  // standing pedestrian), drawn among the options that the spec compiler accepts.
+  void placeRelated(const OrientedBox& target_box) {
+    if (!plan_ || !plan_->related) return;
+    const std::vector<RelatedOption> options = plan_->related(target_box);
+    if (options.empty()) return;  // the world already meets the relation
+    const RelatedOption& o = options[static_cast<std::size_t>(
+        rng_.uniformInt(0, static_cast<long>(options.size()) - 1))];
+    Entity e;
+    e.cls = o.cls;
+    e.attributes = o.attributes;
+    e.box = o.box;
+    if (o.cls == EntityClass::kCar) {
+      e.id = nextCarId();
+      e.block = world_.blockAt(e.box.center2());
+      if (o.slot >= 0) slot_taken_[static_cast<std::size_t>(o.slot)] = 1;
+      add(std::move(e), "traffic");
+    } else {
+      e.id = nextPedId();
+      add(std::move(e), "pedestrian");
     }
   }
 
@@ -750,6 +825,7 @@ class ScenarioBuilder {
     Entity target = parkCar(slot, *model, color);
     const Vec2 tp = target.box.center2();
     add(target, "target");
+    placeRelated(target.box);
     m.objective.type = "find";
     m.objective.targets.push_back(describe(target));
     m.objective.text = "Find the " + lookText(m.objective.targets.back()) + ".";
@@ -1161,6 +1237,7 @@ class ScenarioBuilder {
     const Vec2 tp = target.box.center2();
     m.priors.push_back(makePrior(aoi, &tp));
     add(target, "target", traj);
+    placeRelated(target.box);
 
     // Pedestrian subjects at the moment they are nearest the car, for EVENTUALLY_NEXT_TO.
     movingTargetRelations(target, traj, {});

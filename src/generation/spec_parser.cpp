@@ -124,7 +124,7 @@ std::vector<Token> lex(const Source& src) {
       t.kind = Tok::kPunct;
       t.text = "..";
       advance(2);
-    } else if (std::string("{}(),:=|").find(c) != std::string::npos) {
+    } else if (std::string("{}(),:=|[]").find(c) != std::string::npos) {
       t.kind = Tok::kPunct;
       t.text = std::string(1, c);
       advance(1);
@@ -177,6 +177,7 @@ class Vocabulary {
     }
     add(EntityClass::kPedestrian, "activity", "walking");
     add(EntityClass::kPedestrian, "activity", "running");
+    add(EntityClass::kPedestrian, "activity", "standing");
   }
   static std::string valueText(const scenario::AttributeValue& v) {
     if (const auto* s = std::get_if<std::string>(&v)) return *s;
@@ -225,6 +226,15 @@ std::string nearestHint(const std::string& name, const std::vector<std::string>&
   return "; did you mean " + joinList(q) + "?";
 }
 
+// `s` without spaces, to compare a requirement as written with its normalized text.
+std::string squeeze(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    if (ch != ' ' && ch != '\t') out += ch;
+  }
+  return out;
+}
+
 // Limits of each section key: [min, max] and whether the value is a whole number.
 struct KeyLimits {
   double min, max;
@@ -245,6 +255,7 @@ const std::map<std::string, KeyLimits>& keyLimits() {
       {"route.edges", {2, 10, true}},
       {"route.band", {20, 200, false}},
       {"confusers.count", {0, 16, true}},
+      {"confusers.within", {80, 1000, false}},
       {"traffic.cars", {0, 48, true}},
       {"traffic.pedestrians", {0, 40, true}},
       {"environment.time", {0, 24, false}},
@@ -442,12 +453,14 @@ class Parser {
           describe(t));
     }
     if (t.text == "import") return importStatement();
+    if (t.text == "world") return worldStatement();
     if (t.text == "param") return paramStatement();
     if (t.text == "scenario") return scenarioStatement();
     if (t.text == "target") return targetStatement();
     if (t.text == "require" || t.text == "prefer") return requirement();
     if (specSections().count(t.text)) return section();
-    std::vector<std::string> words = {"import", "param", "scenario", "target", "require", "prefer"};
+    std::vector<std::string> words = {"import",  "param",  "scenario", "target",
+                                      "require", "prefer", "world"};
     for (const auto& kv : specSections()) words.push_back(kv.first);
     error("unknown statement '" + t.text + "'" + nearestHint(t.text, words) +
           "; statements: " + joinList(words));
@@ -463,6 +476,25 @@ class Parser {
     const SourcePos at = pos(f);
     parseFile(p.string(), &at, src_);
     (void)kw;
+  }
+
+  // world suburb|city: the world type the spec is written for. hameritt_generate builds that
+  // world (specWorld()); any other world is refused here.
+  void worldStatement() {
+    take();
+    const Token w = expectIdent("a world type after 'world' (suburb, city)");
+    scenario::WorldType type;
+    if (!scenario::parseWorldType(w.text, &type)) {
+      error("unknown world type '" + w.text + "'" + nearestHint(w.text, {"suburb", "city"}) +
+                "; world types: suburb, city",
+            &w);
+    }
+    if (type != world_type_) {
+      error(std::string("this spec is written for the ") + scenario::toString(type) +
+                " world; the world here is " + scenario::toString(world_type_) +
+                " (hameritt_generate builds the spec's world; --world must agree)",
+            &w);
+    }
   }
 
   void paramStatement() {
@@ -538,6 +570,25 @@ class Parser {
                 &b);
         }
         t.block = b.text;
+      } else if (isWord("within")) {
+        const Token w = take();
+        const Token d = peek();
+        if (d.kind != Tok::kNumber || !(d.number > 0 && d.number <= 2000))
+          error("expected a distance in metres in (0, 2000] after 'within', got " + describe(d));
+        take();
+        if (!isWord("of")) error("expected 'of' after the distance, got " + describe(peek()));
+        take();
+        const Token l = expectIdent("a landmark (intersection or a class of the world)");
+        std::vector<std::string> marks = {"intersection"};
+        for (const auto& c : world_classes_) marks.push_back(c);
+        if (std::find(marks.begin(), marks.end(), l.text) == marks.end()) {
+          error("unknown landmark '" + l.text + "'" + nearestHint(l.text, marks) +
+                    "; landmarks in this world: " + joinList(marks),
+                &l);
+        }
+        t.within = d.number;
+        t.within_of = l.text;
+        t.within_pos = pos(w);
       } else if (isWord("on")) {
         take();
         const Token s = peek();
@@ -676,9 +727,19 @@ class Parser {
   void section() {
     const Token name = take();
     expectPunct("{", "after '" + name.text + "'");
-    const auto& keys = specSections().at(name.text);
+    std::vector<std::string> keys = specSections().at(name.text);
+    if (name.text == "confusers") {
+      keys.push_back("share");
+      keys.push_back("told_apart_by");
+      std::sort(keys.begin(), keys.end());
+    }
     while (!isPunct("}")) {
       const Token k = expectIdent("a setting of '" + name.text + "' or '}'");
+      if (name.text == "confusers" && (k.text == "share" || k.text == "told_apart_by")) {
+        confuserSetting(k);
+        if (isPunct(",")) take();
+        continue;
+      }
       if (std::find(keys.begin(), keys.end(), k.text) == keys.end()) {
         error("unknown setting '" + k.text + "' in " + name.text + nearestHint(k.text, keys) +
                   "; settings of " + name.text + ": " + joinList(keys),
@@ -695,6 +756,51 @@ class Parser {
       if (isPunct(",")) take();
     }
     take();
+  }
+
+  // confusers { share: [KEY, ...] } and { told_apart_by: "REQUIREMENT" }.
+  void confuserSetting(const Token& k) {
+    expectPunct(":", "after '" + k.text + "'");
+    ConfuserSpec& c = spec_.confusers;
+    if (k.text == "told_apart_by") {
+      const Token t = peek();
+      if (t.kind != Tok::kString || t.text.empty())
+        error(
+            "expected a requirement of this spec as a \"string\" after 'told_apart_by' (e.g. "
+            "\"garage LEFT_OF target\"), got " +
+            describe(t));
+      take();
+      c.told_apart_by = t.text;
+      c.told_pos = pos(t);
+      told_src_ = src_;
+      return;
+    }
+    const std::vector<std::string> all = {"vehicle_class", "make", "model", "color"};
+    c.share_pos = pos(peek());
+    share_src_ = src_;
+    expectPunct("[", "to open the list of shared attributes (e.g. [vehicle_class, color])");
+    c.share.clear();
+    c.have_share = true;
+    while (!isPunct("]")) {
+      const Token a = expectIdent("an attribute of the target (" + joinList(all) + ") or ']'");
+      if (std::find(all.begin(), all.end(), a.text) == all.end()) {
+        error("unknown attribute '" + a.text + "' to share" + nearestHint(a.text, all) +
+                  "; look-alikes share: " + joinList(all),
+              &a);
+      }
+      if (std::find(c.share.begin(), c.share.end(), a.text) != c.share.end())
+        error("attribute '" + a.text + "' given twice", &a);
+      c.share.push_back(a.text);
+      if (isPunct(",")) take();
+    }
+    take();
+    // A model has one make and one vehicle class: sharing it shares them.
+    if (std::find(c.share.begin(), c.share.end(), "model") != c.share.end()) {
+      for (const char* implied : {"make", "vehicle_class"}) {
+        if (std::find(c.share.begin(), c.share.end(), implied) == c.share.end())
+          c.share.push_back(implied);
+      }
+    }
   }
 
   // ---------------------------------------------------------------- expressions
@@ -863,10 +969,15 @@ class Parser {
         errorAt(t.pos, target_src_,
                 "'in' and 'on' place a parked target; route_search targets drive");
       }
+      if (t.within > 0 && route) {
+        errorAt(t.within_pos, target_src_,
+                "'within' places a parked target; route_search targets drive");
+      }
       if (!t.street.empty() && !t.block.empty()) {
         errorAt(t.pos, target_src_, "expected one of 'in BLOCK' and 'on \"STREET\"', not both");
       }
     }
+    bool placed_seen = false;
     for (std::size_t i = 0; i < spec_.requirements.size(); ++i) {
       const Requirement& r = spec_.requirements[i];
       if (route) {
@@ -893,13 +1004,59 @@ class Parser {
         }
       }
       if (!r.eventually &&
-          (r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar)) {
-        errorAt(r.pos, requirement_src_[i],
-                "relations to cars and pedestrians change with the scene: requirements relate "
-                "the target to the neighborhood (street, driveway, house, garage, fence, tree)");
+          (r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar) && !r.negated) {
+        // A positive relation to a car or pedestrian is constructed: the sampler parks a car or
+        // stands a pedestrian beside the target, one per spec, in every scenario.
+        if (r.probability < 1.0) {
+          errorAt(r.pos, requirement_src_[i],
+                  "a relation to a car or pedestrian is constructed (a parked car or a standing "
+                  "pedestrian is placed for it): use 'require', not 'prefer'");
+        }
+        if (placed_seen) {
+          errorAt(r.pos, requirement_src_[i],
+                  "one relation per spec may place a car or pedestrian beside the target; "
+                  "this is the second");
+        }
+        placed_seen = true;
+        for (const auto& a : r.attributes) {
+          if (a.key == "activity" && !a.values.empty() &&
+              std::find(a.values.begin(), a.values.end(), "standing") == a.values.end()) {
+            errorAt(a.pos, requirement_src_[i],
+                    "the pedestrian placed for a relation to the parked target stands: activity "
+                    "must allow 'standing'");
+          }
+        }
       }
     }
+    ConfuserSpec& c = spec_.confusers;
+    if (!c.told_apart_by.empty()) {
+      std::vector<std::string> hard;
+      c.told_apart = -1;
+      for (std::size_t i = 0; i < spec_.requirements.size(); ++i) {
+        const Requirement& r = spec_.requirements[i];
+        if (r.probability < 1.0 || r.eventually || r.related == EntityClass::kCar ||
+            r.related == EntityClass::kPedestrian)
+          continue;
+        hard.push_back(r.text);
+        if (squeeze(r.text) == squeeze(c.told_apart_by)) c.told_apart = static_cast<int>(i);
+      }
+      if (c.told_apart < 0) {
+        errorAt(c.told_pos, told_src_,
+                "told_apart_by: '" + c.told_apart_by +
+                    "' is not a hard requirement on the neighborhood of this spec; " +
+                    (hard.empty() ? std::string("it has none")
+                                  : "its requirements: " + joinList(hard)));
+      }
+    }
+    if ((c.have_share || !c.told_apart_by.empty()) && route) {
+      errorAt(c.have_share ? c.share_pos : c.told_pos, c.have_share ? share_src_ : told_src_,
+              "share and told_apart_by apply to the look-alikes of a parked target (area_search, "
+              "pursuit)");
+    }
     for (const auto& kv : settings_) {
+      if (kv.first == "confusers.within" && route) {
+        errorAt(kv.second.pos, kv.second.src, kv.first + " applies to area_search and pursuit");
+      }
       if (kv.first == "aois.target_offset" && spec_.cls != scenario::ScenarioClass::kAreaSearch) {
         errorAt(kv.second.pos, kv.second.src, kv.first + " applies to area_search only");
       }
@@ -916,6 +1073,10 @@ class Parser {
 
   Vocabulary vocab_;
   std::vector<std::string> world_blocks_;
+  std::vector<std::string> world_classes_;  // classes of the world's entities (landmarks)
+  const Source* told_src_ = nullptr;
+  const Source* share_src_ = nullptr;
+  scenario::WorldType world_type_ = scenario::WorldType::kSuburb;
   std::vector<std::unique_ptr<Source>> sources_;
   const Source* src_ = nullptr;
   std::vector<Token>* toks_ = nullptr;
@@ -934,6 +1095,10 @@ class Parser {
  public:
   void setBlocks(const scenario::World& world) {
     for (const auto& b : world.blocks()) world_blocks_.push_back(b.name);
+    std::set<std::string> classes;
+    for (const auto& e : world.entities()) classes.insert(scenario::toString(e.cls));
+    world_classes_.assign(classes.begin(), classes.end());
+    world_type_ = world.params().type;
   }
 };
 
@@ -1125,6 +1290,45 @@ Spec parseSpec(const std::string& path, const std::vector<std::string>& override
   p.setBlocks(world);
   p.parseFile(path, nullptr, nullptr);
   return p.finish(overrides, path);
+}
+
+namespace {
+// specWorld() on one file and its imports; `depth` bounds import cycles.
+void scanWorld(const std::string& path, int depth, std::string* out) {
+  if (depth > 16) return;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return;
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (ss.str().size() > (1u << 20)) return;
+  Source src;
+  src.file = path;
+  src.text = ss.str();
+  std::vector<Token> toks;
+  try {
+    toks = lex(src);
+  } catch (const SpecError&) {
+    return;  // the parse reports it
+  }
+  for (std::size_t i = 0; i + 1 < toks.size(); ++i) {
+    if (toks[i].kind != Tok::kIdent ||
+        (i > 0 && toks[i - 1].kind == Tok::kPunct && toks[i - 1].text == ":"))
+      continue;
+    if (toks[i].text == "import" && toks[i + 1].kind == Tok::kString) {
+      std::filesystem::path p(toks[i + 1].text);
+      if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
+      scanWorld(p.string(), depth + 1, out);
+    } else if (toks[i].text == "world" && toks[i + 1].kind == Tok::kIdent) {
+      *out = toks[i + 1].text;
+    }
+  }
+}
+}  // namespace
+
+std::string specWorld(const std::string& path) {
+  std::string out;
+  scanWorld(path, 0, &out);
+  return out;
 }
 
 Spec parseSpecText(const std::string& text, const std::string& file,

@@ -44,6 +44,17 @@ std::string history(const std::vector<NarrowingStep>& steps) {
   return "(" + s + ")";
 }
 
+// The spec's target as a relation subject: a car with this box and no attributes.
+scenario::Subject specTarget(const OrientedBox& box) {
+  static const scenario::Attributes kNone;
+  scenario::Subject target;
+  target.id = "__spec_target__";
+  target.cls = EntityClass::kCar;
+  target.attributes = &kNone;
+  target.box = box;
+  return target;
+}
+
 // The target's box parked at a slot, rounded as the generator rounds it.
 OrientedBox parkedBox(const scenario::ParkingSlot& sl, const scenario::catalog::CarModel& m) {
   return scenario::boxFromPose(
@@ -66,42 +77,38 @@ std::vector<int> relatedNear(const scenario::World& world, const Requirement& r,
   return out;
 }
 
+// The centre-line test before measure(): false when the relation cannot hold between these
+// boxes (distance or bearing), with the margins of holdsAmong().
+bool couldHold(const scenario::RelationConfig& cfg, scenario::RelationOp op,
+               const OrientedBox& target, const OrientedBox& related, double d) {
+  using scenario::RelationOp;
+  if (d > cfg.radius) return false;
+  if (op == RelationOp::kNextTo) return d < cfg.next_to_distance + 1e-3;
+  double nominal = -1;
+  if (op == RelationOp::kLeftOf || op == RelationOp::kOrthogonalTo) nominal = 90.0;
+  if (op == RelationOp::kRightOf) nominal = 270.0;
+  if (op == RelationOp::kInFrontOf) nominal = 180.0;
+  if (nominal < 0) return true;
+  const Vec2 dv = related.center2() - target.center2();
+  const double bearing =
+      geometry::wrapDeg360(geometry::radToDeg(std::atan2(dv.y(), dv.x()) - target.yaw));
+  const double tol = cfg.bearing_tolerance_deg + 1e-6;
+  return geometry::angleDiffDeg(bearing, nominal) <= tol ||
+         (op == RelationOp::kOrthogonalTo && geometry::angleDiffDeg(bearing, 270.0) <= tol);
+}
+
 // True when one of `candidates` (a superset of the related entities near the box) stands in the
 // requirement's relation to a target with this box (the negation is applied by the caller). The
 // same answer as holds(measure()) over nearbyWorldDistances(), but line of sight (the costly
 // part) is traced only where the distance and bearing leave the relation possible.
 bool holdsAmong(const scenario::RelationEvaluator& eval, const scenario::World& world,
                 const Requirement& r, const OrientedBox& box, const std::vector<int>& candidates) {
-  static const scenario::Attributes kNone;
-  const scenario::RelationConfig& cfg = eval.config();
-  scenario::Subject target;
-  target.id = "__spec_target__";
-  target.cls = EntityClass::kCar;
-  target.attributes = &kNone;
-  target.box = box;
-  double nominal = -1;  // the directional operators' bearing; ORTHOGONAL_TO: 90 or 270
-  if (r.op == scenario::RelationOp::kLeftOf || r.op == scenario::RelationOp::kOrthogonalTo)
-    nominal = 90.0;
-  if (r.op == scenario::RelationOp::kRightOf) nominal = 270.0;
-  if (r.op == scenario::RelationOp::kInFrontOf) nominal = 180.0;
+  const scenario::Subject target = specTarget(box);
   for (int i : candidates) {
     const scenario::Entity& e = world.entities()[static_cast<std::size_t>(i)];
     const auto& [c, s] = world.footprints().trig(i);
     const double d = geometry::footprintDistance(box, e.box, c, s);
-    if (d > cfg.radius) continue;  // not nearby: never considered
-    // Margins of 1 mm and 1e-6 deg over the thresholds keep the pruning on the safe side of
-    // measure()'s own rounding.
-    if (r.op == scenario::RelationOp::kNextTo && d >= cfg.next_to_distance + 1e-3) continue;
-    if (nominal >= 0) {
-      const Vec2 dv = e.box.center2() - box.center2();
-      const double bearing =
-          geometry::wrapDeg360(geometry::radToDeg(std::atan2(dv.y(), dv.x()) - box.yaw));
-      const double tol = cfg.bearing_tolerance_deg + 1e-6;
-      const bool could = geometry::angleDiffDeg(bearing, nominal) <= tol ||
-                         (r.op == scenario::RelationOp::kOrthogonalTo &&
-                          geometry::angleDiffDeg(bearing, 270.0) <= tol);
-      if (!could) continue;
-    }
+    if (!couldHold(eval.config(), r.op, box, e.box, d)) continue;
     const scenario::RelationFacts f = eval.measure(target, scenario::worldSubject(world, i));
     if (eval.holds(r.op, f, e.cls)) return true;
   }
@@ -120,12 +127,7 @@ bool worldRelationHoldsPruned(const scenario::RelationEvaluator& eval, const sce
 bool worldRelationHoldsReference(const scenario::RelationEvaluator& eval,
                                  const scenario::World& world, const Requirement& r,
                                  const OrientedBox& box) {
-  static const scenario::Attributes kNone;
-  scenario::Subject target;
-  target.id = "__spec_target__";
-  target.cls = EntityClass::kCar;
-  target.attributes = &kNone;
-  target.box = box;
+  const scenario::Subject target = specTarget(box);
   for (const auto& [i, d] : eval.nearbyWorldDistances(box)) {
     const scenario::Entity& e = world.entities()[static_cast<std::size_t>(i)];
     if (!r.matchesRelated(e.cls, e.attributes)) continue;
@@ -134,6 +136,242 @@ bool worldRelationHoldsReference(const scenario::RelationEvaluator& eval,
   }
   return false;
 }
+
+// Whether p lies within `d` m of an intersection (`of` == "intersection") or of the footprint
+// of a world entity of class `of`.
+bool withinLandmark(const scenario::World& world, const std::string& of, double d, const Vec2& p) {
+  if (of == "intersection") {
+    for (const auto& n : world.nodes()) {
+      if ((n.position - p).norm() <= d) return true;
+    }
+    return false;
+  }
+  EntityClass cls;
+  if (!scenario::parseEntityClass(of, &cls)) return false;
+  for (int i : world.footprints().near(p, d)) {
+    if (world.entities()[static_cast<std::size_t>(i)].cls == cls) return true;
+  }
+  return false;
+}
+
+std::string withinText(const TargetSpec& t) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%g", t.within);
+  return std::string("within ") + buf + " of " + t.within_of;
+}
+
+// A positive relation to a car or pedestrian: the sampler places the related entity.
+bool placesRelated(const Requirement& r) {
+  return !r.eventually && !r.negated &&
+         (r.related == EntityClass::kCar || r.related == EntityClass::kPedestrian);
+}
+
+}  // namespace
+
+// Where the related car or pedestrian of a placing requirement can go: free parking places
+// (a parked car of each look the requirement allows) and points every metre along the
+// sidewalks (a standing pedestrian). An option is kept when the relation holds, no negated
+// requirement comes to hold with it, and every other requirement keeps its outcome with it as
+// an occluder; the compiler and the generator use the same test.
+struct RelatedPlacer {
+  static constexpr double kCell = 16.0;
+  static constexpr double kStandStep = 1.0;
+  const scenario::World& world;
+  scenario::RelationEvaluator eval;
+  Requirement req;
+  std::vector<Requirement> others;  // every other static requirement
+  ScenarioClass cls;
+  std::vector<int> models;          // car looks: catalog models
+  std::vector<std::string> colors;  // car colours or pedestrian clothing colours
+  std::vector<OrientedBox> stands;  // standing pedestrian boxes
+  double max_half_diagonal = 0.5 * std::hypot(0.5, 0.6);  // of the related footprints
+  // Grid cells of kCell m: free parking slots (cars) or indices of `stands` (pedestrians).
+  std::map<std::pair<int, int>, std::vector<int>> cells;
+
+  RelatedPlacer(const scenario::World& w, const scenario::RelationConfig& rc, Requirement r,
+                const std::vector<Requirement>& all, ScenarioClass c)
+      : world(w), eval(w, rc), req(std::move(r)), cls(c) {
+    for (const auto& o : all) {
+      if (!o.eventually && o.text != req.text) others.push_back(o);
+    }
+    auto allowed = [&](const std::string& key, const std::string& v) {
+      for (const auto& a : req.attributes) {
+        if (a.key == key && !a.values.empty() &&
+            std::find(a.values.begin(), a.values.end(), v) == a.values.end())
+          return false;
+      }
+      return true;
+    };
+    if (req.related == EntityClass::kCar) {
+      const auto& cm = scenario::catalog::carModels();
+      for (int m = 0; m < static_cast<int>(cm.size()); ++m) {
+        const auto& x = cm[static_cast<std::size_t>(m)];
+        if (allowed("vehicle_class", x.vehicle_class) && allowed("make", x.make) &&
+            allowed("model", x.model)) {
+          models.push_back(m);
+          max_half_diagonal = std::max(max_half_diagonal, 0.5 * std::hypot(x.length, x.width));
+        }
+      }
+      for (const auto& col : scenario::catalog::carColors()) {
+        if (allowed("color", col)) colors.push_back(col);
+      }
+      for (int i = 0; i < static_cast<int>(world.slots().size()); ++i) {
+        const auto& sl = world.slots()[static_cast<std::size_t>(i)];
+        if (sl.occupant < 0) cells[cell(sl.position)].push_back(i);
+      }
+      return;
+    }
+    for (const auto& col : scenario::catalog::clothingColors()) {
+      if (allowed("clothing_color", col)) colors.push_back(col);
+    }
+    for (const auto& b : world.blocks()) {
+      const double ring = geometry::polylineLength(b.sidewalk);
+      for (double s = 0; s + kStandStep <= ring + 1e-9; s += kStandStep) {
+        const Vec2 p = geometry::polylinePointAt(b.sidewalk, s);
+        const Vec2 q = geometry::polylinePointAt(b.sidewalk, std::min(ring, s + 0.5));
+        const Vec2 dq = q - p;
+        const double yaw = dq.norm() > 1e-9 ? std::atan2(dq.y(), dq.x()) : 0.0;
+        const OrientedBox box = scenario::boxFromPose(
+            Vec3(scenario::roundMilli(p.x()), scenario::roundMilli(p.y()), 0.0),
+            scenario::roundMilli(geometry::wrapPi(yaw)), Vec3(0.5, 0.6, 1.75));
+        // Not inside a world entity (a fence, a tree, a parked car on a driveway).
+        bool clear = true;
+        for (int i : world.footprints().near(p, 2.0)) {
+          const auto& [c, sn] = world.footprints().trig(i);
+          if (geometry::footprintDistance(box, world.entities()[static_cast<std::size_t>(i)].box, c,
+                                          sn) < 0.05)
+            clear = false;
+        }
+        if (!clear) continue;
+        cells[cell(p)].push_back(static_cast<int>(stands.size()));
+        stands.push_back(box);
+      }
+    }
+  }
+
+  static std::pair<int, int> cell(const Vec2& p) {
+    return {static_cast<int>(std::floor(p.x() / kCell)),
+            static_cast<int>(std::floor(p.y() / kCell))};
+  }
+
+  scenario::Attributes look(const std::string& color, int model) const {
+    scenario::Attributes a;
+    if (req.related == EntityClass::kCar) {
+      const auto& x = scenario::catalog::carModels()[static_cast<std::size_t>(model)];
+      a.set("vehicle_class", x.vehicle_class);
+      a.set("make", x.make);
+      a.set("model", x.model);
+      a.set("color", color);
+    } else {
+      a.set("clothing_color", color);
+      a.set("activity", std::string("standing"));
+    }
+    return a;
+  }
+
+  // Whether `q` holds among the world's entities for a target with this box, as the checker
+  // sees it with `ev` (the world, and the candidate as an occluder when given).
+  static bool worldHolds(const scenario::RelationEvaluator& ev, const scenario::World& w,
+                         const Requirement& q, const OrientedBox& box) {
+    return worldRelationHoldsPruned(ev, w, q, box);
+  }
+
+  // The options for a target with this box (all of them, or the first only).
+  std::vector<scenario::RelatedOption> options(const OrientedBox& target, bool first) const {
+    std::vector<scenario::RelatedOption> out;
+    const scenario::RelationConfig& cfg = eval.config();
+    static const scenario::Attributes kNone;
+    const scenario::Subject ts = specTarget(target);
+    // Centre to centre, the farthest a related entity can stand: the operator's footprint
+    // distance plus half of each footprint's diagonal.
+    const double op_reach =
+        (req.op == scenario::RelationOp::kNextTo ? cfg.next_to_distance + 1e-3 : cfg.radius);
+    const double reach = op_reach + 0.5 * target.size.head<2>().norm() + max_half_diagonal + 0.01;
+    std::vector<char> before;  // outcomes of the other requirements without the candidate
+    auto tryBox = [&](const OrientedBox& box, int slot, const std::vector<int>& looks) {
+      const double d = geometry::footprintDistance(target, box);
+      if (d < 0.3) return;  // touching the target
+      if (!couldHold(cfg, req.op, target, box, d)) return;
+      scenario::Subject rs;
+      rs.id = "__spec_related__";
+      rs.cls = req.related;
+      rs.attributes = &kNone;
+      rs.box = box;
+      const scenario::RelationFacts f = eval.measure(ts, rs);
+      if (!eval.holds(req.op, f, req.related)) return;
+      if (before.empty()) {
+        // The hard ones hold (negations: do not) wherever a placement is sought.
+        for (const auto& q : others) {
+          before.push_back(q.probability == 1.0 ? !q.negated : worldHolds(eval, world, q, target));
+        }
+      }
+      scenario::RelationEvaluator with = eval;
+      with.addOccluder(rs.id, box);
+      std::vector<char> after_world;
+      for (std::size_t k = 0; k < others.size(); ++k) {
+        const Requirement& q = others[k];
+        // An occluder only takes relations away, but NOT_NEXT_TO and NOT_ON_TOP_OF.
+        const bool can_appear =
+            q.op == scenario::RelationOp::kNotNextTo || q.op == scenario::RelationOp::kNotOnTopOf;
+        after_world.push_back(!before[k] && !can_appear ? 0 : worldHolds(with, world, q, target));
+      }
+      for (int m : looks) {
+        for (const auto& col : colors) {
+          const scenario::Attributes a = look(col, m);
+          bool ok = true;
+          for (std::size_t k = 0; k < others.size() && ok; ++k) {
+            const Requirement& q = others[k];
+            const bool by_it = q.related == req.related && q.matchesRelated(req.related, a) &&
+                               eval.holds(q.op, f, req.related);
+            ok = (after_world[k] || by_it) == (before[k] != 0);
+          }
+          if (!ok) continue;
+          scenario::RelatedOption o;
+          o.cls = req.related;
+          o.box = box;
+          o.slot = slot;
+          o.attributes = a;
+          out.push_back(std::move(o));
+          if (first) return;
+        }
+      }
+    };
+    const auto& cm = scenario::catalog::carModels();
+    const Vec2 fwd(std::cos(target.yaw), std::sin(target.yaw));
+    const auto [cx, cy] = cell(target.center2());
+    const int span = static_cast<int>(std::ceil(reach / kCell));
+    for (int gx = cx - span; gx <= cx + span; ++gx) {
+      for (int gy = cy - span; gy <= cy + span; ++gy) {
+        auto it = cells.find({gx, gy});
+        if (it == cells.end()) continue;
+        for (int k : it->second) {
+          if (req.related == EntityClass::kPedestrian) {
+            const OrientedBox& box = stands[static_cast<std::size_t>(k)];
+            if ((box.center2() - target.center2()).norm() > reach) continue;
+            tryBox(box, -1, {-1});
+            if (first && !out.empty()) return out;
+            continue;
+          }
+          const auto& sl = world.slots()[static_cast<std::size_t>(k)];
+          const Vec2 dv = sl.position - target.center2();
+          if (dv.norm() > reach || dv.norm() < 1.0) continue;  // far, or the target's own place
+          if (cls == ScenarioClass::kPursuit) {
+            // Not in the pursuit target's way as it pulls out of the kerb ahead.
+            const double along = dv.dot(fwd), lat = std::abs(dv.x() * fwd.y() - dv.y() * fwd.x());
+            if (along > 0 && along < scenario::kPullOut + 12.0 && lat < 4.0) continue;
+          }
+          for (int m : models) {
+            tryBox(parkedBox(sl, cm[static_cast<std::size_t>(m)]), k, {m});
+            if (first && !out.empty()) return out;
+          }
+        }
+      }
+    }
+    return out;
+  }
+};
+
+namespace {
 
 double radicalInverse(int base, std::uint64_t i) {
   double inv = 1.0 / base, f = inv, r = 0;
@@ -222,6 +460,8 @@ void applySetting(const std::string& key, double v, ScenarioClass cls, scenario:
     plan->uav_start_within = v;
   } else if (key == "aois.target_offset") {
     plan->aoi_target_offset = v;
+  } else if (key == "confusers.within") {
+    plan->confuser_within = v;
   }
 }
 
@@ -304,6 +544,9 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
       throw SpecError(buf);
     }
   }
+  if (spec_.confusers.told_apart >= 0) {
+    told_eval_ = std::make_shared<const scenario::RelationEvaluator>(world, base.relations);
+  }
   if (!placed_) return;
   // Where: a block or a street.
   if (!spec_.target.block.empty() || !spec_.target.street.empty()) {
@@ -327,6 +570,21 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     if (slots.empty()) refuse(spec_.target.pos, "target " + label, before);
     steps_.push_back({label, count(slots.size() * models_.size())});
   }
+  // Near a landmark.
+  if (spec_.target.within > 0) {
+    const long long before = steps_.back().count;
+    std::vector<int> kept;
+    for (int i : slots) {
+      const Vec2& p = world.slots()[static_cast<std::size_t>(i)].position;
+      if (withinLandmark(world, spec_.target.within_of, spec_.target.within,
+                         Vec2(scenario::roundMilli(p.x()), scenario::roundMilli(p.y()))))
+        kept.push_back(i);
+    }
+    slots = kept;
+    if (slots.empty())
+      refuse(spec_.target.within_pos, "target " + withinText(spec_.target), before);
+    steps_.push_back({withinText(spec_.target), count(slots.size() * models_.size())});
+  }
   std::vector<std::pair<int, int>> pairs;
   for (int s : slots) {
     for (int m : models_) pairs.emplace_back(s, m);
@@ -341,20 +599,43 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   // Requirements, hard ones first narrowing the set, soft ones split it.
   const scenario::RelationEvaluator eval(world, base.relations);
   std::vector<std::vector<char>> soft_masks;
+  // The requirement that places a car or pedestrian goes last: it is tested on the places
+  // that every other requirement left.
+  std::vector<std::size_t> order;
   for (std::size_t ri = 0; ri < spec_.requirements.size(); ++ri) {
+    if (!placesRelated(spec_.requirements[ri])) order.push_back(ri);
+  }
+  for (std::size_t ri = 0; ri < spec_.requirements.size(); ++ri) {
+    if (placesRelated(spec_.requirements[ri])) order.push_back(ri);
+  }
+  for (const std::size_t ri : order) {
     const Requirement& r = spec_.requirements[ri];
     if (r.eventually) continue;  // constructed by the pursuit's vignette
     std::vector<char> mask(pairs.size());
     std::vector<int> candidates;  // per parking place: the pairs run place by place
+    std::shared_ptr<const RelatedPlacer> placer;
+    if (placesRelated(r)) {
+      placer = std::make_shared<const RelatedPlacer>(world, base.relations, r, spec_.requirements,
+                                                     spec_.cls);
+      placer_ = placer;
+    }
+    // No entity of the related class and look in the world (pedestrians, a colour no parked
+    // car has): no place meets it through the world, and nothing is measured.
+    bool in_world = false;
+    for (const auto& e : world.entities()) {
+      in_world = in_world ||
+                 (scenario::operatorApplies(r.op, e.cls) && r.matchesRelated(e.cls, e.attributes));
+    }
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       const auto& sl = world.slots()[static_cast<std::size_t>(pairs[k].first)];
-      if (k == 0 || pairs[k].first != pairs[k - 1].first) {
+      if (in_world && (k == 0 || pairs[k].first != pairs[k - 1].first)) {
         candidates = relatedNear(world, r, parkedBox(sl, models[0]).center2(),
                                  base.relations.radius + 0.5 * max_diagonal);
       }
-      const bool holds =
-          holdsAmong(eval, world, r,
-                     parkedBox(sl, models[static_cast<std::size_t>(pairs[k].second)]), candidates);
+      const OrientedBox box = parkedBox(sl, models[static_cast<std::size_t>(pairs[k].second)]);
+      bool holds = in_world && holdsAmong(eval, world, r, box, candidates);
+      // Constructed: a car or pedestrian that the generator places beside the target.
+      if (!holds && placer) holds = !placer->options(box, true).empty();
       mask[k] = holds != r.negated;
     }
     if (r.probability < 1.0) {
@@ -445,6 +726,25 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
     prov.values.emplace_back("prefer " + r.text, holds);
   }
   if (placed_) d.plan.placements = &combos_[bits];
+  if (spec_.confusers.have_share) d.plan.confuser_share = spec_.confusers.share;
+  if (spec_.confusers.told_apart >= 0) {
+    const Requirement r = spec_.requirements[static_cast<std::size_t>(spec_.confusers.told_apart)];
+    d.plan.confuser_told_apart = [r, ev = told_eval_](const OrientedBox& box) {
+      return worldRelationHoldsPruned(*ev, ev->world(), r, box) == r.negated;
+    };
+  }
+  if (placer_) {
+    d.plan.related = [p = placer_](const OrientedBox& box) {
+      if (worldRelationHoldsPruned(p->eval, p->world, p->req, box)) {
+        return std::vector<scenario::RelatedOption>{};
+      }
+      std::vector<scenario::RelatedOption> o = p->options(box, false);
+      if (o.empty()) {
+        throw scenario::GenerationError("no place beside the target for '" + p->req.text + "'");
+      }
+      return o;
+    };
+  }
   d.plan.models = models_;
   d.plan.colors = colors_;
   d.plan.target_count = spec_.target.count;
@@ -521,6 +821,10 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
       fail("target " + t.entity.id + " is not parked on \"" + spec.target.street + "\"");
     }
   }
+  if (spec.target.within > 0 &&
+      !withinLandmark(world, spec.target.within_of, spec.target.within, box.center2())) {
+    fail("target " + t.entity.id + " is not " + withinText(spec.target));
+  }
   scenario::RelationEvaluator eval(world, base.relations);
   for (const auto& se : sim.entities) {
     if (se.trajectory.empty() && se.entity.id != t.entity.id)
@@ -550,6 +854,26 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
       }
     } else {
       exists = worldRelationHoldsReference(eval, world, r, box);
+      // Cars and pedestrians of the scenario that stand still (parked cars, standing
+      // pedestrians) relate to the target at t = 0 like the world's own.
+      if (r.related == EntityClass::kCar || r.related == EntityClass::kPedestrian) {
+        scenario::Subject ts;
+        ts.id = t.entity.id;
+        ts.cls = t.entity.cls;
+        ts.attributes = &t.entity.attributes;
+        ts.box = box;
+        for (const auto& se : sim.entities) {
+          if (exists || !se.trajectory.empty() || se.entity.id == t.entity.id ||
+              !r.matchesRelated(se.entity.cls, se.entity.attributes))
+            continue;
+          scenario::Subject rs;
+          rs.id = se.entity.id;
+          rs.cls = se.entity.cls;
+          rs.attributes = &se.entity.attributes;
+          rs.box = se.entity.box;
+          exists = eval.holds(r.op, eval.measure(ts, rs), rs.cls);
+        }
+      }
     }
     const bool holds = exists != r.negated;
     if (r.probability < 1.0) {
@@ -579,6 +903,52 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
                             rel.related_class == scenario::toString(r.related));
       }
       if (!listed) fail("requirement '" + r.text + "' holds but the mission does not list it");
+    }
+  }
+  // Look-alikes: what they share with the target, how far they park, and the requirement that
+  // tells them apart (measured against the world, as the sampler places them).
+  const ConfuserSpec& cs = spec.confusers;
+  const Distribution* within = spec.setting("confusers.within");
+  if (cs.have_share || cs.told_apart >= 0 || within) {
+    const scenario::RelationEvaluator world_eval(world, base.relations);
+    std::optional<double> within_drawn;
+    if (sim.spec) {
+      for (const auto& [name, v] : sim.spec->values) {
+        if (name == "confusers.within" && std::holds_alternative<double>(v))
+          within_drawn = std::get<double>(v);
+      }
+    }
+    for (const auto& se : sim.entities) {
+      if (se.role != "confuser") continue;
+      const std::string& id = se.entity.id;
+      if (cs.have_share) {
+        for (const char* k : {"vehicle_class", "make", "model", "color"}) {
+          const bool same = se.entity.attributes.str(k) == t.entity.attributes.str(k);
+          const bool want = std::find(cs.share.begin(), cs.share.end(), k) != cs.share.end();
+          if (same != want) {
+            fail("confuser " + id + ": " + k + " '" + se.entity.attributes.str(k) + "' " +
+                 (want ? "differs from" : "is") + " the target's" + (want ? "" : " (not shared)"));
+          }
+        }
+      }
+      if (within) {
+        const double far = (se.entity.box.center2() - box.center2()).norm();
+        const double limit = within_drawn ? *within_drawn : within->maxValue();
+        if (far > limit + 1e-3) {
+          char buf[160];
+          std::snprintf(
+              buf, sizeof(buf),
+              "confusers.within: confuser %s parks %.3f m from the target, expected at most %.3f",
+              id.c_str(), far, limit);
+          fail(buf);
+        }
+      }
+      if (cs.told_apart >= 0) {
+        const Requirement& r = spec.requirements[static_cast<std::size_t>(cs.told_apart)];
+        if (worldRelationHoldsReference(world_eval, world, r, se.entity.box) != r.negated) {
+          fail("confuser " + id + " meets '" + r.text + "', which should tell it apart");
+        }
+      }
     }
   }
   // Drawn values inside their distributions' supports.

@@ -163,6 +163,13 @@ int main(int argc, char** argv) {
     req.jobs = jobs;
     req.exact_seed = exact;
     WorldParams wp = loadWorldParams(world_cfg);
+    // A spec's `world suburb|city` picks the world unless --world does (an unknown name is
+    // reported by the parse, with its place).
+    if (world_type.empty() && !spec_file.empty()) {
+      const std::string w = hameritt::generation::specWorld(spec_file);
+      hameritt::scenario::WorldType t;
+      if (parseWorldType(w, &t)) world_type = w;
+    }
     if (!world_type.empty()) {
       if (!parseWorldType(world_type, &wp.type)) {
         throw UsageError("--world: expected suburb or city, got '" + world_type + "'");

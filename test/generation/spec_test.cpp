@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -309,6 +310,8 @@ TEST(SpecCompile, PrunedRelationsAgreeWithTheReference) {
   long compared = 0, held = 0, differ = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
     if (e.path().extension() != ".hspec") continue;
+    const std::string w = specWorld(e.path().string());
+    if (!w.empty() && w != "suburb") continue;  // written for another world
     const Spec s = parseSpec(e.path().string(), {}, world);
     for (const auto& r : s.requirements) {
       if (r.eventually) continue;
@@ -381,6 +384,250 @@ TEST(SpecCompile, AoiOffsetAndUavStartAreMetAndChecked) {
   EXPECT_NE(errorOf("scenario pursuit\ntarget car\naois { target_offset: 10 }\n")
                 .find("aois.target_offset applies to area_search only"),
             std::string::npos);
+}
+
+// Generates `n` scenarios of a spec and checks each with the independent checker.
+std::vector<scenario::Scenario> generateChecked(const Spec& s, int n) {
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  std::vector<scenario::Scenario> out;
+  for (int i = 0; i < n; ++i) {
+    const std::uint64_t seed = scenario::batchSeed(21, static_cast<std::uint64_t>(i));
+    const ScenarioDraw d = c.draw(seed, static_cast<std::uint64_t>(i), 21, SamplerKind::kRandom);
+    out.push_back(scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan));
+    const auto fails = checkScenarioAgainstSpec(s, shippedWorld(), cfg, out.back().mission,
+                                                out.back().sim, nullptr);
+    EXPECT_TRUE(fails.empty()) << i << ": " << fails.front();
+  }
+  return out;
+}
+
+std::vector<std::string> checkOf(const Spec& s, const scenario::Scenario& sc,
+                                 const scenario::SimConfig& sim) {
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  return checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sim, nullptr);
+}
+
+TEST(SpecRelated, ACarOrPedestrianIsPlacedBesideTheTargetAndChecked) {
+  struct Case {
+    std::string text, related, role;
+  };
+  const Case cases[] = {
+      {"target car parked\nrequire car NEXT_TO target {color: white}\n",
+       "car NEXT_TO target {color: white}", "traffic"},
+      {"target car {vehicle_class: sedan} parked\nrequire garage RIGHT_OF target\n"
+       "require car IN_FRONT_OF target {vehicle_class: van | pickup}\n",
+       "car IN_FRONT_OF target {vehicle_class: van | pickup}", "traffic"},
+      {"target car parked\nrequire pedestrian NEXT_TO target {clothing_color: red}\n",
+       "pedestrian NEXT_TO target {clothing_color: red}", "pedestrian"},
+  };
+  int placed = 0;
+  for (const auto& k : cases) {
+    const Spec s = parse(std::string(kHead) + k.text);
+    for (const auto& sc : generateChecked(s, 12)) {
+      // The relation is listed, with a parked car or standing pedestrian of the scenario.
+      const scenario::ScenarioEntity* rel = nullptr;
+      for (const auto& r : sc.mission.relations) {
+        for (const auto& se : sc.sim.entities) {
+          if (se.entity.id == r.related_id && se.role == k.role && se.trajectory.empty() &&
+              r.related_class == scenario::toString(se.entity.cls))
+            rel = &se;
+        }
+      }
+      if (!rel) continue;  // a world entity meets it
+      ++placed;
+      if (k.role == "pedestrian") EXPECT_EQ(rel->entity.attributes.str("activity"), "standing");
+      // Negative control: without the placed entity the requirement fails.
+      scenario::SimConfig without = sc.sim;
+      const std::string id = rel->entity.id;
+      without.entities.erase(std::remove_if(without.entities.begin(), without.entities.end(),
+                                            [&](const auto& se) { return se.entity.id == id; }),
+                             without.entities.end());
+      const auto f = checkOf(s, sc, without);
+      ASSERT_FALSE(f.empty()) << k.text;
+      EXPECT_NE(f[0].find("requirement '" + k.related + "' does not hold"), std::string::npos)
+          << f[0];
+    }
+  }
+  EXPECT_GE(placed, 30);  // of 36: world cars rarely meet them
+}
+
+TEST(SpecRelated, NegationsKeepCarsAwayAndAreChecked) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car parked\nrequire car LEFT_OF target\n"
+                       "require not car NEXT_TO target\nrequire not pedestrian NEXT_TO target\n");
+  for (const auto& sc : generateChecked(s, 10)) {
+    // Negative control: a standing pedestrian put beside the target breaks the negation.
+    const scenario::ScenarioEntity* target = nullptr;
+    for (const auto& se : sc.sim.entities) {
+      if (se.role == "target") target = &se;
+    }
+    ASSERT_TRUE(target);
+    scenario::ScenarioEntity p;
+    p.entity.id = "pedestrian_99";
+    p.entity.cls = scenario::EntityClass::kPedestrian;
+    p.role = "pedestrian";
+    const geometry::OrientedBox& tb = target->entity.box;
+    const geometry::Vec2 side(-std::sin(tb.yaw), std::cos(tb.yaw));
+    const geometry::Vec2 at = tb.center2() - (0.5 * tb.size.y() + 1.0) * side;
+    p.entity.box = scenario::boxFromPose(geometry::Vec3(at.x(), at.y(), tb.minZ()), tb.yaw,
+                                         geometry::Vec3(0.5, 0.6, 1.75));
+    scenario::SimConfig near = sc.sim;
+    near.entities.push_back(p);
+    const auto f = checkOf(s, sc, near);
+    ASSERT_EQ(f.size(), 1u);
+    EXPECT_EQ(f[0].find("requirement 'not pedestrian NEXT_TO target' does not hold"), 0u) << f[0];
+  }
+}
+
+TEST(SpecRelated, TypeCheckerRules) {
+  const std::string soft =
+      errorOf(std::string(kHead) + "target car parked\nprefer 0.5 car NEXT_TO target\n");
+  EXPECT_EQ(soft.substr(0, soft.find('\n')),
+            "t.hspec:3:1: error: a relation to a car or pedestrian is constructed (a parked car or "
+            "a standing pedestrian is placed for it): use 'require', not 'prefer'");
+  const std::string two = errorOf(std::string(kHead) +
+                                  "target car parked\nrequire car NEXT_TO target\n"
+                                  "require pedestrian LEFT_OF target\n");
+  EXPECT_EQ(two.substr(0, two.find('\n')),
+            "t.hspec:4:1: error: one relation per spec may place a car or pedestrian beside the "
+            "target; this is the second");
+  const std::string walk = errorOf(std::string(kHead) +
+                                   "target car parked\n"
+                                   "require pedestrian NEXT_TO target {activity: walking}\n");
+  EXPECT_EQ(walk.substr(0, walk.find('\n')),
+            "t.hspec:3:36: error: the pedestrian placed for a relation to the parked target "
+            "stands: activity must allow 'standing'");
+  // Negations add up with the one placing relation.
+  EXPECT_NO_THROW(parse(std::string(kHead) +
+                        "target car parked\nrequire car NEXT_TO target\n"
+                        "require not car IN_FRONT_OF target\nrequire not pedestrian NEXT_TO "
+                        "target\n"));
+}
+
+TEST(SpecWithin, TheTargetParksNearALandmarkAndIsChecked) {
+  const Spec s = parse(std::string(kHead) + "target car parked within 25 of intersection\n");
+  int far = 0;
+  for (const auto& sc : generateChecked(s, 12)) {
+    const scenario::ScenarioEntity* target = nullptr;
+    for (const auto& se : sc.sim.entities) {
+      if (se.role == "target") target = &se;
+    }
+    ASSERT_TRUE(target);
+    double nearest = 1e18;
+    for (const auto& n : shippedWorld().nodes())
+      nearest = std::min(nearest, (n.position - target->entity.box.center2()).norm());
+    EXPECT_LE(nearest, 25.0);
+    // Negative control: the same scene with the target moved to a place far from every
+    // intersection.
+    scenario::SimConfig moved = sc.sim;
+    for (const auto& sl : shippedWorld().slots()) {
+      double d = 1e18;
+      for (const auto& n : shippedWorld().nodes())
+        d = std::min(d, (n.position - sl.position).norm());
+      if (d < 40.0) continue;
+      for (auto& se : moved.entities) {
+        if (se.role == "target") se.entity.box.center.head<2>() = sl.position;
+      }
+      break;
+    }
+    const auto f = checkOf(s, sc, moved);
+    ASSERT_FALSE(f.empty());
+    EXPECT_NE(f[0].find("is not within 25 of intersection"), std::string::npos) << f[0];
+    ++far;
+  }
+  EXPECT_EQ(far, 12);
+  // A landmark the world lacks is a name error; a distance no place meets is unsatisfiable.
+  const std::string bus = errorOf(std::string(kHead) + "target car parked within 80 of bus_stp\n");
+  EXPECT_EQ(bus.substr(0, bus.find(';')), "t.hspec:2:32: error: unknown landmark 'bus_stp'");
+  const Spec tight = parse(std::string(kHead) + "target car parked within 0.5 of intersection\n");
+  const std::string m = messageOf([&] { CompiledSpec(tight, shippedWorld(), shippedConfig()); });
+  EXPECT_EQ(m.find("t.hspec:2:19: error: unsatisfiable in this world: target within 0.5 of "
+                   "intersection: 0 of "),
+            0u)
+      << m;
+}
+
+TEST(SpecConfusers, ShareDistanceAndToldApartAreMetAndChecked) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car {make: Chevrolet, model: Impala, color: blue} parked\n"
+                       "require garage LEFT_OF target {color: white}\n"
+                       "confusers { count: 4, share: [vehicle_class, color], within: 250,\n"
+                       "  told_apart_by: \"garage LEFT_OF target {color: white}\" }\n");
+  int confusers = 0;
+  for (const auto& sc : generateChecked(s, 10)) {
+    const scenario::ScenarioEntity* target = nullptr;
+    for (const auto& se : sc.sim.entities) {
+      if (se.role == "target") target = &se;
+    }
+    ASSERT_TRUE(target);
+    for (std::size_t i = 0; i < sc.sim.entities.size(); ++i) {
+      const auto& c = sc.sim.entities[i];
+      if (c.role != "confuser") continue;
+      ++confusers;
+      EXPECT_EQ(c.entity.attributes.str("vehicle_class"), "sedan");
+      EXPECT_EQ(c.entity.attributes.str("color"), "blue");
+      EXPECT_NE(c.entity.attributes.str("model"), "Impala");
+      EXPECT_LE((c.entity.box.center2() - target->entity.box.center2()).norm(), 250.0 + 1e-3);
+      // Negative controls: another colour; parked 1 km away; parked where the target is (its
+      // garage on the left tells nothing apart there).
+      scenario::SimConfig color = sc.sim;
+      color.entities[i].entity.attributes.set("color", std::string("red"));
+      auto f = checkOf(s, sc, color);
+      ASSERT_EQ(f.size(), 1u);
+      EXPECT_EQ(f[0], "confuser " + c.entity.id + ": color 'red' differs from the target's");
+      scenario::SimConfig far = sc.sim;
+      far.entities[i].entity.box.center.x() += 1000.0;
+      f = checkOf(s, sc, far);
+      ASSERT_FALSE(f.empty());
+      EXPECT_EQ(f[0].find("confusers.within: confuser " + c.entity.id + " parks"), 0u) << f[0];
+      scenario::SimConfig same = sc.sim;
+      same.entities[i].entity.box = target->entity.box;
+      f = checkOf(s, sc, same);
+      ASSERT_FALSE(f.empty());
+      EXPECT_NE(std::find(f.begin(), f.end(),
+                          "confuser " + c.entity.id +
+                              " meets 'garage LEFT_OF target {color: white}', which should tell "
+                              "it apart"),
+                f.end());
+    }
+  }
+  EXPECT_GE(confusers, 20);  // of at most 40
+  const std::string share =
+      errorOf(std::string(kHead) + "target car parked\nconfusers { share: [colour] }\n");
+  EXPECT_EQ(share.substr(0, share.find('?') + 1),
+            "t.hspec:3:21: error: unknown attribute 'colour' to share; did you mean 'color'?");
+  const std::string told = errorOf(std::string(kHead) +
+                                   "target car parked\nrequire garage LEFT_OF target\n"
+                                   "confusers { told_apart_by: \"tree NEXT_TO target\" }\n");
+  EXPECT_EQ(told.substr(0, told.find('\n')),
+            "t.hspec:4:28: error: told_apart_by: 'tree NEXT_TO target' is not a hard requirement "
+            "on the neighborhood of this spec; its requirements: garage LEFT_OF target");
+}
+
+TEST(SpecWorld, TheSpecNamesItsWorldAndOtherWorldsRefuseIt) {
+  const std::string city = errorOf("world city\n" + std::string(kHead) + "target car parked\n");
+  EXPECT_EQ(city.substr(0, city.find('\n')),
+            "t.hspec:1:7: error: this spec is written for the city world; the world here is "
+            "suburb (hameritt_generate builds the spec's world; --world must agree)");
+  EXPECT_NO_THROW(parse("world suburb\n" + std::string(kHead) + "target car parked\n"));
+  const std::string typo = errorOf("world citty\n" + std::string(kHead));
+  EXPECT_EQ(typo.substr(0, typo.find('?') + 1),
+            "t.hspec:1:7: error: unknown world type 'citty'; did you mean 'city'?");
+  // specWorld() reads it before the world is built, through imports; the last one wins.
+  const auto dir = std::filesystem::temp_directory_path() / "hameritt_spec_world_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "base.hspec") << "world city\nenvironment { fog: 0.1 }\n";
+  std::ofstream(dir / "a.hspec") << "import \"base.hspec\"\nscenario area_search\n";
+  std::ofstream(dir / "b.hspec") << "import \"base.hspec\"\nworld suburb\n";
+  std::ofstream(dir / "c.hspec") << "scenario area_search\nconfusers { count: 2 }\n";
+  EXPECT_EQ(specWorld((dir / "a.hspec").string()), "city");
+  EXPECT_EQ(specWorld((dir / "b.hspec").string()), "suburb");
+  EXPECT_EQ(specWorld((dir / "c.hspec").string()), "");
+  EXPECT_EQ(specWorld((dir / "missing.hspec").string()), "");
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SpecNames, EditDistance) {

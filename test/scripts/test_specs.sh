@@ -144,5 +144,50 @@ printf 'scenario area_search\ntarget car parked\naois { target_offset: 100 }\n' 
 expect 2 "aois.target_offset: up to 100 m" "$G" --spec "$T/off.hspec" --count 3 --seed 1 --out "$T/x8"
 [[ ! -e "$T/x8" ]] && ok || bad "a refused run wrote $T/x8"
 
+# The van placed beside the sedan, and the landmark distance, recomputed from the scene: one
+# scene without its van fails (exit 2); a spec asking for the target within 0.5 m of an
+# intersection is refused as unsatisfiable; scenes generated within 40 m of an intersection pass
+# and fail a 10 m spec.
+v1=$(/usr/bin/python3 - "$OUT/van_beside_sedan" <<'EOF2'
+import glob, json, sys
+for sdir in sorted(glob.glob(sys.argv[1] + "/*/")):
+    d = json.load(open(sdir + "sim_config.json"))
+    m = json.load(open(sdir + "mission.json"))
+    ids = {r["related"]["id"] for r in m["scene_relations"] if r["related"]["class"] == "car"}
+    kept = [e for e in d["entities"] if not (e["role"] == "traffic" and e["id"] in ids
+                                             and e["trajectory"] == [])]
+    if len(kept) == len(d["entities"]) - 1:
+        d["entities"] = kept
+        json.dump(d, open(sdir + "sim_config.json", "w"), indent=2)
+        print(sdir)
+        break
+EOF2
+)
+[[ -n "$v1" ]] && ok || bad "no van_beside_sedan scene with a placed van"
+expect 2 "requirement 'car NEXT_TO target \{vehicle_class: van, color: white\}' does not hold" "$V" --spec "$S/van_beside_sedan.hspec" "$v1"
+# A look-alike of the Impala repainted red no longer shares the target's colour (exit 2).
+c1="$(ls -d "$OUT/impala_lookalikes"/*/ | head -1)"
+/usr/bin/python3 - "$c1/sim_config.json" <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+c = [e for e in d["entities"] if e["role"] == "confuser"]
+assert c, "no confuser"
+c[0]["attributes"]["color"] = "red"
+json.dump(d, open(sys.argv[1], "w"), indent=2)
+EOF2
+expect 2 "confuser car_[0-9]+: color 'red' differs from the target's" "$V" --spec "$S/impala_lookalikes.hspec" "$c1"
+# The city spec builds the city (its scenes say so); on suburb scenes it is refused (exit 2).
+grep -q '"type": "city"' "$(ls -d "$OUT/city_bus_stop"/*/ | head -1)/sim_config.json" && ok || bad "city_bus_stop: scene not in the city"
+expect 2 "city_bus_stop.hspec:3:7: error: this spec is written for the city world; the world here is suburb" "$V" --spec "$S/city_bus_stop.hspec" "$T/j1"
+printf 'scenario area_search\ntarget car parked within 0.5 of intersection\n' >"$T/w0.hspec"
+expect 2 "w0.hspec:2:19: error: unsatisfiable in this world: target within 0.5 of intersection: 0 of" "$G" --spec "$T/w0.hspec" --count 3 --seed 1 --out "$T/x9"
+[[ ! -e "$T/x9" ]] && ok || bad "a refused run wrote $T/x9"
+printf 'scenario area_search\ntarget car parked within 40 of intersection\n' >"$T/w40.hspec"
+printf 'scenario area_search\ntarget car parked within 10 of intersection\n' >"$T/w10.hspec"
+"$G" --spec "$T/w40.hspec" --count 30 --seed 3 --out "$T/w40" --quiet && ok || bad "within 40: generation failed"
+"$V" --spec "$T/w40.hspec" "$T/w40" >/dev/null 2>&1 && ok || bad "within 40: scenes fail their spec"
+out=$("$V" --spec "$T/w10.hspec" "$T/w40" 2>/dev/null | tail -1)
+[[ "$out" =~ ^30\ scenarios,\ ([0-9]+)\ meet\ the\ spec,\ ([0-9]+)\ fail$ && ${BASH_REMATCH[2]} -gt 0 ]] && ok || bad "within 10 on within-40 scenes: $out"
+
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -14,6 +14,15 @@ namespace hameritt::scenario {
 // "<class>-<16 hex digits of the seed>", e.g. "area_search-00000000000004d2".
 std::string scenarioId(ScenarioClass cls, std::uint64_t seed);
 
+// A car or pedestrian to put beside the target so that a spec's relation to it holds: its pose,
+// look and (cars) the parking place it takes.
+struct RelatedOption {
+  EntityClass cls = EntityClass::kCar;
+  geometry::OrientedBox box;
+  int slot = -1;  // parking slot of a car, -1 for a standing pedestrian
+  Attributes attributes;
+};
+
 // What a spec fixes for one scenario beyond the generator's ranges (generation/spec_sampler.h
 // fills it): the target's feasible placements and looks, the relations the mission must list,
 // and environment values. Null members leave the random generator's choice.
@@ -34,6 +43,17 @@ struct ScenarioPlan {
   // min(120, this / 2) from it.
   std::optional<double> uav_start_within;
   std::optional<SpecProvenance> provenance;
+  // Given the parked target's box: every option for the related car or pedestrian that a spec
+  // requires beside it (the generator draws one and adds it as a parked traffic car or a
+  // standing pedestrian); empty when the world already meets the relation. Null: none.
+  std::function<std::vector<RelatedOption>(const geometry::OrientedBox&)> related;
+  // Look-alikes: the attributes they share with the target (vehicle_class, make, model,
+  // color; the others differ); unset: make, model and colour.
+  std::optional<std::vector<std::string>> confuser_share;
+  // Look-alikes park at most this far from the target (m), drawn among every such place.
+  std::optional<double> confuser_within;
+  // True when a look-alike parked with this box fails the requirement that tells it apart.
+  std::function<bool(const geometry::OrientedBox&)> confuser_told_apart;
 };
 
 // Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give

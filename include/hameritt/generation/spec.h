@@ -81,7 +81,22 @@ struct TargetSpec {
   std::optional<bool> moving;            // unset: the class decides
   std::string block;                     // "in block_07"
   std::string street;                    // "on \"Oak Street\""
+  // "within 80 of bus_stop": the parked target's centre lies within this many metres of the
+  // nearest landmark, an intersection or a world entity of that class (footprint). 0: none.
+  double within = 0;
+  std::string within_of;
+  SourcePos within_pos;
   SourcePos pos;
+};
+
+// What the look-alikes share with the target and what tells them apart:
+// confusers { share: [vehicle_class, color], told_apart_by: "garage LEFT_OF target" }.
+struct ConfuserSpec {
+  bool have_share = false;         // false: the same make, model and colour (the default)
+  std::vector<std::string> share;  // of vehicle_class, make, model, color; the others differ
+  std::string told_apart_by;       // a requirement's text, as written in the spec
+  int told_apart = -1;             // its index in Spec::requirements; -1: none
+  SourcePos share_pos, told_pos;
 };
 
 // A type-checked spec: everything the compiler needs, with its sources' hash.
@@ -92,6 +107,7 @@ struct Spec {
   bool have_class = false;
   TargetSpec target;
   std::vector<Requirement> requirements;
+  ConfuserSpec confusers;
   // "section.key" -> distribution (mission.time_limit, aois.count, environment.snow, ...), in
   // the order first written.
   std::vector<std::pair<std::string, Distribution>> settings;
@@ -106,6 +122,10 @@ struct Spec {
 // ConfigError (unreadable file, bad --param).
 Spec parseSpec(const std::string& path, const std::vector<std::string>& overrides,
                const scenario::World& world);
+// The world type a spec file asks for with `world suburb|city` (its imports included, the last
+// one written wins), read before the world is built; "" when it names none or cannot be read
+// (parseSpec() then reports why). parseSpec() refuses a spec whose world is not `world`'s.
+std::string specWorld(const std::string& path);
 // The same from source text named `file` (imports relative to the working directory).
 Spec parseSpecText(const std::string& text, const std::string& file,
                    const std::vector<std::string>& overrides, const scenario::World& world);

@@ -33,6 +33,8 @@ struct ScenarioDraw {
   scenario::ScenarioPlan plan;
 };
 
+struct RelatedPlacer;
+
 class CompiledSpec {
  public:
   // Throws SpecError (exit 2) when the world cannot satisfy the spec.
@@ -61,6 +63,10 @@ class CompiledSpec {
   std::vector<std::vector<std::pair<int, int>>> combos_;
   std::vector<NarrowingStep> steps_;
   bool placed_ = false;  // the target is parked (area_search, pursuit)
+  // The requirement that places a car or pedestrian beside the target, if any.
+  std::shared_ptr<const RelatedPlacer> placer_;
+  // The world's relations, for the requirement that tells look-alikes apart.
+  std::shared_ptr<const scenario::RelationEvaluator> told_eval_;
 };
 
 // Whether some world entity of the requirement's related class and look stands in its relation
