@@ -76,11 +76,23 @@ bool StreetPredictor::observe(double t, const Vec3& position) {
 }
 
 VehicleState StreetPredictor::predict(double t) const {
-  VehicleState out = last_;
+  return walk(t, Branches::kStraight).front();
+}
+
+std::vector<VehicleState> StreetPredictor::hypotheses(double t) const {
+  return walk(t, Branches::kEvery);
+}
+
+VehicleState StreetPredictor::predictToJunction(double t) const {
+  return walk(t, Branches::kStopAtJunction).front();
+}
+
+std::vector<VehicleState> StreetPredictor::walk(double t, Branches branches) const {
+  VehicleState start = last_;
+  start.t = t;
   const double dt = std::clamp(t - last_.t, 0.0, settings_.predict_horizon);
-  out.t = t;
-  double left = last_.speed * dt;
-  if (!(left > 1e-6) || world_.edges().empty()) return out;
+  const double distance = last_.speed * dt;
+  if (!(distance > 1e-6) || world_.edges().empty()) return {start};
   // The street the vehicle drives on: the nearest centreline, driven the way it heads.
   const Vec2 p = last_.position.head<2>();
   const Vec2 heading(std::cos(last_.yaw), std::sin(last_.yaw));
@@ -95,44 +107,59 @@ VehicleState StreetPredictor::predict(double t) const {
   const auto& e0 = world_.edges()[static_cast<std::size_t>(edge)];
   const Vec2 a0 = world_.nodes()[e0.a].position, b0 = world_.nodes()[e0.b].position;
   const bool forward = (b0 - a0).dot(heading) >= 0.0;
-  int to = forward ? e0.b : e0.a;
   // Walk from the projection, keeping the lateral offset (the lane).
-  Vec2 along = geometry::closestPointOnSegment(p, a0, b0);
+  const Vec2 along0 = geometry::closestPointOnSegment(p, a0, b0);
   const Vec2 dir0 = ((forward ? b0 : a0) - (forward ? a0 : b0)).normalized();
-  const Vec2 right0(dir0.y(), -dir0.x());
-  const double lateral = (p - along).dot(right0);
-  Vec2 dir = dir0;
-  for (int hops = 0; hops < 64 && left > 1e-9; ++hops) {
-    const Vec2 node = world_.nodes()[static_cast<std::size_t>(to)].position;
-    const double span = (node - along).norm();
-    if (left <= span) {
-      along += dir * left;
-      left = 0.0;
-      break;
+  const double lateral = (p - along0).dot(Vec2(dir0.y(), -dir0.x()));
+  struct Walker {
+    Vec2 along, dir;
+    int to;
+    double left;
+  };
+  std::vector<Walker> open{{along0, dir0, forward ? e0.b : e0.a, distance}};
+  std::vector<VehicleState> ends;
+  auto finish = [&](const Vec2& along, const Vec2& dir) {
+    VehicleState out = start;
+    const Vec2 q = along + Vec2(dir.y(), -dir.x()) * lateral;
+    out.position = Vec3(q.x(), q.y(), last_.position.z());
+    out.yaw = std::atan2(dir.y(), dir.x());
+    ends.push_back(out);
+  };
+  constexpr std::size_t kMaxHypotheses = 64;
+  for (int steps = 0; !open.empty() && steps < 4096; ++steps) {
+    Walker w = open.back();
+    open.pop_back();
+    const Vec2 node = world_.nodes()[static_cast<std::size_t>(w.to)].position;
+    const double span = (node - w.along).norm();
+    if (w.left <= span) {
+      finish(w.along + w.dir * w.left, w.dir);
+      continue;
     }
-    left -= span;
-    along = node;
-    // Straight on: the leaving edge with the smallest turn, never back the way it came.
-    int next = -1;
-    double best_cos = -2.0;
-    for (int ei : world_.adjacency()[static_cast<std::size_t>(to)]) {
+    // The leaving edges, never back the way it came; straight on (the smallest turn) first.
+    std::vector<std::pair<double, int>> next;
+    for (int ei : world_.adjacency()[static_cast<std::size_t>(w.to)]) {
       const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
-      const int other = e.a == to ? e.b : e.a;
-      const Vec2 d = (world_.nodes()[static_cast<std::size_t>(other)].position - node);
+      const int other = e.a == w.to ? e.b : e.a;
+      const Vec2 d = world_.nodes()[static_cast<std::size_t>(other)].position - node;
       if (d.norm() < 1e-9) continue;
-      const double c = d.normalized().dot(dir);
+      const double c = d.normalized().dot(w.dir);
       if (c < -0.99) continue;
-      if (c > best_cos) best_cos = c, next = other;
+      next.emplace_back(-c, other);
     }
-    if (next < 0) break;  // a dead end: the vehicle stops there
-    dir = (world_.nodes()[static_cast<std::size_t>(next)].position - node).normalized();
-    to = next;
+    std::sort(next.begin(), next.end());
+    if (next.empty() || (branches == Branches::kStopAtJunction && next.size() > 1)) {
+      finish(node, w.dir);  // a dead end, or a choice ahead: it is there or beyond
+      continue;
+    }
+    const std::size_t take = branches == Branches::kEvery ? next.size() : 1;
+    for (std::size_t k = take; k-- > 0;) {  // pushed last = straight on, walked first
+      if (ends.size() + open.size() >= kMaxHypotheses) break;
+      const Vec2 to = world_.nodes()[static_cast<std::size_t>(next[k].second)].position;
+      open.push_back({node, (to - node).normalized(), next[k].second, w.left - span});
+    }
   }
-  const Vec2 right(dir.y(), -dir.x());
-  const Vec2 q = along + right * lateral;
-  out.position = Vec3(q.x(), q.y(), last_.position.z());
-  out.yaw = std::atan2(dir.y(), dir.x());
-  return out;
+  if (ends.empty()) ends.push_back(start);
+  return ends;
 }
 
 ViewpointChooser::ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,

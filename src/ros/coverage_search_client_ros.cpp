@@ -40,8 +40,11 @@ geometry_msgs::PoseStamped poseAt(const geometry::Vec3& p, double yaw, const ros
 constexpr double kLostAfter = 2.0;
 // A sighting of the description farther from the prediction than the gate is another vehicle
 // (a parked look-alike the target drives past): 2.5 m while the track is fresh, growing by 2 m
-// per second without a sighting (the prediction's error grows), at most 15 m.
-double associationGate(double unseen) { return std::min(15.0, 2.5 + 2.0 * std::max(0.0, unseen)); }
+// per second without a sighting (the prediction's error grows), at most 25 m.
+double associationGate(double unseen) { return std::min(25.0, 2.5 + 2.0 * std::max(0.0, unseen)); }
+// Unseen for longer than this, a sighting is matched against every branch of the prediction
+// (the vehicle may have turned while hidden), not only the straight-on one.
+constexpr double kBranchAfter = 0.5;
 // Detection claims come seconds apart: their gate.
 constexpr double kAssociationGate = 15.0;
 
@@ -300,8 +303,14 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
   // The pursued vehicle: the sighting of the description nearest the prediction, within the
   // gate (a tracker's data association; the context describes t = 0 and the AOI only).
   const bool tracking = pursue_ && predictor_ && predictor_->tracking();
-  const geometry::Vec3 predicted = tracking ? predictor_->predict(t).position : geometry::Vec3();
-  double nearest = tracking ? associationGate(t - predictor_->last().t) : 0.0;
+  std::vector<clients::VehicleState> predicted;
+  double nearest = 0.0;
+  if (tracking) {
+    const double unseen = t - predictor_->last().t;
+    predicted = unseen > kBranchAfter ? predictor_->hypotheses(t)
+                                      : std::vector<clients::VehicleState>{predictor_->predict(t)};
+    nearest = associationGate(unseen);
+  }
   std::optional<std::pair<geometry::Vec3, double>> associated;
   for (const auto& e : msg->entities) {
     // Class and attributes only: the entity's id and role are ground truth a client never uses.
@@ -309,9 +318,12 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     if (targets.empty()) continue;
     const scenario::TargetDescription& target = *targets.front();
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
-    if (tracking && (p - predicted).head<2>().norm() < nearest) {
-      nearest = (p - predicted).head<2>().norm();
-      associated = std::make_pair(p, static_cast<double>(e.yaw));
+    for (const auto& h : predicted) {
+      const double d = (p - h.position).head<2>().norm();
+      if (d < nearest) {
+        nearest = d;
+        associated = std::make_pair(p, static_cast<double>(e.yaw));
+      }
     }
     if (pursuing_) continue;
     clients::ContextVerdict v;
@@ -383,7 +395,9 @@ void CoverageSearchClientRos::onPursuitTick() {
   }
   // Lost: climb (up to 15 m) for a wider view around the prediction.
   const double climb = lost_ ? std::min(15.0, 2.0 * (unseen - kLostAfter)) : 0.0;
-  const clients::VehicleState v = predictor_->predict(t + pursuit_.lead);
+  // Lost, it flies to where the vehicle must pass: the next intersection with a choice.
+  const clients::VehicleState v = lost_ ? predictor_->predictToJunction(t + pursuit_.lead)
+                                        : predictor_->predict(t + pursuit_.lead);
   const clients::PursuitView view = chooser_->choose(v, uav, t, climb);
   const ros::Time now = ros::Time::now();
   ROS_INFO_THROTTLE(10.0,

@@ -123,6 +123,50 @@ TEST(Pursuit, PredictionFollowsTheStreetRoundACorner) {
   EXPECT_NEAR(claims.last().speed, 10.0, 1e-9);
 }
 
+TEST(Pursuit, HypothesesTakeEveryBranchOfAnIntersection) {
+  const auto& w = world();
+  // A four-way intersection whose streets are all longer than 30 m.
+  int node = -1;
+  for (std::size_t n = 0; n < w.nodes().size() && node < 0; ++n) {
+    if (w.adjacency()[n].size() != 4) continue;
+    bool long_enough = true;
+    for (int ei : w.adjacency()[n]) {
+      const auto& e = w.edges()[static_cast<std::size_t>(ei)];
+      long_enough &= (w.nodes()[e.a].position - w.nodes()[e.b].position).norm() > 30.0;
+    }
+    if (long_enough) node = static_cast<int>(n);
+  }
+  ASSERT_GE(node, 0) << "no four-way intersection in the shipped world";
+  const Vec2 c = w.nodes()[static_cast<std::size_t>(node)].position;
+  const auto& e = w.edges()[static_cast<std::size_t>(w.adjacency()[node][0])];
+  const Vec2 from = w.nodes()[static_cast<std::size_t>(e.a == node ? e.b : e.a)].position;
+  const Vec2 in = (c - from).normalized();
+  const double yaw = std::atan2(in.y(), in.x());
+  StreetPredictor predictor(w, PursuitSettings());
+  const Vec2 p0 = c - in * 30.0, p1 = c - in * 20.0;
+  ASSERT_TRUE(predictor.observe(0.0, Vec3(p0.x(), p0.y(), 0), yaw));
+  ASSERT_TRUE(predictor.observe(1.0, Vec3(p1.x(), p1.y(), 0), yaw));
+  // 3 s later, 30 m on: 10 m past the intersection on each of the three streets ahead.
+  const std::vector<VehicleState> h = predictor.hypotheses(4.0);
+  ASSERT_EQ(h.size(), 3u);
+  int ahead = 0;
+  for (const auto& v : h) {
+    EXPECT_NEAR((v.position.head<2>() - c).norm(), 10.0, 1e-6);
+    EXPECT_LT(streetDistance(v.position.head<2>()), 1e-6);
+    // None goes back the way it came.
+    EXPECT_GT((v.position.head<2>() - c).normalized().dot(in), -0.5);
+    ahead += (v.position.head<2>() - c).normalized().dot(in) > 0.95;  // (streets bend a little)
+  }
+  EXPECT_EQ(ahead, 1);
+  // The straight-on one first, and it is the single prediction.
+  EXPECT_NEAR((h.front().position - predictor.predict(4.0).position).norm(), 0.0, 1e-9);
+  // Held at the intersection, where it has a choice.
+  EXPECT_NEAR((predictor.predictToJunction(4.0).position.head<2>() - c).norm(), 0.0, 1e-6);
+  // Before it reaches it, the same as the prediction.
+  EXPECT_NEAR((predictor.predictToJunction(1.5).position - predictor.predict(1.5).position).norm(),
+              0.0, 1e-9);
+}
+
 TEST(Pursuit, ViewpointSeesTheVehiclePastOccluders) {
   const auto& w = world();
   PursuitSettings settings;

@@ -53,8 +53,16 @@ class StreetPredictor {
   const VehicleState& last() const { return last_; }
   // The predicted state at time t (>= the last sighting).
   VehicleState predict(double t) const;
+  // Every way it may have gone by time t: each branch at each intersection (no U-turns), at
+  // most 64; the straight-on prediction first.
+  std::vector<VehicleState> hypotheses(double t) const;
+  // The prediction, held at the next intersection where the vehicle has a choice: where a
+  // lost vehicle is sure to pass (or to have passed).
+  VehicleState predictToJunction(double t) const;
 
  private:
+  enum class Branches { kStraight, kEvery, kStopAtJunction };
+  std::vector<VehicleState> walk(double t, Branches branches) const;
   const scenario::World& world_;
   PursuitSettings settings_;
   std::deque<VehicleState> recent_;
