@@ -45,6 +45,8 @@ double associationGate(double unseen) { return std::min(25.0, 2.5 + 2.0 * std::m
 // Unseen for longer than this, a sighting is matched against every branch of the prediction
 // (the vehicle may have turned while hidden), not only the straight-on one.
 constexpr double kBranchAfter = 0.5;
+// A sighting this close to a parked car of the public map is that car.
+constexpr double kParkedRadius = 1.5;
 // Detection claims come seconds apart: their gate.
 constexpr double kAssociationGate = 15.0;
 
@@ -115,6 +117,10 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
         gate_->subscribe(nh, "adk/perfect_perception", 20, &Self::onPerfectPerception, this);
   }
   if (pursue_) {
+    // The parked cars of the public map: a sighting at one's place is that car.
+    for (const auto& e : world_->entities()) {
+      if (e.cls == scenario::EntityClass::kCar) parked_.push_back(e.box.center2());
+    }
     pose_pub_ = gate_->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
     predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
     gate_->every(nh, 1.0 / pursuit_rate, [this] { onPursuitTick(); });
@@ -318,7 +324,10 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     if (targets.empty()) continue;
     const scenario::TargetDescription& target = *targets.front();
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
-    for (const auto& h : predicted) {
+    const bool parked = std::any_of(parked_.begin(), parked_.end(), [&](const geometry::Vec2& c) {
+      return (c - p.head<2>()).norm() < kParkedRadius;
+    });
+    for (const auto& h : parked ? std::vector<clients::VehicleState>{} : predicted) {
       const double d = (p - h.position).head<2>().norm();
       if (d < nearest) {
         nearest = d;

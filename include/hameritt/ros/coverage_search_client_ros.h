@@ -98,6 +98,7 @@ class CoverageSearchClientRos {
   clients::PursuitSettings pursuit_;
   std::unique_ptr<clients::StreetPredictor> predictor_;
   std::unique_ptr<clients::ViewpointChooser> chooser_;
+  std::vector<geometry::Vec2> parked_;  // the public map's parked cars
   double planner_sent_at_ = -1e9;
   int losses_ = 0;
 
