@@ -19,17 +19,15 @@ still driving at 100 s). Twice:
 The in-view time is the ADK's (ground truth: camera boxes with enough visible pixels), not the
 client's own account.
 """
-import json
 import os
 import re
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
 
 from graph_util import private_master_port, start_master, stop_master
-from fault_util import Checks, metrics_validator
+from fault_util import Checks, launch_mission, metrics_validator
 
 PORT = private_master_port(27000)
 SEED = int(os.environ.get("HAMERITT_PURSUIT_SEED", "1"))
@@ -52,26 +50,12 @@ def run(tmp, scenario, pursue):
     label = "pursue" if pursue else "hover"
     out = os.path.join(tmp, label)
     log = os.path.join(tmp, label + ".log")
-    launch = subprocess.Popen(
-        ["roslaunch", "hameritt", "mission.launch", "scenario:=" + scenario,
-         "mode:=maneuver_only", "lockstep:=true", "real_time_factor:=0",
-         "time_limit:=%d" % TIME_LIMIT, "pursue:=%s" % ("true" if pursue else "false"),
-         "output_dir:=" + out],
-        stdout=open(log, "w"), stderr=subprocess.STDOUT,
-        env=dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1"))
     # A guard against a hang only: what is judged is the outcome, not how long it took.
-    try:
-        rc = launch.wait(900)
-    except subprocess.TimeoutExpired:
-        launch.send_signal(signal.SIGINT)
-        rc = launch.wait(60)
-        check(False, "%s: the launch did not end by itself" % label)
-    text = open(log).read()
-    try:
-        with open(os.path.join(out, "metrics.json")) as f:
-            m = json.load(f)
-    except (OSError, ValueError) as e:
-        check(False, "%s: metrics.json: %s" % (label, e))
+    rc, text, m = launch_mission(
+        ["scenario:=" + scenario, "mode:=maneuver_only", "lockstep:=true", "real_time_factor:=0",
+         "time_limit:=%d" % TIME_LIMIT, "pursue:=%s" % ("true" if pursue else "false")],
+        out, log, label, check, 900)
+    if m is None:
         return None, text
     errors = [e.message for e in METRICS.iter_errors(m)]
     check(rc == 0, "%s: the launch exited %d" % (label, rc))
