@@ -245,6 +245,7 @@ void AdkRos::onClock(const rosgraph_msgs::Clock::ConstPtr& msg) {
   // the sample at the limit (the simulator publishes the clock before the odometry of a step);
   // the clock alone decides without odometry or when it has stalled for a second.
   if (have_odom_ && t - last_odom_t_ <= 1.0) return;
+  judgeTrackAtLimit(t);
   if (lifecycle_->update(t, have_odom_)) {
     publishState();
     if (lifecycle_->ended()) finish();
@@ -289,6 +290,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     publishConstraints(t);
     next_status_t_ = t + status_period_;
   }
+  judgeTrackAtLimit(t);
   if (lifecycle_->update(t, true)) {
     publishState();
     if (lifecycle_->ended()) finish();
@@ -357,6 +359,17 @@ void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {
   std::snprintf(buf, sizeof(buf), "crashed into %s at %.2f m/s", msg->entity_id.c_str(),
                 msg->speed);
   if (lifecycle_->crash(std::max(t, 0.0), buf)) {
+    publishState();
+    finish();
+  }
+}
+
+void AdkRos::judgeTrackAtLimit(double t) {
+  if (lifecycle_->state() != adk::MissionState::kRunning || !metrics_->isTrack()) return;
+  const double limit = lifecycle_->timeLimit();
+  if (t < limit || !metrics_->objectiveMet(limit)) return;  // else the time limit: timeout
+  const std::string how = metrics_->targets().size() == 1 ? "the target" : "every target";
+  if (lifecycle_->succeed(t, how + " in view for the track fraction of the time limit")) {
     publishState();
     finish();
   }

@@ -3,6 +3,7 @@
 #include <nav_msgs/Path.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "hameritt/clients/public_config.h"
 #include "hameritt/ros/client_conversions.h"
@@ -26,6 +27,28 @@ geometry_msgs::PoseStamped poseAt(const geometry::Vec3& p, const ros::Time& stam
   m.pose.orientation.w = 1.0;
   return m;
 }
+
+// A pose that faces `yaw`.
+geometry_msgs::PoseStamped poseAt(const geometry::Vec3& p, double yaw, const ros::Time& stamp) {
+  geometry_msgs::PoseStamped m = poseAt(p, stamp);
+  m.pose.orientation.z = std::sin(0.5 * yaw);
+  m.pose.orientation.w = std::cos(0.5 * yaw);
+  return m;
+}
+
+// Seconds without a sighting after which the pursued vehicle counts as lost.
+constexpr double kLostAfter = 2.0;
+// A sighting of the description farther from the prediction than the gate is another vehicle
+// (a parked look-alike the target drives past): 2.5 m while the track is fresh, growing by 2 m
+// per second without a sighting (the prediction's error grows), at most 25 m.
+double associationGate(double unseen) { return std::min(25.0, 2.5 + 2.0 * std::max(0.0, unseen)); }
+// Unseen for longer than this, a sighting is matched against every branch of the prediction
+// (the vehicle may have turned while hidden), not only the straight-on one.
+constexpr double kBranchAfter = 0.5;
+// A sighting this close to a parked car of the public map is that car.
+constexpr double kParkedRadius = 1.5;
+// Detection claims come seconds apart: their gate.
+constexpr double kAssociationGate = 15.0;
 
 }  // namespace
 
@@ -55,6 +78,16 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   pnh.param("mission_start_time", mission_start_, mission_start_);
   pnh.param("rate_hz", rate, rate);
   if (!(rate > 0 && rate <= 100)) throw scenario::ConfigError("~rate_hz: expected (0, 100]");
+  double pursuit_rate = 10.0;
+  pnh.param("pursue", pursue_, pursue_);
+  pnh.param("pursuit_standoff", pursuit_.standoff, pursuit_.standoff);
+  pnh.param("pursuit_height", pursuit_.height, pursuit_.height);
+  pnh.param("pursuit_lead", pursuit_.lead, pursuit_.lead);
+  pnh.param("pursuit_rate_hz", pursuit_rate, pursuit_rate);
+  if (!(pursuit_rate > 0 && pursuit_rate <= 100)) {
+    throw scenario::ConfigError("~pursuit_rate_hz: expected (0, 100]");
+  }
+  pursuit_.validate();
 
   // The honesty rule: the map and the UAV's own specification, never the scenario's entities.
   sim_ = clients::loadPublicSimConfig(sim_path);
@@ -66,7 +99,7 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   settings_.validate();
   claims_ = clients::ClaimLedger(claim_radius, claim_hold);
   detections_ = clients::ClaimLedger(claim_radius, 0.0);
-  if (claim_ && use_context_) {
+  if ((claim_ && use_context_) || pursue_) {
     world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
   }
 
@@ -82,6 +115,15 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
     detection_pub_ = gate_->advertise<hameritt::Detection>(nh, "perception/detections", 50);
     perfect_sub_ =
         gate_->subscribe(nh, "adk/perfect_perception", 20, &Self::onPerfectPerception, this);
+  }
+  if (pursue_) {
+    // The parked cars of the public map: a sighting at one's place is that car.
+    for (const auto& e : world_->entities()) {
+      if (e.cls == scenario::EntityClass::kCar) parked_.push_back(e.box.center2());
+    }
+    pose_pub_ = gate_->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
+    predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
+    gate_->every(nh, 1.0 / pursuit_rate, [this] { onPursuitTick(); });
   }
   gate_->every(nh, 1.0 / rate, [this] { onTick(); });
   ROS_INFO("%s: %s camera, altitude %.1f m, swath %.1f m, lines %.1f m apart%s", kClientName,
@@ -100,8 +142,13 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   if (mission_ && mission_->scenario_id == m->scenario_id) return;  // the same, again
   mission_ = std::move(*m);
   filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get());
+  if (pursue_) {
+    chooser_ =
+        std::make_unique<clients::ViewpointChooser>(*world_, sim_.uav, mission_->kozs, pursuit_);
+    predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
+  }
   covered_.clear();
-  planned_ = stopped_ = exhausted_ = false;
+  planned_ = stopped_ = exhausted_ = pursuing_ = false;
   ROS_INFO("%s: mission %s: %s", kClientName, mission_->scenario_id.c_str(),
            mission_->objective.text.c_str());
   if (odom_) replan("mission received");
@@ -135,7 +182,7 @@ void CoverageSearchClientRos::replan(const std::string& why) {
 }
 
 void CoverageSearchClientRos::sendIfDue() {
-  if (stopped_ || !planned_ || sent_ || !mission_) return;
+  if (stopped_ || pursuing_ || !planned_ || sent_ || !mission_) return;
   if (leg_ >= plan_.legs.size()) {
     if (exhausted_) return;
     if (repeat_ && !covered_.empty()) {
@@ -171,7 +218,7 @@ void CoverageSearchClientRos::sendIfDue() {
 }
 
 void CoverageSearchClientRos::onProgress(const hameritt::FollowProgress::ConstPtr& msg) {
-  if (!sent_ || stopped_ || leg_ >= plan_.legs.size()) return;
+  if (!sent_ || stopped_ || pursuing_ || leg_ >= plan_.legs.size()) return;
   const clients::SearchLeg& leg = plan_.legs[leg_];
   if (!acked_) {
     // The follower's first answer to this leg: it plans as soon as the waypoints arrive.
@@ -234,25 +281,60 @@ void CoverageSearchClientRos::onDetection(const hameritt::Detection::ConstPtr& m
   for (const auto& t : mission_->objective.targets) wanted |= clients::matchesDescription(seen, t);
   if (!wanted) return;
   const geometry::Vec3 p(msg->position.x, msg->position.y, msg->position.z);
+  const double t = msg->header.stamp.toSec() - mission_start_;
+  // A pursuit fed by claims alone (no perfect perception): each claim near the prediction.
+  if (pursue_ && !claim_ && predictor_ &&
+      (!predictor_->tracking() ||
+       (predictor_->predict(t).position - p).head<2>().norm() < kAssociationGate)) {
+    predictor_->observe(t, p);
+  }
+  if (pursuing_) return;
   detections_.claim(p, msg->header.stamp.toSec());
   const std::size_t wanted_places = std::max<std::size_t>(1, mission_->objective.targets.size());
   if (detections_.locations() >= wanted_places) {
     char buf[160];
     std::snprintf(buf, sizeof(buf), "%s detected %s at (%.1f, %.1f)", msg->client.c_str(),
                   msg->description.c_str(), p.x(), p.y());
-    stop(buf);
+    if (pursue_ && mission_->objective.type == "track" && predictor_->tracking()) {
+      startPursuit(buf);
+    } else {
+      stop(buf);
+    }
   }
 }
 
 void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg) {
   if (!mission_ || !filter_) return;
   const double t = msg->header.stamp.toSec() - mission_start_;
+  // The pursued vehicle: the sighting of the description nearest the prediction, within the
+  // gate (a tracker's data association; the context describes t = 0 and the AOI only).
+  const bool tracking = pursue_ && predictor_ && predictor_->tracking();
+  std::vector<clients::VehicleState> predicted;
+  double nearest = 0.0;
+  if (tracking) {
+    const double unseen = t - predictor_->last().t;
+    predicted = unseen > kBranchAfter ? predictor_->hypotheses(t)
+                                      : std::vector<clients::VehicleState>{predictor_->predict(t)};
+    nearest = associationGate(unseen);
+  }
+  std::optional<std::pair<geometry::Vec3, double>> associated;
   for (const auto& e : msg->entities) {
     // Class and attributes only: the entity's id and role are ground truth a client never uses.
     const auto targets = filter_->targetsMatching(toObservation(e));
     if (targets.empty()) continue;
     const scenario::TargetDescription& target = *targets.front();
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
+    const bool parked = std::any_of(parked_.begin(), parked_.end(), [&](const geometry::Vec2& c) {
+      return (c - p.head<2>()).norm() < kParkedRadius;
+    });
+    for (const auto& h : parked ? std::vector<clients::VehicleState>{} : predicted) {
+      const double d = (p - h.position).head<2>().norm();
+      if (d < nearest) {
+        nearest = d;
+        associated = std::make_pair(p, static_cast<double>(e.yaw));
+      }
+    }
+    if (pursuing_) continue;
     clients::ContextVerdict v;
     v.accepted = true;
     if (use_context_) {
@@ -268,6 +350,10 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
                         clients::describe(target).c_str(), p.x(), p.y(), v.reason.c_str());
       continue;
     }
+    // The first accepted sighting starts the track that a pursuit follows.
+    if (pursue_ && predictor_ && !tracking && !associated) {
+      associated = std::make_pair(p, static_cast<double>(e.yaw));
+    }
     if (!claims_.claim(p, t)) continue;
     const double confidence =
         clients::claimConfidence(1.0, v.relations_checked, v.relations_skipped);
@@ -276,6 +362,7 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     ROS_INFO("%s: claim: %s at (%.1f, %.1f), confidence %.2f (%s)", kClientName,
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
   }
+  if (associated) predictor_->observe(t, associated->first, associated->second);
 }
 
 void CoverageSearchClientRos::onTick() {
@@ -287,9 +374,76 @@ void CoverageSearchClientRos::onTick() {
   sendIfDue();
 }
 
+void CoverageSearchClientRos::startPursuit(const std::string& why) {
+  if (pursuing_ || stopped_) return;
+  pursuing_ = true;
+  planner_flying_ = true;  // the search leg: stopped on the first pursuit tick
+  planner_sent_at_ = -1e9;
+  lost_ = false;
+  losses_ = 0;
+  const auto& s = predictor_->last();
+  ROS_INFO("%s: %s: pursuing it from (%.1f, %.1f), %.1f m/s, standoff %.1f m, height %.1f m",
+           kClientName, why.c_str(), s.position.x(), s.position.y(), s.speed, pursuit_.standoff,
+           pursuit_.height);
+}
+
+void CoverageSearchClientRos::onPursuitTick() {
+  if (!pursuing_ || stopped_ || !odom_ || !chooser_) return;
+  const double t = missionTime();
+  const auto& o = odom_->pose.pose.position;
+  const geometry::Vec3 uav(o.x, o.y, o.z);
+  const double unseen = t - predictor_->last().t;
+  if (unseen > kLostAfter && !lost_) {
+    lost_ = true;
+    ++losses_;
+    ROS_INFO("%s: pursuit: lost the target (loss %d); flying to its prediction", kClientName,
+             losses_);
+  } else if (unseen <= kLostAfter && lost_) {
+    lost_ = false;
+    ROS_INFO("%s: pursuit: reacquired the target after loss %d", kClientName, losses_);
+  }
+  // Lost: climb (up to 15 m) for a wider view around the prediction.
+  const double climb = lost_ ? std::min(15.0, 2.0 * (unseen - kLostAfter)) : 0.0;
+  // Lost, it flies to where the vehicle must pass: the next intersection with a choice.
+  const clients::VehicleState v = lost_ ? predictor_->predictToJunction(t + pursuit_.lead)
+                                        : predictor_->predict(t + pursuit_.lead);
+  const clients::PursuitView view = chooser_->choose(v, uav, t, climb);
+  const ros::Time now = ros::Time::now();
+  ROS_INFO_THROTTLE(10.0,
+                    "%s: pursuit t %.1f: UAV (%.1f, %.1f, %.1f), last sighting %.1f s ago at "
+                    "(%.1f, %.1f) %.1f m/s, viewpoint (%.1f, %.1f, %.1f)%s",
+                    kClientName, t, uav.x(), uav.y(), uav.z(), unseen,
+                    predictor_->last().position.x(), predictor_->last().position.y(),
+                    predictor_->last().speed, view.position.x(), view.position.y(),
+                    view.position.z(), view.visible ? "" : ", no line of sight");
+  if (chooser_->kozClear(uav, view.position, t)) {
+    if (planner_flying_) {
+      nav_msgs::Path stop_planner;  // empty: the planner stops following
+      stop_planner.header.stamp = now;
+      stop_planner.header.frame_id = "map";
+      gate_->publish(waypoints_pub_, stop_planner);
+      planner_flying_ = false;
+    }
+    gate_->publish(pose_pub_, poseAt(view.position, view.yaw, now));
+  } else if (t - planner_sent_at_ > 3.0) {
+    // A keep-out zone lies between: the planner finds the way round.
+    nav_msgs::Path path;
+    path.header.stamp = now;
+    path.header.frame_id = "map";
+    path.poses.push_back(poseAt(view.position, now));
+    gate_->publish(waypoints_pub_, path);
+    planner_flying_ = true;
+    planner_sent_at_ = t;
+  }
+}
+
 void CoverageSearchClientRos::stop(const std::string& why) {
   if (stopped_) return;
   stopped_ = true;
+  if (pursuing_) {
+    ROS_INFO("%s: pursuit over: the target was lost %d times", kClientName, losses_);
+  }
+  pursuing_ = false;
   ROS_INFO("%s: stopping the search: %s", kClientName, why.c_str());
   nav_msgs::Path path;
   path.header.stamp = ros::Time::now();

@@ -1,5 +1,6 @@
-"""Shared pieces of the write-fault, full-disk and duration-end tests: a tally of checks, the
-metrics.json schema (python3-jsonschema) and an ADK that writes its metrics without a mission."""
+"""Shared pieces of the write-fault, full-disk, duration-end and pursuit tests: a tally of
+checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics without a
+mission, and a mission.launch run read back."""
 import json
 import os
 import signal
@@ -74,3 +75,27 @@ def run_adk(out, log, name, params=(), env=None):
     except subprocess.TimeoutExpired:
         p.kill()
         return p.wait()
+
+
+def launch_mission(args, out, log, label, check, guard):
+    """Runs `roslaunch hameritt mission.launch ARGS output_dir:=OUT` (its output in LOG) until it
+    ends by itself; after `guard` wall seconds (a hang, not a timing) it is stopped and that is a
+    failed check. Returns (exit code, log text, metrics.json or None: a failed check)."""
+    launch = subprocess.Popen(
+        ["roslaunch", "hameritt", "mission.launch"] + list(args) + ["output_dir:=" + out],
+        stdout=open(log, "w"), stderr=subprocess.STDOUT,
+        env=dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1"))
+    try:
+        rc = launch.wait(guard)
+    except subprocess.TimeoutExpired:
+        launch.send_signal(signal.SIGINT)
+        rc = launch.wait(60)
+        check(False, "%s: the launch did not end by itself" % label)
+    with open(log) as f:
+        text = f.read()
+    try:
+        with open(os.path.join(out, "metrics.json")) as f:
+            return rc, text, json.load(f)
+    except (OSError, ValueError) as e:
+        check(False, "%s: metrics.json: %s" % (label, e))
+        return rc, text, None

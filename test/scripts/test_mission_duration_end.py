@@ -15,16 +15,13 @@ Negative controls, run here: the schema rejects a metrics.json whose outcome is 
 five; the log check rejects a log in which the watchdog ended the mission.
 """
 import copy
-import json
 import os
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
 
 from graph_util import private_master_port, start_master, stop_master
-from fault_util import Checks, metrics_validator
+from fault_util import Checks, launch_mission, metrics_validator
 
 PORT = private_master_port(25000)
 DURATION = 4
@@ -51,26 +48,12 @@ def log_problems(text):
 def run(tmp, label, lockstep):
     out = os.path.join(tmp, label)
     log = os.path.join(tmp, label + ".log")
-    launch = subprocess.Popen(
-        ["roslaunch", "hameritt", "mission.launch", "lockstep:=%s" % lockstep,
-         "duration:=%d" % DURATION, "mode:=maneuver_only", "real_time_factor:=0",
-         "output_dir:=" + out],
-        stdout=open(log, "w"), stderr=subprocess.STDOUT,
-        env=dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1"))
     # A guard against a hang only (longer than the lock-step watchdog's 130 s): what is judged
     # is how the mission ended, not how long it took.
-    try:
-        rc = launch.wait(400)
-    except subprocess.TimeoutExpired:
-        launch.send_signal(signal.SIGINT)
-        rc = launch.wait(60)
-        check(False, "%s: the launch did not end by itself" % label)
-    text = open(log).read()
-    try:
-        with open(os.path.join(out, "metrics.json")) as f:
-            m = json.load(f)
-    except (OSError, ValueError) as e:
-        check(False, "%s: metrics.json: %s" % (label, e))
+    rc, text, m = launch_mission(
+        ["lockstep:=%s" % lockstep, "duration:=%d" % DURATION, "mode:=maneuver_only",
+         "real_time_factor:=0"], out, log, label, check, 400)
+    if m is None:
         return None
     errors = [e.message for e in METRICS.iter_errors(m)]
     print("%s: launch exit %d, outcome %s, reason %r, end_time %.3f s; schema: %s; log: %s" % (

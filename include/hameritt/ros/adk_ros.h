@@ -76,6 +76,9 @@ class AdkRos {
   void publishState();
   void publishConstraints(double t);
   void checkObjective(double t);
+  // Track objectives are judged at the time limit: at t >= the limit, success when every
+  // target was in view for the track fraction of it (before the time limit's timeout).
+  void judgeTrackAtLimit(double t);
   // Ends the mission (lifecycle already ended): metrics.json, /adk/metrics, /adk/state.
   void finish();
 

@@ -2,8 +2,10 @@
 // The baseline maneuver client: a prior-weighted coverage search (clients::planSearch) of the
 // mission's areas of interest and route bands, flown through the planner's waypoint follower one
 // leg at a time; it hovers when the ADK says the mission is over, at the mission's time limit, or
-// once the objective's targets have been detected. In maneuver-only mode it also turns the ADK's
-// perfect perception into claims (the paper's maneuver-only training thread).
+// once the objective's targets have been detected. A track objective (pursuit) is not over at
+// the find: the client then pursues the target (clients::ViewpointChooser, StreetPredictor) until
+// the mission ends. In maneuver-only mode it also turns the ADK's perfect perception into claims
+// (the paper's maneuver-only training thread).
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -21,6 +23,7 @@
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/context_filter.h"
 #include "hameritt/clients/coverage.h"
+#include "hameritt/clients/pursuit.h"
 #include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
@@ -29,8 +32,9 @@ namespace hameritt::ros_wrappers {
 
 // Topics (relative names): sub mission (hameritt/Mission, latched), uav/odom, planner/progress,
 // adk/state (any type), perception/detections; pub planner/waypoints (nav_msgs/Path), ~plan
-// (nav_msgs/Path, latched: every waypoint of the current plan); in maneuver-only mode sub
-// adk/perfect_perception and pub perception/detections.
+// (nav_msgs/Path, latched: every waypoint of the current plan), uav/cmd_pose while pursuing
+// (geometry_msgs/PoseStamped); in maneuver-only mode sub adk/perfect_perception and pub
+// perception/detections.
 //
 // Parameters (private): ~sim_config (required; only its public part is read:
 // clients::loadPublicSimConfig), ~camera ("down"), ~altitude (0: highest that keeps a car's width
@@ -38,7 +42,9 @@ namespace hameritt::ros_wrappers {
 // ~cover_zero_cells (false), ~repeat (true: sweep again when everything open has been swept),
 // ~stop_on_detection (true), ~claim_from_perfect_perception (false), ~use_context (true: claims
 // must pass the context filter), ~claim_radius (4 m), ~claim_hold (30 s), ~mission_start_time
-// (0: sim time of mission time 0), ~rate_hz (2).
+// (0: sim time of mission time 0), ~rate_hz (2), ~pursue (true: pursue a track objective's
+// target after its find instead of hovering), ~pursuit_standoff (8 m), ~pursuit_height (20 m),
+// ~pursuit_lead (1 s), ~pursuit_rate_hz (10).
 class CoverageSearchClientRos {
  public:
   // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
@@ -54,6 +60,9 @@ class CoverageSearchClientRos {
   void onDetection(const hameritt::Detection::ConstPtr& msg);
   void onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg);
   void onTick();
+  // Pursuit: starts it (after the find of a track objective's target) and flies it.
+  void startPursuit(const std::string& why);
+  void onPursuitTick();
 
   double missionTime() const;
   void replan(const std::string& why);
@@ -84,7 +93,16 @@ class CoverageSearchClientRos {
   clients::ClaimLedger claims_;
   clients::ClaimLedger detections_;
 
-  ros::Publisher waypoints_pub_, plan_pub_, detection_pub_;
+  // Pursuit.
+  bool pursue_ = true, pursuing_ = false, planner_flying_ = false, lost_ = false;
+  clients::PursuitSettings pursuit_;
+  std::unique_ptr<clients::StreetPredictor> predictor_;
+  std::unique_ptr<clients::ViewpointChooser> chooser_;
+  std::vector<geometry::Vec2> parked_;  // the public map's parked cars
+  double planner_sent_at_ = -1e9;
+  int losses_ = 0;
+
+  ros::Publisher waypoints_pub_, plan_pub_, detection_pub_, pose_pub_;
   ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_;
 };
 

@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""Success rate of the baseline on seeded pursuit missions (maneuver-only mode).
+
+Generates `hameritt_generate --class pursuit --count N --seed SEED` and flies each scenario in
+mission.launch (mode maneuver_only, lock-step, as fast as it goes, the mission's own time limit
+unless --time-limit), then prints per scenario the outcome, the target's in-view time and
+fraction (from metrics.json, the ADK's ground truth) and the wall time, and the success count.
+
+  /usr/bin/python3 bench/bench_pursuit.py [--count 10] [--seed 1] [--pursue true|false]
+      [--time-limit 0] [--out DIR] [--jobs 1]
+
+--jobs runs that many missions at once, each on its own ROS master.
+"""
+import argparse
+import concurrent.futures
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test",
+                                "scripts"))
+from graph_util import start_master, stop_master  # noqa: E402
+
+
+def fly(scenario, out, pursue, time_limit, port):
+    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port,
+               ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
+    core = start_master(port)
+    t0 = time.time()
+    try:
+        with open(out + ".log", "w") as log:
+            rc = subprocess.call(
+                ["roslaunch", "-p", str(port), "hameritt", "mission.launch",
+                 "scenario:=" + scenario, "mode:=maneuver_only", "lockstep:=true",
+                 "real_time_factor:=0", "time_limit:=%g" % time_limit, "pursue:=" + pursue,
+                 "output_dir:=" + out], stdout=log, stderr=subprocess.STDOUT, env=env,
+                timeout=3600)
+    finally:
+        stop_master(core)
+    wall = time.time() - t0
+    try:
+        with open(os.path.join(out, "metrics.json")) as f:
+            m = json.load(f)
+    except (OSError, ValueError) as e:
+        return {"scenario": os.path.basename(scenario), "outcome": "no metrics: %s" % e,
+                "rc": rc, "wall_s": wall}
+    limit = m["time_limit"]
+    in_view = m["targets"][0]["in_view_time"]
+    return {"scenario": os.path.basename(scenario), "outcome": m["outcome"], "rc": rc,
+            "time_limit": limit, "in_view_time": in_view,
+            "in_view_fraction": in_view / limit if limit else 0.0,
+            "first_seen": m["targets"][0].get("first_seen_time"), "wall_s": wall}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--count", type=int, default=10)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--pursue", default="true", choices=["true", "false"])
+    ap.add_argument("--time-limit", type=float, default=0.0, help="0: the mission's")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--out", default=None)
+    a = ap.parse_args()
+    out = a.out or tempfile.mkdtemp(prefix="hameritt_bench_pursuit.")
+    scen = os.path.join(out, "scenarios")
+    subprocess.run(["rosrun", "hameritt", "hameritt_generate", "--class", "pursuit", "--count",
+                    str(a.count), "--seed", str(a.seed), "--out", scen], check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(os.path.join(scen, "manifest.json")) as f:
+        manifest = json.load(f)
+    dirs = [os.path.join(scen, s["path"]) for s in manifest["scenarios"]]
+    results = []
+    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
+        futures = [pool.submit(fly, d, os.path.join(out, "run_%02d" % i), a.pursue, a.time_limit,
+                               21000 + 17 * i + os.getpid() % 1000)
+                   for i, d in enumerate(dirs)]
+        for fut in futures:
+            r = fut.result()
+            results.append(r)
+            print("%-26s %-8s in view %6.1f s of %4.0f s (%3.0f %%), first seen %s, wall %.0f s"
+                  % (r["scenario"], r["outcome"], r.get("in_view_time", 0),
+                     r.get("time_limit", 0), 100 * r.get("in_view_fraction", 0),
+                     r.get("first_seen"), r["wall_s"]), flush=True)
+    ok = sum(r["outcome"] == "success" for r in results)
+    print("pursue %s, seed %d: %d of %d succeeded" % (a.pursue, a.seed, ok, len(results)))
+    with open(os.path.join(out, "summary.json"), "w") as f:
+        json.dump({"seed": a.seed, "pursue": a.pursue, "succeeded": ok, "runs": results}, f,
+                  indent=1)
+    print("results in", out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,111 @@
+#pragma once
+// Standoff pursuit of a ground vehicle after its find: the vehicle's motion predicted at constant
+// speed along the street graph from its last sightings, and a viewpoint a standoff behind and
+// above it from which a payload camera sees it with a clear line of sight past the world's
+// buildings and trees. The baseline maneuver client flies it so that a pursuit target stays in
+// view after it drives off. ROS-free.
+
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hameritt/geometry/types.h"
+#include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/world.h"
+
+namespace hameritt::clients {
+
+struct PursuitSettings {
+  double standoff = 8.0;         // m behind the vehicle (against its heading), horizontally
+  double height = 20.0;          // m above the vehicle's ground point
+  double lead = 1.0;             // s: the viewpoint of where the vehicle will be (the autopilot's
+                                 // position loop lags about 1 / 0.95 s behind a moving setpoint)
+  double predict_horizon = 8.0;  // s: after the last sighting the prediction moves this long
+  double clearance = 4.0;        // m above the tallest occluder near the UAV and the viewpoint
+  double margin_px = 20.0;       // the vehicle's centre projects this far inside the image
+  double speed_window = 1.0;     // s of sightings that estimate the speed
+  // Throws scenario::ConfigError naming "pursuit.<field>" and the bad value.
+  void validate() const;
+};
+
+// A vehicle's state as a detector (or the perfect-perception report) gives it.
+struct VehicleState {
+  double t = 0.0;
+  geometry::Vec3 position{0, 0, 0};  // bottom centre, map frame
+  double yaw = 0.0;                  // heading
+  double speed = 0.0;                // m/s along the heading (estimated)
+};
+
+// Constant-speed prediction along the street graph: the vehicle keeps its speed along the
+// street it drives on and goes straight on (the smallest turn) at each intersection; it stops
+// moving predict_horizon seconds after its last sighting.
+class StreetPredictor {
+ public:
+  StreetPredictor(const scenario::World& world, const PursuitSettings& settings);
+  // A sighting; sightings at or before the last one are ignored (false).
+  bool observe(double t, const geometry::Vec3& position, double yaw);
+  // A sighting without a heading (a detection claim): the heading of the displacement from the
+  // last sighting when it moved more than 2 m, else the last heading.
+  bool observe(double t, const geometry::Vec3& position);
+  bool tracking() const { return !recent_.empty(); }
+  // The last sighting (with its estimated speed); requires tracking().
+  const VehicleState& last() const { return last_; }
+  // The predicted state at time t (>= the last sighting).
+  VehicleState predict(double t) const;
+  // Every way it may have gone by time t: each branch at each intersection (no U-turns), at
+  // most 64; the straight-on prediction first.
+  std::vector<VehicleState> hypotheses(double t) const;
+  // The prediction, held at the next intersection where the vehicle has a choice: where a
+  // lost vehicle is sure to pass (or to have passed).
+  VehicleState predictToJunction(double t) const;
+
+ private:
+  enum class Branches { kStraight, kEvery, kStopAtJunction };
+  std::vector<VehicleState> walk(double t, Branches branches) const;
+  const scenario::World& world_;
+  PursuitSettings settings_;
+  std::deque<VehicleState> recent_;
+  VehicleState last_;
+};
+
+// A place to look from.
+struct PursuitView {
+  geometry::Vec3 position{0, 0, 0};
+  double yaw = 0.0;
+  bool visible = false;  // some camera sees the vehicle's centre with a clear line of sight
+  std::string camera;    // which one (empty when none)
+};
+
+// Chooses the viewpoint: the preferred one (standoff behind, height above, facing the vehicle's
+// heading), else the nearest of a ring of candidates around the vehicle (12 bearings x 4
+// standoffs x 2 heights, nadir included) from which a camera sees it; candidates inside a
+// keep-out zone active at t whose band holds the altitude are skipped. All candidates are
+// clamped into the altitude band and kept `clearance` above nearby occluders.
+class ViewpointChooser {
+ public:
+  ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
+                   const std::vector<scenario::KeepOutZone>& kozs, const PursuitSettings& settings);
+  // `climb`: metres added to the height (a wider view while the vehicle is lost). When no
+  // candidate sees the vehicle, the nearest one outside the keep-out zones (visible false).
+  PursuitView choose(const VehicleState& vehicle, const geometry::Vec3& uav, double t,
+                     double climb = 0.0) const;
+  // The camera (by name) that sees the point `target` from a UAV at `position` with `yaw`
+  // with a clear line of sight, or nullopt.
+  std::optional<std::string> seenBy(const geometry::Vec3& position, double yaw,
+                                    const geometry::Vec3& target) const;
+  // True when the straight flight a -> b at time t stays out of every keep-out zone active then
+  // whose altitude band reaches the flight's altitudes.
+  bool kozClear(const geometry::Vec3& a, const geometry::Vec3& b, double t) const;
+
+ private:
+  double safeAltitude(const geometry::Vec2& p, double wanted) const;
+  bool inKoz(const geometry::Vec3& p, double t) const;
+
+  const scenario::World& world_;
+  scenario::UavSpec uav_;
+  std::vector<scenario::KeepOutZone> kozs_;
+  PursuitSettings settings_;
+};
+
+}  // namespace hameritt::clients

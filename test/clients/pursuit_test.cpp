@@ -1,0 +1,287 @@
+// Standoff pursuit: the street-graph prediction (along the street, round corners, held after
+// the horizon) and the viewpoint choice (the preferred standoff when it sees the vehicle, a
+// candidate with a clear line of sight when a tree or house hides it, never inside an active
+// keep-out zone), on the shipped scenario's world.
+#include "hameritt/clients/pursuit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "hameritt/clients/public_config.h"
+#include "hameritt/geometry/segment.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/sim_config_io.h"
+
+namespace hameritt::clients {
+namespace {
+
+using geometry::Vec2;
+using geometry::Vec3;
+
+const char* kSimConfig = "scenarios/default/sim_config.json";
+
+const scenario::SimConfig& sim() {
+  static const scenario::SimConfig s = loadPublicSimConfig(kSimConfig);
+  return s;
+}
+
+const scenario::World& world() {
+  static const scenario::World w = scenario::generateCheckedWorld(sim(), kSimConfig);
+  return w;
+}
+
+// Distance from p to the nearest street centreline.
+double streetDistance(const Vec2& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& e : world().edges()) {
+    best = std::min(best, geometry::pointSegmentDistance(p, world().nodes()[e.a].position,
+                                                         world().nodes()[e.b].position));
+  }
+  return best;
+}
+
+// A node with exactly two streets that meet at a right angle (a corner of the outer ring), the
+// edge that arrives at it and the one that leaves it.
+struct Corner {
+  int node = -1, from = -1, to = -1;
+};
+
+Corner findCorner() {
+  const auto& w = world();
+  for (std::size_t n = 0; n < w.nodes().size(); ++n) {
+    const auto& adj = w.adjacency()[n];
+    if (adj.size() != 2) continue;
+    auto other = [&](int ei) {
+      const auto& e = w.edges()[static_cast<std::size_t>(ei)];
+      return e.a == static_cast<int>(n) ? e.b : e.a;
+    };
+    const Vec2 c = w.nodes()[n].position;
+    const Vec2 d0 = (w.nodes()[static_cast<std::size_t>(other(adj[0]))].position - c).normalized();
+    const Vec2 d1 = (w.nodes()[static_cast<std::size_t>(other(adj[1]))].position - c).normalized();
+    if (std::abs(d0.dot(d1)) < 0.2) return {static_cast<int>(n), other(adj[0]), other(adj[1])};
+  }
+  return {};
+}
+
+TEST(Pursuit, SettingsNameTheBadField) {
+  PursuitSettings s;
+  EXPECT_NO_THROW(s.validate());
+  s.standoff = -1.0;
+  try {
+    s.validate();
+    FAIL() << "a negative standoff was accepted";
+  } catch (const scenario::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("pursuit.standoff"), std::string::npos) << e.what();
+  }
+  s = PursuitSettings();
+  s.height = std::nan("");
+  EXPECT_THROW(s.validate(), scenario::ConfigError);
+}
+
+TEST(Pursuit, PredictionFollowsTheStreetRoundACorner) {
+  const Corner c = findCorner();
+  ASSERT_GE(c.node, 0) << "no right-angle corner in the shipped world";
+  const auto& w = world();
+  const Vec2 corner = w.nodes()[static_cast<std::size_t>(c.node)].position;
+  const Vec2 from = w.nodes()[static_cast<std::size_t>(c.from)].position;
+  const Vec2 to = w.nodes()[static_cast<std::size_t>(c.to)].position;
+  const Vec2 in = (corner - from).normalized(), out = (to - corner).normalized();
+  const double yaw = std::atan2(in.y(), in.x());
+  PursuitSettings settings;
+  settings.predict_horizon = 5.0;
+  StreetPredictor predictor(w, settings);
+  EXPECT_FALSE(predictor.tracking());
+  // 10 m/s on the centreline, 20 m before the corner.
+  const Vec2 p0 = corner - in * 30.0, p1 = corner - in * 20.0;
+  ASSERT_TRUE(predictor.observe(10.0, Vec3(p0.x(), p0.y(), 0), yaw));
+  ASSERT_TRUE(predictor.observe(11.0, Vec3(p1.x(), p1.y(), 0), yaw));
+  EXPECT_FALSE(predictor.observe(11.0, Vec3(p1.x(), p1.y(), 0), yaw)) << "a repeated stamp";
+  EXPECT_NEAR(predictor.last().speed, 10.0, 1e-9);
+
+  // 1 s later: 10 m further along the same street.
+  const VehicleState a = predictor.predict(12.0);
+  EXPECT_NEAR((a.position.head<2>() - (corner - in * 10.0)).norm(), 0.0, 1e-6);
+  // 3 s later: round the corner, 10 m along the leaving street, heading along it.
+  const VehicleState b = predictor.predict(14.0);
+  EXPECT_NEAR((b.position.head<2>() - (corner + out * 10.0)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR(std::cos(b.yaw - std::atan2(out.y(), out.x())), 1.0, 1e-9);
+  EXPECT_LT(streetDistance(b.position.head<2>()), 1e-6);
+  // Negative control: a straight constant-velocity extrapolation leaves the street there.
+  const Vec2 straight = p1 + in * 30.0;
+  EXPECT_GT(streetDistance(straight), 5.0);
+  // After the horizon the prediction stops.
+  const VehicleState c5 = predictor.predict(11.0 + settings.predict_horizon);
+  const VehicleState c100 = predictor.predict(111.0);
+  EXPECT_NEAR((c5.position - c100.position).norm(), 0.0, 1e-9);
+  // A sighting without a heading takes the heading of its displacement.
+  StreetPredictor claims(w, settings);
+  ASSERT_TRUE(claims.observe(1.0, Vec3(p0.x(), p0.y(), 0)));
+  ASSERT_TRUE(claims.observe(2.0, Vec3(p1.x(), p1.y(), 0)));
+  EXPECT_NEAR(claims.last().yaw, yaw, 1e-9);
+  EXPECT_NEAR(claims.last().speed, 10.0, 1e-9);
+}
+
+TEST(Pursuit, HypothesesTakeEveryBranchOfAnIntersection) {
+  const auto& w = world();
+  // A four-way intersection whose streets are all longer than 30 m.
+  int node = -1;
+  for (std::size_t n = 0; n < w.nodes().size() && node < 0; ++n) {
+    if (w.adjacency()[n].size() != 4) continue;
+    bool long_enough = true;
+    for (int ei : w.adjacency()[n]) {
+      const auto& e = w.edges()[static_cast<std::size_t>(ei)];
+      long_enough &= (w.nodes()[e.a].position - w.nodes()[e.b].position).norm() > 30.0;
+    }
+    if (long_enough) node = static_cast<int>(n);
+  }
+  ASSERT_GE(node, 0) << "no four-way intersection in the shipped world";
+  const Vec2 c = w.nodes()[static_cast<std::size_t>(node)].position;
+  const auto& e = w.edges()[static_cast<std::size_t>(w.adjacency()[node][0])];
+  const Vec2 from = w.nodes()[static_cast<std::size_t>(e.a == node ? e.b : e.a)].position;
+  const Vec2 in = (c - from).normalized();
+  const double yaw = std::atan2(in.y(), in.x());
+  StreetPredictor predictor(w, PursuitSettings());
+  const Vec2 p0 = c - in * 30.0, p1 = c - in * 20.0;
+  ASSERT_TRUE(predictor.observe(0.0, Vec3(p0.x(), p0.y(), 0), yaw));
+  ASSERT_TRUE(predictor.observe(1.0, Vec3(p1.x(), p1.y(), 0), yaw));
+  // 3 s later, 30 m on: 10 m past the intersection on each of the three streets ahead.
+  const std::vector<VehicleState> h = predictor.hypotheses(4.0);
+  ASSERT_EQ(h.size(), 3u);
+  int ahead = 0;
+  for (const auto& v : h) {
+    EXPECT_NEAR((v.position.head<2>() - c).norm(), 10.0, 1e-6);
+    EXPECT_LT(streetDistance(v.position.head<2>()), 1e-6);
+    // None goes back the way it came.
+    EXPECT_GT((v.position.head<2>() - c).normalized().dot(in), -0.5);
+    ahead += (v.position.head<2>() - c).normalized().dot(in) > 0.95;  // (streets bend a little)
+  }
+  EXPECT_EQ(ahead, 1);
+  // The straight-on one first, and it is the single prediction.
+  EXPECT_NEAR((h.front().position - predictor.predict(4.0).position).norm(), 0.0, 1e-9);
+  // Held at the intersection, where it has a choice.
+  EXPECT_NEAR((predictor.predictToJunction(4.0).position.head<2>() - c).norm(), 0.0, 1e-6);
+  // Before it reaches it, the same as the prediction.
+  EXPECT_NEAR((predictor.predictToJunction(1.5).position - predictor.predict(1.5).position).norm(),
+              0.0, 1e-9);
+}
+
+TEST(Pursuit, ViewpointSeesTheVehiclePastOccluders) {
+  const auto& w = world();
+  PursuitSettings settings;
+  const ViewpointChooser chooser(w, sim().uav, {}, settings);
+  // Vehicles on every street: along each edge every 10 m, both directions.
+  int tested = 0, preferred_used = 0, occluded_preferred = 0;
+  for (const auto& e : w.edges()) {
+    const Vec2 a = w.nodes()[static_cast<std::size_t>(e.a)].position;
+    const Vec2 b = w.nodes()[static_cast<std::size_t>(e.b)].position;
+    const double len = (b - a).norm();
+    for (double s = 10.0; s < len - 10.0; s += 10.0) {
+      for (int dir = 0; dir < 2; ++dir) {
+        const Vec2 u = dir ? Vec2((a - b) / len) : Vec2((b - a) / len);
+        const Vec2 p = a + (b - a) * (s / len) + Vec2(u.y(), -u.x()) * 2.0;  // right lane
+        VehicleState v;
+        v.position = Vec3(p.x(), p.y(), 0.0);
+        v.yaw = std::atan2(u.y(), u.x());
+        const Vec3 uav = v.position + Vec3(0, 0, 30);
+        const PursuitView view = chooser.choose(v, uav, 0.0);
+        ++tested;
+        const Vec3 centre = v.position + Vec3(0, 0, 0.8);
+        ASSERT_TRUE(view.visible) << "no viewpoint sees a vehicle at " << p.transpose();
+        // The chooser's claim is checked again here: the named camera sees it.
+        const auto cam = chooser.seenBy(view.position, view.yaw, centre);
+        ASSERT_TRUE(cam.has_value());
+        EXPECT_EQ(*cam, view.camera);
+        EXPECT_GE(view.position.z(), sim().uav.altitude_min);
+        EXPECT_LE(view.position.z(), sim().uav.altitude_max);
+        // The preferred viewpoint: standoff behind, height above.
+        const Vec2 behind = p - u * settings.standoff;
+        preferred_used += (view.position.head<2>() - behind).norm() < 1e-6;
+      }
+    }
+  }
+  std::printf("%d street positions, %d seen from the preferred standoff\n", tested, preferred_used);
+  EXPECT_GT(tested, 200);
+  EXPECT_GT(preferred_used, tested / 2);
+}
+
+TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
+  // A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its
+  // edge: the preferred viewpoint (8 m behind, 20 m above) often looks through the occluder.
+  const auto& w = world();
+  PursuitSettings settings;
+  const ViewpointChooser chooser(w, sim().uav, {}, settings);
+  const auto& occ = w.occluders();
+  int hidden = 0, recovered = 0;
+  for (std::size_t i = 0; i < occ.size(); ++i) {
+    const auto& box = occ.box(static_cast<int>(i));
+    if (box.maxZ() < 5.0) continue;
+    const Vec2 u(std::cos(box.yaw), std::sin(box.yaw));
+    const Vec2 p = box.center2() + u * (0.5 * box.size.x() + 2.5);
+    VehicleState v;
+    v.position = Vec3(p.x(), p.y(), 0.0);
+    v.yaw = std::atan2(u.y(), u.x());
+    const Vec3 centre = v.position + Vec3(0, 0, 0.8);
+    const Vec2 behind = p - u * settings.standoff;
+    const PursuitView view = chooser.choose(v, v.position + Vec3(0, 0, 30), 0.0);
+    const Vec3 pref(behind.x(), behind.y(), view.position.z());
+    if (chooser.seenBy(pref, v.yaw, centre)) continue;
+    ++hidden;
+    if (view.visible && chooser.seenBy(view.position, view.yaw, centre)) ++recovered;
+    // Never the hidden preferred viewpoint itself.
+    EXPECT_GT((view.position.head<2>() - behind).norm(), 1.0);
+  }
+  std::printf("%d vehicles hidden from the preferred viewpoint, %d seen from another\n", hidden,
+              recovered);
+  // The case arises (negative control: the preferred viewpoint alone would not see these) ...
+  EXPECT_GT(hidden, 10);
+  // ... and the chooser finds a viewpoint that sees nearly every one.
+  EXPECT_GE(recovered, hidden * 9 / 10);
+}
+
+TEST(Pursuit, ViewpointStaysOutOfActiveKeepOutZones) {
+  const auto& w = world();
+  PursuitSettings settings;
+  const ViewpointChooser open(w, sim().uav, {}, settings);
+  // The first street midpoint whose preferred viewpoint sees the vehicle.
+  VehicleState v;
+  Vec2 p, u;
+  bool found = false;
+  for (const auto& e : w.edges()) {
+    const Vec2 a = w.nodes()[static_cast<std::size_t>(e.a)].position;
+    const Vec2 b = w.nodes()[static_cast<std::size_t>(e.b)].position;
+    u = (b - a).normalized();
+    p = 0.5 * (a + b);
+    v.position = Vec3(p.x(), p.y(), 0.0);
+    v.yaw = std::atan2(u.y(), u.x());
+    const PursuitView view = open.choose(v, v.position + Vec3(0, 0, 30), 0.0);
+    if (view.visible && (view.position.head<2>() - (p - u * settings.standoff)).norm() < 1e-6) {
+      found = true;
+      break;
+    }
+  }
+  ASSERT_TRUE(found);
+  // A zone of 24 x 24 m around the preferred viewpoint, active from t = 100 s.
+  scenario::KeepOutZone k;
+  k.id = "koz_test";
+  const Vec2 c = p - u * settings.standoff;
+  k.polygon = geometry::rectangle(c - Vec2(12, 12), c + Vec2(12, 12));
+  k.window.net = 100.0;
+  const ViewpointChooser chooser(w, sim().uav, {k}, settings);
+  const Vec3 uav = v.position + Vec3(0, 0, 30);
+  const PursuitView before = chooser.choose(v, uav, 50.0);
+  const PursuitView during = chooser.choose(v, uav, 150.0);
+  // Before the window the preferred viewpoint (inside the zone's polygon) is taken.
+  EXPECT_TRUE(k.polygon.contains(before.position.head<2>()));
+  // While it is active the view is outside it, and still sees the vehicle.
+  EXPECT_FALSE(k.polygon.contains(during.position.head<2>()));
+  EXPECT_TRUE(during.visible);
+  // The straight flight from inside the zone's far side crosses it only while it is active.
+  const Vec3 far(c.x() - 30 * u.x(), c.y() - 30 * u.y(), 25.0);
+  EXPECT_TRUE(chooser.kozClear(far, before.position, 50.0));
+  EXPECT_FALSE(chooser.kozClear(far, Vec3(p.x(), p.y(), 25.0), 150.0));
+}
+
+}  // namespace
+}  // namespace hameritt::clients
