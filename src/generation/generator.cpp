@@ -1372,19 +1372,48 @@ class ScenarioBuilder {
       ac.model = fixed_wing ? "fixed_wing" : "quadrotor";
       ac.size = fixed_wing ? Vec3(1.2, 2.0, 0.35) : Vec3(0.6, 0.6, 0.25);
       const double speed = fixed_wing ? rng_.uniform(10.0, 16.0) : rng_.uniform(4.0, 9.0);
-      for (int attempt = 0; attempt < 30 && ac.trajectory.empty(); ++attempt) {
+      for (int attempt = 0; attempt < 60 && ac.trajectory.empty(); ++attempt) {
+        // Among tall buildings (the city) long chords and wide laps rarely fit: after 30
+        // attempts they shrink to half, and the last 15 of a crossing aircraft fly head-on.
+        const double reach = attempt < 30 ? 1.0 : 0.5;
         AircraftPattern pat;
         pat.speed = roundMilli(speed);
         const double along = rng_.uniform(0.25, 0.75) * ref_len;
         const Vec2 c = geometry::polylinePointAt(ref2, along);
         const Vec2 ahead = geometry::polylinePointAt(ref2, std::min(ref_len, along + 1.0));
         const double heading = std::atan2(ahead.y() - c.y(), ahead.x() - c.x());
-        if (i < n_cross) {
+        if (i < n_cross && attempt >= 45) {
+          // Last resort among tall buildings: head-on along the reference flight's longest leg,
+          // a little above it (what clears the leg clears anything higher), 25 m short of its
+          // ends.
+          pat.kind = AircraftPattern::Kind::kCrossing;
+          const double lift = rng_.uniform(0.5, 3.0);
+          const double jitter = rng_.uniform(-6.0, 6.0);
+          std::size_t leg = 0;
+          double leg_len = 0.0, leg_start = 0.0, acc = 0.0;
+          for (std::size_t k = 1; k < ref.path.size(); ++k) {
+            const double h = (ref.path[k] - ref.path[k - 1]).head<2>().norm();
+            if (h > leg_len) leg = k, leg_len = h, leg_start = acc;
+            acc += h;
+          }
+          if (leg_len < 60.0) continue;
+          const Vec3 p0 = ref.path[leg - 1], p1 = ref.path[leg];
+          const double u = 25.0 / leg_len;
+          Vec3 a3 = p0 + (p1 - p0) * (1.0 - u), b3 = p0 + (p1 - p0) * u;  // towards the start
+          const double up = std::max(a3.z(), b3.z()) + lift <= amax ? lift : 0.0;
+          a3.z() += up;
+          b3.z() += up;
+          if (!clearOfEnds(a3.head<2>(), b3.head<2>())) continue;
+          pat.a = Vec3(roundMilli(a3.x()), roundMilli(a3.y()), roundMilli(a3.z()));
+          pat.b = Vec3(roundMilli(b3.x()), roundMilli(b3.y()), roundMilli(b3.z()));
+          pat.cross = 0.5 * (pat.a + pat.b);
+          pat.t_cross = std::max(0.0, t_climb + (leg_start + 0.5 * leg_len) / v_nominal + jitter);
+        } else if (i < n_cross) {
           pat.kind = AircraftPattern::Kind::kCrossing;
           const double turn = rng_.uniform(0.7, 2.4);
           const double side = rng_.bernoulli(0.5) ? 1.0 : -1.0;
-          const double h1 = rng_.uniform(60.0, 150.0);
-          const double h2 = rng_.uniform(60.0, 150.0);
+          const double h1 = reach * rng_.uniform(60.0, 150.0);
+          const double h2 = reach * rng_.uniform(60.0, 150.0);
           const double zc = rng_.uniform(amin + 2.0, std::min(amax - 2.0, amin + 12.0));
           const double dz = rng_.uniform(-6.0, 6.0);
           const double jitter = rng_.uniform(-6.0, 6.0);
@@ -1401,8 +1430,8 @@ class ScenarioBuilder {
         } else {
           pat.kind = AircraftPattern::Kind::kOrbit;
           const double side = rng_.bernoulli(0.5) ? 1.0 : -1.0;  // "Draw order" at the top
-          const double off = rng_.uniform(30.0, 90.0) * side;
-          const double radius = rng_.uniform(25.0, 60.0);
+          const double off = reach * rng_.uniform(30.0, 90.0) * side;
+          const double radius = reach * rng_.uniform(25.0, 60.0);
           const double climb = rng_.uniform(0.0, 4.0);
           const double z = rng_.uniform(amin + 2.0 + climb, amax - 2.0 - climb);
           pat.phase = rng_.uniform(-geometry::kPi, geometry::kPi);
