@@ -249,11 +249,13 @@ class PanelBuilder {
 
   void moverEntries() {
     bool has[4] = {false, false, false, false};  // confuser, traffic, pedestrian, other
-    bool aircraft = false;
+    bool aircraft = false, hostile = false;
     for (const auto& m : d_.entities) {
       if (isTarget(m, d_)) continue;
       if (m.role == "aircraft")
         aircraft = true;
+      else if (m.role == "hostile")
+        hostile = true;
       else if (m.role == "confuser")
         has[0] = true;
       else if (m.role == "traffic")
@@ -299,6 +301,13 @@ class PanelBuilder {
         cv::line(img_, cv::Point(b.x, b.y + 7), cv::Point(b.x + b.width, b.y + 7), kVignette, 1,
                  cv::LINE_AA);
         cv::circle(img_, cv::Point(b.x + 14, b.y + 7), 3, kVignette, cv::FILLED, cv::LINE_AA);
+      });
+    }
+    if (hostile) {
+      entry("Hostile vehicle (its KOZ moves with it)", [&](const cv::Rect& b) {
+        cv::line(img_, cv::Point(b.x, b.y + 7), cv::Point(b.x + b.width, b.y + 7), kVignette, 1,
+                 cv::LINE_AA);
+        cv::rectangle(img_, cv::Rect(b.x + 10, b.y + 5, 8, 4), kVignette, cv::FILLED);
       });
     }
     if (aircraft) {
