@@ -96,6 +96,19 @@ def expect_rejected(validators, name, doc, where):
         ok(name)
 
 
+def expect_beyond_schema(name, validators, validate, schema_dir, doc, path, want):
+    """doc (written to `path`) passes jsonschema, and hameritt_validate rejects the file with
+    exit 2 and stderr starting with `want`: a rule beyond what a schema can express."""
+    run = subprocess.run([validate, "--schema-dir", schema_dir, path], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, universal_newlines=True, timeout=60)
+    if errors_of(validators, doc):
+        fail(name, "jsonschema rejected it: %s" % errors_of(validators, doc))
+    elif run.returncode != 2 or not run.stderr.startswith(want):
+        fail(name, "hameritt_validate exit %d, stderr %r" % (run.returncode, run.stderr))
+    else:
+        ok(name)
+
+
 def expect_all_valid(name, validate, schema_dir, files):
     """hameritt_validate accepts every file: exit 0 and one "FILE: ok" line each."""
     run = subprocess.run([validate, "--schema-dir", schema_dir] + files, stdout=subprocess.PIPE,
@@ -159,15 +172,8 @@ def check_avoid(validators, generate, validate, schema_dir, out, search_mission)
     broken = os.path.join(out, "jump_sim_config.json")
     with open(broken, "w") as f:
         json.dump(b, f)
-    run = subprocess.run([validate, "--schema-dir", schema_dir, broken], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, universal_newlines=True, timeout=60)
-    want = broken + ": /aircraft/0/trajectory/1: trajectory_speed: "
-    if errors_of(validators, b):
-        fail("aircraft jump", "jsonschema rejected it: %s" % errors_of(validators, b))
-    elif run.returncode != 2 or not run.stderr.startswith(want):
-        fail("aircraft jump", "hameritt_validate exit %d, stderr %r" % (run.returncode, run.stderr))
-    else:
-        ok("aircraft jump")
+    expect_beyond_schema("aircraft jump", validators, validate, schema_dir, b, broken,
+                         broken + ": /aircraft/0/trajectory/1: trajectory_speed: ")
     # Against the world (beyond the files): a stated shortest path shorter than the straight
     # line passes jsonschema; hameritt_validate checks the sim_config with its mission.
     src = os.path.dirname(files[0])
@@ -179,16 +185,9 @@ def check_avoid(validators, generate, validate, schema_dir, out, search_mission)
     with open(os.path.join(bad_dir, "mission.json"), "w") as f:
         json.dump(b, f)
     bad_sim = os.path.join(bad_dir, "sim_config.json")
-    run = subprocess.run([validate, "--schema-dir", schema_dir, bad_sim], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, universal_newlines=True, timeout=60)
-    want = bad_sim + ": (root): avoid_scenario: mission.json: phases: avoid shortest_path_m 1 "
-    if errors_of(validators, b):
-        fail("avoid short path", "jsonschema rejected it: %s" % errors_of(validators, b))
-    elif run.returncode != 2 or not run.stderr.startswith(want):
-        fail("avoid short path", "hameritt_validate exit %d, stderr %r"
-             % (run.returncode, run.stderr))
-    else:
-        ok("avoid short path")
+    expect_beyond_schema("avoid short path", validators, validate, schema_dir, b, bad_sim,
+                         bad_sim + ": (root): avoid_scenario: mission.json: phases: avoid "
+                         "shortest_path_m 1 ")
 
 
 def main():
@@ -329,17 +328,8 @@ def main():
             with open(broken, "w") as f:
                 json.dump(m, f)
             # Schemas cannot express geometry: jsonschema accepts it, hameritt_validate does not.
-            run = subprocess.run([validate, "--schema-dir", schema_dir, broken],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                 universal_newlines=True, timeout=60)
-            want = broken + ": /areas_of_interest/0/polygon: polygon_simple: "
-            if errors_of(validators, m):
-                fail("bow-tie AOI", "jsonschema rejected it: %s" % errors_of(validators, m))
-            elif run.returncode != 2 or not run.stderr.startswith(want):
-                fail("bow-tie AOI", "hameritt_validate exit %d, stderr %r"
-                     % (run.returncode, run.stderr))
-            else:
-                ok("bow-tie AOI")
+            expect_beyond_schema("bow-tie AOI", validators, validate, schema_dir, m, broken,
+                                 broken + ": /areas_of_interest/0/polygon: polygon_simple: ")
         check_avoid(validators, generate, validate, schema_dir, out, mission)
     finally:
         shutil.rmtree(out, ignore_errors=True)
