@@ -202,7 +202,13 @@ std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon, con
 
 std::vector<Interval> prismIntervals(const scenario::KeepOutZone& zone, const Vec3& a,
                                      const Vec3& b, double ta, double tb) {
-  return toTime(prismParams(zone, a, b), ta, tb);
+  if (zone.motion.empty()) return toTime(prismParams(zone, a, b), ta, tb);
+  // A moving zone stands where it is at the middle of the step (samples come at the state
+  // rate, over which a zone escorting a car moves a metre or two).
+  scenario::KeepOutZone here = zone;
+  here.polygon = scenario::kozPolygonAt(zone, 0.5 * (ta + tb));
+  here.motion.clear();
+  return toTime(prismParams(here, a, b), ta, tb);
 }
 
 std::vector<Interval> violationIntervals(const scenario::KeepOutZone& zone, const Vec3& a,

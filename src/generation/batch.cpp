@@ -31,8 +31,10 @@ std::vector<ScenarioClass> parseClassList(const std::string& s) {
     const std::string name = s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     ScenarioClass c;
     if (!parseScenarioClass(name, &c)) {
-      throw ConfigError("--class: expected area_search, route_search, pursuit, all or a "
-                        "comma-separated list of them, got '" + name + "'");
+      throw ConfigError(
+          "--class: expected area_search, route_search, pursuit, avoid, all or a "
+          "comma-separated list of them, got '" +
+          name + "'");
     }
     out.push_back(c);
     if (comma == std::string::npos) break;

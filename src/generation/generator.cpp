@@ -7,6 +7,8 @@
 #include <set>
 #include <unordered_map>
 
+#include "hameritt/generation/avoid.h"
+#include "hameritt/generation/target_slots.h"
 #include "hameritt/geometry/segment.h"
 #include "hameritt/planning/look_at.h"
 #include "hameritt/planning/validity.h"
@@ -15,7 +17,6 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/trajectory.h"
-#include "hameritt/generation/target_slots.h"
 
 namespace hameritt::scenario {
 
@@ -44,6 +45,15 @@ namespace {
 
 constexpr double kLaneOffsetFromKerb = 3.45;  // lane centre = half width - this
 constexpr int kMaxAttempts = 200;
+// Avoid: the goal's distance from the start (m), its radius, the fraction of the top speed that
+// sets the time limit (the reference flight at this speed, plus a minute), and the escorted
+// zone around the hostile vehicle (side, and how near the start and goal its centre may come).
+constexpr double kAvoidGoalDistanceMin = 250.0;
+constexpr double kAvoidGoalDistanceMax = 450.0;
+constexpr double kAvoidGoalRadius = 5.0;
+constexpr double kAvoidNominalSpeedFraction = 0.35;
+constexpr double kEscortSide = 30.0;
+constexpr double kEscortClearance = 36.0;  // half the diagonal plus 15 m
 
 Vec2 round2(const Vec2& v) { return {roundMilli(v.x()), roundMilli(v.y())}; }
 
@@ -98,14 +108,17 @@ class ScenarioBuilder {
       case ScenarioClass::kPursuit:
         buildPursuit();
         break;
+      case ScenarioClass::kAvoid:
+        buildAvoid();  // places the UAV itself, at the start of its reference flight
+        break;
     }
-    placeUavStart();
+    if (cls_ != ScenarioClass::kAvoid) placeUavStart();
     addTraffic();
     drawEnvironment();
     s.duration = m.time_limit;
     finalizeRelations();
     finishGroups();
-    if (cfg_.perception_paths) planPerceptionPath();
+    if (cfg_.perception_paths && cls_ != ScenarioClass::kAvoid) planPerceptionPath();
     if (plan_ && plan_->provenance) sc_.sim.spec = plan_->provenance;
     return std::move(sc_);
   }
@@ -1267,6 +1280,269 @@ class ScenarioBuilder {
     std::vector<SceneRelation> rels;
     for (const auto& r : m.relations) rels.push_back(r);
     addConfusers(target, rels, aois, nullptr, 60.0);
+  }
+
+  // ------------------------------------------------------------------ avoid
+  // The avoid class: fly from an intersection to a goal (a viewpoint in the flight band or a
+  // landing spot at an intersection) among scripted aircraft, past a keep-out zone that
+  // escorts a hostile vehicle and up to two static restricted zones near the direct line.
+  void buildAvoid() {
+    Mission& m = sc_.mission;
+    const planning::ValiditySettings vs = planning::validitySettingsFor(uav_);
+    const double amin = uav_.altitude_min, amax = uav_.altitude_max;
+    Vec3 start(0, 0, 0), goal(0, 0, 0);
+    bool landing = false;
+    ReferenceFlight ref;
+    for (int attempt = 0; attempt < 40 && !ref.ok; ++attempt) {
+      m.kozs.clear();
+      const Vec2 s = world_.nodes()[static_cast<std::size_t>(randomNode())].position;
+      if (!insideBy(s, 30.0)) continue;
+      landing = rng_.bernoulli(0.5);
+      bool placed = false;
+      for (int g = 0; g < 60 && !placed; ++g) {
+        Vec2 q;
+        double z = 0.0;
+        if (landing) {
+          q = world_.nodes()[static_cast<std::size_t>(randomNode())].position;
+        } else {
+          const double qy = rng_.uniform(world_.bounds().min.y(), world_.bounds().max.y());
+          const double qx = rng_.uniform(world_.bounds().min.x(), world_.bounds().max.x());
+          q = Vec2(qx, qy);
+          z = std::round(rng_.uniform(amin + 5.0, amax - 5.0));
+        }
+        const double d = (q - s).norm();
+        if (!insideBy(q, 30.0) || d < kAvoidGoalDistanceMin || d > kAvoidGoalDistanceMax) continue;
+        start = Vec3(roundMilli(s.x()), roundMilli(s.y()), 0.0);
+        goal = Vec3(roundMilli(q.x()), roundMilli(q.y()), z);
+        placed = true;
+      }
+      if (!placed) continue;
+      // Static restricted zones near the direct line, clear of the start and the goal; some
+      // low enough to fly over.
+      const Vec2 s2(start.x(), start.y()), g2(goal.x(), goal.y());
+      const Vec2 dir = (g2 - s2).normalized(), left(-dir.y(), dir.x());
+      const int n_koz = static_cast<int>(rng_.uniformInt(0, 2));
+      for (int i = 0; i < n_koz; ++i) {
+        const double u = rng_.uniform(0.3, 0.7);
+        const double off = rng_.uniform(-20.0, 20.0);
+        const double kl = rng_.uniform(30.0, 70.0);
+        const double kw = rng_.uniform(20.0, 50.0);
+        const double kyaw = std::atan2(dir.y(), dir.x()) + rng_.uniform(-0.4, 0.4);
+        const bool tall = rng_.bernoulli(0.5);
+        const double low = std::round(amin + rng_.uniform(8.0, 20.0));
+        const Vec2 c = s2 + (g2 - s2) * u + left * off;
+        KeepOutZone k = makeKoz(geometry::orientedRectangle(c, kl, kw, kyaw), "restricted");
+        if (k.polygon.distance(s2) < 25.0 || k.polygon.distance(g2) < 25.0) continue;
+        k.alt_min = 0.0;
+        k.alt_max = tall ? std::round(amax + 20.0) : std::min(low, amax - 6.0);
+        m.kozs.push_back(k);
+      }
+      const planning::WorldValidity band(world_, m.kozs, vs);
+      ref = shortestFlight(band, start, goal);
+    }
+    if (!ref.ok) throw GenerationError("no start and goal with a flight between them");
+    uav_.start = {0.0, start.x(), start.y(), 0.0,
+                  roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
+    sc_.sim.uav = uav_;
+    const double shortest = std::round(ref.length * 100.0) / 100.0;
+    m.time_limit = std::round(shortest / (kAvoidNominalSpeedFraction * uav_.max_speed) + 60.0);
+
+    addHostileEscort(start, goal);
+    addAircraft(ref, start, goal, vs);
+
+    MissionPhase phase;
+    phase.id = "avoid_1";
+    phase.type = PhaseType::kAvoid;
+    phase.avoid.goal = goal;
+    phase.avoid.goal_radius = kAvoidGoalRadius;
+    phase.avoid.shortest_path_m = shortest;
+    m.phases.push_back(phase);
+    m.objective.type = "reach";
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  landing ? "Land within %.0f m of (%.1f, %.1f) before the time limit"
+                          : "Fly to within %.0f m of the viewpoint (%.1f, %.1f, %.1f) before the "
+                            "time limit",
+                  kAvoidGoalRadius, goal.x(), goal.y(), goal.z());
+    m.objective.text = std::string(text) +
+                       ", keeping at least 5 m horizontally or 3 m vertically from every other "
+                       "aircraft and out of the keep-out zones.";
+  }
+
+  // True for points at least `inset` metres inside the neighborhood bounds.
+  bool insideBy(const Vec2& p, double inset) const {
+    const auto& b = world_.bounds();
+    return p.x() >= b.min.x() + inset && p.x() <= b.max.x() - inset && p.y() >= b.min.y() + inset &&
+           p.y() <= b.max.y() - inset;
+  }
+
+  // A hostile car that drives a few blocks, escorted by a square keep-out zone over the whole
+  // band; preferably across the direct line, never within 36 m of the start or the goal.
+  void addHostileEscort(const Vec3& start, const Vec3& goal) {
+    const Vec2 s2(start.x(), start.y()), g2(goal.x(), goal.y());
+    const double horizon = sc_.mission.time_limit;
+    Trajectory chosen;
+    for (int attempt = 0; attempt < 40; ++attempt) {
+      const int hops = static_cast<int>(rng_.uniformInt(4, 8));
+      const std::vector<int> nodes = randomWalk(randomNode(), hops);
+      if (nodes.size() < 2) continue;
+      DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
+      spec.depart_delay = rng_.uniform(0.0, 10.0);
+      Trajectory traj = planDrive(nodePositions(nodes), spec);
+      bool clear = true;
+      for (double t = 0.0; t <= horizon + 1.0 && clear; t += 1.0) {
+        const TrajectoryPoint p = sampleTrajectory(traj, t);
+        const Vec2 q(p.x, p.y);
+        clear = (q - s2).norm() >= kEscortClearance && (q - g2).norm() >= kEscortClearance;
+      }
+      if (!clear) continue;
+      bool crosses = false;
+      for (std::size_t i = 1; i < traj.size() && !crosses; ++i) {
+        crosses = geometry::segmentsIntersect(Vec2(traj[i - 1].x, traj[i - 1].y),
+                                              Vec2(traj[i].x, traj[i].y), s2, g2);
+      }
+      if (chosen.empty() || crosses) chosen = std::move(traj);
+      if (crosses) break;
+    }
+    if (chosen.empty())
+      throw GenerationError("no route for the hostile vehicle clear of the start and goal");
+    const auto& model = catalog::pickModel(rng_);
+    Entity e = makeCar(model, catalog::pick(rng_, catalog::carColors()),
+                       Vec3(chosen[0].x, chosen[0].y, chosen[0].z), chosen[0].yaw);
+    KeepOutZone k = makeKoz(
+        geometry::orientedRectangle(Vec2(chosen[0].x, chosen[0].y), kEscortSide, kEscortSide, 0.0),
+        "restricted");
+    k.alt_min = 0.0;
+    k.alt_max = std::round(uav_.altitude_max + 20.0);
+    for (const auto& p : chosen) k.motion.push_back({p.t, p.x, p.y, 0.0, 0.0});
+    sc_.mission.kozs.push_back(k);
+    add(std::move(e), "hostile", std::move(chosen));
+  }
+
+  // 2-6 aircraft: the first half cross the reference flight about when the UAV would get
+  // there (at 60 % of its top speed after the climb), the rest circle near it. Each clears
+  // the static obstacles, keeps 20 m from the start's column and the goal radius + 15 m from
+  // the goal horizontally, and 10 m from the aircraft before it.
+  void addAircraft(const ReferenceFlight& ref, const Vec3& start, const Vec3& goal,
+                   const planning::ValiditySettings& vs) {
+    const planning::WorldValidity band(world_, std::vector<KeepOutZone>{}, vs);
+    const double amin = uav_.altitude_min, amax = uav_.altitude_max;
+    const double horizon = sc_.mission.time_limit;
+    std::vector<Vec2> ref2;
+    for (const auto& p : ref.path) ref2.push_back(Vec2(p.x(), p.y()));
+    const double ref_len = geometry::polylineLength(ref2);
+    const double t_climb = amin / 3.0;
+    const double v_nominal = 0.6 * uav_.max_speed;
+    const Vec2 s2(start.x(), start.y()), g2(goal.x(), goal.y());
+    auto clearOfEnds = [&](const Vec2& a, const Vec2& b) {
+      return geometry::pointSegmentDistance(s2, a, b) >= 20.0 &&
+             geometry::pointSegmentDistance(g2, a, b) >= kAvoidGoalRadius + 15.0;
+    };
+    const int n = static_cast<int>(rng_.uniformInt(2, 6));
+    const int n_cross = (n + 1) / 2;
+    int crossing = 0;
+    std::vector<Aircraft>& fleet = sc_.sim.aircraft;
+    for (int i = 0; i < n; ++i) {
+      Aircraft ac;
+      ac.id = "aircraft_" + std::to_string(i + 1);
+      const bool fixed_wing = rng_.bernoulli(0.5);
+      ac.model = fixed_wing ? "fixed_wing" : "quadrotor";
+      ac.size = fixed_wing ? Vec3(1.2, 2.0, 0.35) : Vec3(0.6, 0.6, 0.25);
+      const double speed = fixed_wing ? rng_.uniform(10.0, 16.0) : rng_.uniform(4.0, 9.0);
+      for (int attempt = 0; attempt < 60 && ac.trajectory.empty(); ++attempt) {
+        // Among tall buildings (the city) long chords and wide laps rarely fit: after 30
+        // attempts they shrink to half, and the last 15 of a crossing aircraft fly head-on.
+        const double reach = attempt < 30 ? 1.0 : 0.5;
+        AircraftPattern pat;
+        pat.speed = roundMilli(speed);
+        const double along = rng_.uniform(0.25, 0.75) * ref_len;
+        const Vec2 c = geometry::polylinePointAt(ref2, along);
+        const Vec2 ahead = geometry::polylinePointAt(ref2, std::min(ref_len, along + 1.0));
+        const double heading = std::atan2(ahead.y() - c.y(), ahead.x() - c.x());
+        if (i < n_cross && attempt >= 45) {
+          // Last resort among tall buildings: head-on along the reference flight's longest leg,
+          // a little above it (what clears the leg clears anything higher), 25 m short of its
+          // ends.
+          pat.kind = AircraftPattern::Kind::kCrossing;
+          const double lift = rng_.uniform(0.5, 3.0);
+          const double jitter = rng_.uniform(-6.0, 6.0);
+          std::size_t leg = 0;
+          double leg_len = 0.0, leg_start = 0.0, acc = 0.0;
+          for (std::size_t k = 1; k < ref.path.size(); ++k) {
+            const double h = (ref.path[k] - ref.path[k - 1]).head<2>().norm();
+            if (h > leg_len) leg = k, leg_len = h, leg_start = acc;
+            acc += h;
+          }
+          if (leg_len < 60.0) continue;
+          const Vec3 p0 = ref.path[leg - 1], p1 = ref.path[leg];
+          const double u = 25.0 / leg_len;
+          Vec3 a3 = p0 + (p1 - p0) * (1.0 - u), b3 = p0 + (p1 - p0) * u;  // towards the start
+          const double up = std::max(a3.z(), b3.z()) + lift <= amax ? lift : 0.0;
+          a3.z() += up;
+          b3.z() += up;
+          if (!clearOfEnds(a3.head<2>(), b3.head<2>())) continue;
+          pat.a = Vec3(roundMilli(a3.x()), roundMilli(a3.y()), roundMilli(a3.z()));
+          pat.b = Vec3(roundMilli(b3.x()), roundMilli(b3.y()), roundMilli(b3.z()));
+          pat.cross = 0.5 * (pat.a + pat.b);
+          pat.t_cross = std::max(0.0, t_climb + (leg_start + 0.5 * leg_len) / v_nominal + jitter);
+        } else if (i < n_cross) {
+          pat.kind = AircraftPattern::Kind::kCrossing;
+          const double turn = rng_.uniform(0.7, 2.4);
+          const double side = rng_.bernoulli(0.5) ? 1.0 : -1.0;
+          const double h1 = reach * rng_.uniform(60.0, 150.0);
+          const double h2 = reach * rng_.uniform(60.0, 150.0);
+          const double zc = rng_.uniform(amin + 2.0, std::min(amax - 2.0, amin + 12.0));
+          const double dz = rng_.uniform(-6.0, 6.0);
+          const double jitter = rng_.uniform(-6.0, 6.0);
+          const double yaw = heading + side * turn;
+          const Vec2 d(std::cos(yaw), std::sin(yaw));
+          const double za = std::clamp(zc - dz * h1 / (h1 + h2), amin + 2.0, amax - 2.0);
+          const double zb = std::clamp(zc + dz * h2 / (h1 + h2), amin + 2.0, amax - 2.0);
+          const Vec2 a2 = c - d * h1, b2 = c + d * h2;
+          if (!insideBy(a2, 5.0) || !insideBy(b2, 5.0) || !clearOfEnds(a2, b2)) continue;
+          pat.a = Vec3(roundMilli(a2.x()), roundMilli(a2.y()), roundMilli(za));
+          pat.b = Vec3(roundMilli(b2.x()), roundMilli(b2.y()), roundMilli(zb));
+          pat.cross = pat.a + (pat.b - pat.a) * (h1 / (h1 + h2));
+          pat.t_cross = std::max(0.0, t_climb + along / v_nominal + jitter);
+        } else {
+          pat.kind = AircraftPattern::Kind::kOrbit;
+          const double side = rng_.bernoulli(0.5) ? 1.0 : -1.0;  // "Draw order" at the top
+          const double off = reach * rng_.uniform(30.0, 90.0) * side;
+          const double radius = reach * rng_.uniform(25.0, 60.0);
+          const double climb = rng_.uniform(0.0, 4.0);
+          const double z = rng_.uniform(amin + 2.0 + climb, amax - 2.0 - climb);
+          pat.phase = rng_.uniform(-geometry::kPi, geometry::kPi);
+          const Vec2 centre = c + Vec2(-std::sin(heading), std::cos(heading)) * off;
+          if (!insideBy(centre, radius + 5.0) || std::abs((centre - s2).norm() - radius) < 20.0 ||
+              std::abs((centre - g2).norm() - radius) < kAvoidGoalRadius + 15.0) {
+            continue;
+          }
+          pat.centre = Vec3(roundMilli(centre.x()), roundMilli(centre.y()), roundMilli(z));
+          pat.radius = roundMilli(radius);
+          pat.climb = roundMilli(climb);
+        }
+        Trajectory traj = aircraftTrajectory(pat, horizon);
+        bool ok = true;
+        for (std::size_t k = 1; k < traj.size() && ok; ++k) {
+          ok = band.staticSegmentValid(Vec3(traj[k - 1].x, traj[k - 1].y, traj[k - 1].z),
+                                       Vec3(traj[k].x, traj[k].y, traj[k].z));
+        }
+        for (const auto& other : fleet) {
+          for (double t = 0.0; t <= horizon && ok; t += 0.5) {
+            const TrajectoryPoint p = sampleTrajectory(traj, t),
+                                  q = sampleTrajectory(other.trajectory, t);
+            ok = std::hypot(std::hypot(p.x - q.x, p.y - q.y), p.z - q.z) >= 10.0;
+          }
+        }
+        if (ok) ac.trajectory = std::move(traj);
+      }
+      if (ac.trajectory.empty()) continue;
+      if (i < n_cross) ++crossing;
+      fleet.push_back(std::move(ac));
+    }
+    if (fleet.size() < 2 || crossing < 1) {
+      throw GenerationError("fewer than two aircraft (or none crossing) fit the airspace");
+    }
   }
 
   // ------------------------------------------------------------------ everything else

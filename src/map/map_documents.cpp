@@ -94,11 +94,40 @@ void parseMission(const json& m, const DocReader& r, MapData* d) {
     d->routes.push_back(std::move(rt));
   }
 
+  if (const json* phases = r.find(m, "", "phases")) {
+    r.array(*phases, "phases");
+    for (std::size_t i = 0; i < phases->size(); ++i) {
+      const std::string p = element("phases", i);
+      if (r.stringAt((*phases)[i], p, "type") != "avoid") continue;
+      const std::string gp = member(p, "goal");
+      const json& g = r.array(r.at((*phases)[i], p, "goal"), gp);
+      if (g.size() != 3) r.fail(gp, "expected [x, y, z]");
+      GoalData goal;
+      goal.position = Vec2(r.number(g[0], element(gp, 0)), r.number(g[1], element(gp, 1)));
+      goal.z = r.number(g[2], element(gp, 2));
+      goal.radius = r.numberAt((*phases)[i], p, "goal_radius");
+      d->goal = goal;
+    }
+  }
+
   if (const json* rel = r.find(m, "", "scene_relations")) {
     r.array(*rel, "scene_relations");
     for (std::size_t i = 0; i < rel->size(); ++i) {
       d->relations.push_back(r.stringAt((*rel)[i], element("scene_relations", i), "text"));
     }
+  }
+}
+
+// A trajectory of [t, x, y, z, yaw] samples (t never decreasing) into mv's times and path.
+void readPath(const json& traj_json, const std::string& tp, const DocReader& r, MoverData* mv) {
+  const json& traj = r.array(traj_json, tp);
+  for (std::size_t k = 0; k < traj.size(); ++k) {
+    const std::string q = element(tp, k);
+    if (!traj[k].is_array() || traj[k].size() != 5) r.fail(q, "expected [t, x, y, z, yaw]");
+    const double t = r.number(traj[k][0], element(q, 0));
+    if (!mv->times.empty() && t < mv->times.back()) r.fail(element(q, 0), "time goes backwards");
+    mv->times.push_back(t);
+    mv->path.emplace_back(r.number(traj[k][1], element(q, 1)), r.number(traj[k][2], element(q, 2)));
   }
 }
 
@@ -121,18 +150,31 @@ void parseSimConfig(const json& s, const DocReader& r, MapData* d) {
     mv.length = r.number(size[0], element(zp, 0));
     mv.width = r.number(size[1], element(zp, 1));
     if (mv.length <= 0.0 || mv.width <= 0.0) r.fail(zp, "expected positive sizes");
-    const std::string tp = member(p, "trajectory");
-    const json& traj = r.array(r.at(e, p, "trajectory"), tp);
-    for (std::size_t k = 0; k < traj.size(); ++k) {
-      const std::string q = element(tp, k);
-      if (!traj[k].is_array() || traj[k].size() != 5) r.fail(q, "expected [t, x, y, z, yaw]");
-      const double t = r.number(traj[k][0], element(q, 0));
-      if (!mv.times.empty() && t < mv.times.back()) r.fail(element(q, 0), "time goes backwards");
-      mv.times.push_back(t);
-      mv.path.emplace_back(r.number(traj[k][1], element(q, 1)),
-                           r.number(traj[k][2], element(q, 2)));
-    }
+    readPath(r.at(e, p, "trajectory"), member(p, "trajectory"), r, &mv);
     d->entities.push_back(std::move(mv));
+  }
+  if (const json* air = r.find(s, "", "aircraft")) {
+    r.array(*air, "aircraft");
+    for (std::size_t i = 0; i < air->size(); ++i) {
+      const std::string p = element("aircraft", i);
+      const json& a = (*air)[i];
+      MoverData mv;
+      mv.id = r.stringAt(a, p, "id");
+      mv.cls = r.stringAt(a, p, "model");
+      mv.role = "aircraft";
+      const std::string zp = member(p, "size");
+      const json& size = r.array(r.at(a, p, "size"), zp);
+      if (size.size() != 3) r.fail(zp, "expected [length, span, height]");
+      mv.length = r.number(size[0], element(zp, 0));
+      mv.width = r.number(size[1], element(zp, 1));
+      const std::string tp = member(p, "trajectory");
+      const json& traj = r.at(a, p, "trajectory");
+      readPath(traj, tp, r, &mv);
+      if (mv.path.empty()) r.fail(tp, "expected at least one sample");
+      mv.position = mv.path.front();
+      mv.yaw = r.number(traj[0][4], element(element(tp, 0), 4));
+      d->entities.push_back(std::move(mv));
+    }
   }
   const json& uav = r.at(s, "", "uav");
   const json& start = r.at(uav, "uav", "start");

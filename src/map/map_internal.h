@@ -88,6 +88,13 @@ struct MoverData {
   std::vector<Vec2> path;
 };
 
+// An avoid phase's goal: where, its height and the radius that counts as reached.
+struct GoalData {
+  Vec2 position{0, 0};
+  double z = 0.0;
+  double radius = 0.0;
+};
+
 struct MapData {
   std::string scenario_id;
   std::string cls;
@@ -100,7 +107,8 @@ struct MapData {
   std::vector<PriorData> priors;
   std::vector<RouteData> routes;
   std::vector<std::string> relations;
-  std::vector<MoverData> entities;
+  std::vector<MoverData> entities;  // aircraft too (role "aircraft", class = model)
+  std::optional<GoalData> goal;
   Vec2 uav_start{0, 0};
   double uav_yaw = 0.0;
   double uav_alt_min = 0.0;
@@ -234,6 +242,8 @@ const cv::Scalar kTraffic = rgb(60, 60, 66);
 const cv::Scalar kPedestrian = rgb(0, 125, 140);
 const cv::Scalar kVignette = rgb(175, 0, 175);
 const cv::Scalar kUav = rgb(0, 95, 210);
+const cv::Scalar kAircraft = kAircraftColor;
+const cv::Scalar kGoal = kGoalColor;
 const cv::Scalar kText = rgb(30, 30, 30);
 const cv::Scalar kWhite = rgb(255, 255, 255);
 const cv::Scalar kBlack = rgb(0, 0, 0);

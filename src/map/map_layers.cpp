@@ -195,7 +195,11 @@ void MapPainter::drawMovers(const MapData& d) {
           outline(path, false, kPedestrian, 1);
           break;
         case 2:
-          outline(path, false, kVignette, 1);
+          if (m.role == "aircraft") {
+            outline(path, false, kAircraft, 2);
+          } else {
+            outline(path, false, kVignette, 1);
+          }
           break;
         case 3:
           outline(path, false, kConfuserColor, 2);
@@ -210,7 +214,10 @@ void MapPainter::drawMovers(const MapData& d) {
   for (const auto& m : d.entities) {
     const int level = rank(m);
     if (level >= 3) continue;
-    if (m.cls == "car") {
+    if (m.role == "aircraft") {
+      cv::circle(img_, fx(m.position), static_cast<int>(4 * kOne), kAircraft, cv::FILLED,
+                 cv::LINE_AA, kShift);
+    } else if (m.cls == "car") {
       const auto poly = geometry::orientedRectangle(m.position, m.length, m.width, m.yaw);
       fill(poly.vertices(), level == 0 ? kTraffic : kVignette);
     } else {
@@ -252,6 +259,13 @@ void MapPainter::drawMarkersAndLabels(const MapData& d) {
         img_, cv::Point(static_cast<int>(std::lround(c.x)), static_cast<int>(std::lround(c.y))), 7);
     reserve(c, 9);
   }
+  if (d.goal) {
+    const cv::Point c = fx(d.goal->position);
+    const double r_px = std::max(4.0, d.goal->radius * frame_.px_per_m);
+    cv::circle(img_, c, static_cast<int>(r_px * kOne), kGoal, 2, cv::LINE_AA, kShift);
+    cv::circle(img_, c, static_cast<int>(2.5 * kOne), kGoal, cv::FILLED, cv::LINE_AA, kShift);
+    reserve(px(d.goal->position), static_cast<int>(std::ceil(r_px)) + 2);
+  }
   const cv::Point2d uav = px(d.uav_start);
   uavGlyph(img_, uav, d.uav_yaw, 13.0);
   reserve(uav, 13);
@@ -276,6 +290,14 @@ void MapPainter::drawMarkersAndLabels(const MapData& d) {
     if (isTarget(m, d)) placeLabel({m.id}, px(m.position), 12, 0.6, 2, kTargetDark);
   }
   placeLabel({"UAV start"}, uav, 12, 0.45, 1, kUav);
+  if (d.goal) {
+    placeLabel({d.goal->z > 0.0 ? "goal " + compact(d.goal->z) + " m up" : "landing goal"},
+               px(d.goal->position), std::max(6.0, d.goal->radius * frame_.px_per_m) + 4, 0.45, 1,
+               kGoal);
+  }
+  for (const auto& m : d.entities) {
+    if (m.role == "aircraft") placeLabel({m.id}, px(m.position), 6, 0.4, 1, kAircraft);
+  }
   for (const auto& m : d.entities) {
     if (m.role == "confuser" && !isTarget(m, d)) {
       placeLabel({m.id}, px(m.position), 8, 0.42, 1, kConfuserDark);

@@ -59,6 +59,14 @@ Aabb2 mapRegion(const scenario::World& world, const MapData& d, const MapStyle& 
     in.add(m.path);
   }
   in.add(d.uav_start);
+  if (d.goal) {
+    const Vec2 r(d.goal->radius, d.goal->radius);
+    in.add(d.goal->position - r);
+    in.add(d.goal->position + r);
+  }
+  for (const auto& m : d.entities) {
+    if (m.role == "aircraft") in.add(m.path);
+  }
   Aabb2 full = world.bounds();
   full.min = full.min.cwiseMin(in.box.min) - Vec2(style.margin_m, style.margin_m);
   full.max = full.max.cwiseMax(in.box.max) + Vec2(style.margin_m, style.margin_m);
@@ -206,6 +214,13 @@ class PanelBuilder {
     if (bounded) {
       entry("KOZ active only in [t window]", [&](const cv::Rect& b) { kozSwatch(b, true); });
     }
+    if (d_.goal) {
+      entry("Goal and its radius", [&](const cv::Rect& b) {
+        const cv::Point c(b.x + 14, b.y + 7);
+        cv::circle(img_, c, 7, kGoal, 2, cv::LINE_AA);
+        cv::circle(img_, c, 2, kGoal, cv::FILLED, cv::LINE_AA);
+      });
+    }
     if (!d_.routes.empty()) {
       entry("Route of interest + search band", [&](const cv::Rect& b) {
         cv::rectangle(img_, b, kRoute, 1);
@@ -234,9 +249,14 @@ class PanelBuilder {
 
   void moverEntries() {
     bool has[4] = {false, false, false, false};  // confuser, traffic, pedestrian, other
+    bool aircraft = false, hostile = false;
     for (const auto& m : d_.entities) {
       if (isTarget(m, d_)) continue;
-      if (m.role == "confuser")
+      if (m.role == "aircraft")
+        aircraft = true;
+      else if (m.role == "hostile")
+        hostile = true;
+      else if (m.role == "confuser")
         has[0] = true;
       else if (m.role == "traffic")
         has[1] = true;
@@ -281,6 +301,20 @@ class PanelBuilder {
         cv::line(img_, cv::Point(b.x, b.y + 7), cv::Point(b.x + b.width, b.y + 7), kVignette, 1,
                  cv::LINE_AA);
         cv::circle(img_, cv::Point(b.x + 14, b.y + 7), 3, kVignette, cv::FILLED, cv::LINE_AA);
+      });
+    }
+    if (hostile) {
+      entry("Hostile vehicle (its KOZ moves with it)", [&](const cv::Rect& b) {
+        cv::line(img_, cv::Point(b.x, b.y + 7), cv::Point(b.x + b.width, b.y + 7), kVignette, 1,
+                 cv::LINE_AA);
+        cv::rectangle(img_, cv::Rect(b.x + 10, b.y + 5, 8, 4), kVignette, cv::FILLED);
+      });
+    }
+    if (aircraft) {
+      entry("Other aircraft (t = 0) and its path", [&](const cv::Rect& b) {
+        cv::line(img_, cv::Point(b.x, b.y + 7), cv::Point(b.x + b.width, b.y + 7), kAircraft, 2,
+                 cv::LINE_AA);
+        cv::circle(img_, cv::Point(b.x + 14, b.y + 7), 4, kAircraft, cv::FILLED, cv::LINE_AA);
       });
     }
     entry("UAV start (heading)",

@@ -28,6 +28,7 @@ constexpr ClassName kClassNames[] = {
     {EntityClass::kBusStop, "bus_stop", 17},
     {EntityClass::kBench, "bench", 18},
     {EntityClass::kStreetTree, "street_tree", 19},
+    {EntityClass::kAircraft, "aircraft", 20},
 };
 }  // namespace
 

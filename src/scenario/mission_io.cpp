@@ -117,6 +117,19 @@ KeepOutZone readKoz(const json& j, const std::string& path, const std::string& f
     }
   }
   k.window = window(o);
+  if (o.has("motion")) {
+    const json& mv = o.array("motion");
+    const std::string mp = o.at("motion");
+    for (std::size_t i = 0; i < mv.size(); ++i) {
+      const auto a = strict_json::numbers<3>(mv[i], idx(mp, i), file);
+      if (!(a[0] >= 0) || (!k.motion.empty() && !(a[0] > k.motion.back().t))) {
+        throw ConfigError(file + ": " + idx(mp, i) +
+                          ": expected times >= 0 that strictly increase, got t = " + fmt(a[0]));
+      }
+      k.motion.push_back({a[0], a[1], a[2], 0.0, 0.0});
+    }
+    if (k.motion.size() < 2) o.error("motion", "expected at least 2 samples {t, x, y}");
+  }
   o.finish();
   return k;
 }
@@ -323,8 +336,9 @@ Mission missionFromJson(const json& j, const std::string& file) {
   {
     Obj obj = root.object("objective");
     m.objective.type = obj.string("type");
-    if (m.objective.type != "find" && m.objective.type != "track") {
-      obj.error("type", "expected \"find\" or \"track\", got \"" + m.objective.type + "\"");
+    if (m.objective.type != "find" && m.objective.type != "track" && m.objective.type != "reach") {
+      obj.error("type",
+                "expected \"find\", \"track\" or \"reach\", got \"" + m.objective.type + "\"");
     }
     m.objective.text = obj.string("text");
     const json& targets = obj.array("targets");

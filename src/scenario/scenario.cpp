@@ -11,7 +11,8 @@ struct ClassName {
 };
 constexpr ClassName kClasses[] = {{ScenarioClass::kAreaSearch, "area_search"},
                                   {ScenarioClass::kRouteSearch, "route_search"},
-                                  {ScenarioClass::kPursuit, "pursuit"}};
+                                  {ScenarioClass::kPursuit, "pursuit"},
+                                  {ScenarioClass::kAvoid, "avoid"}};
 struct OpName {
   RelationOp op;
   const char* name;
@@ -25,6 +26,16 @@ constexpr OpName kOps[] = {
 };
 constexpr const char* kEventually = "EVENTUALLY_";
 }  // namespace
+
+geometry::Polygon kozPolygonAt(const KeepOutZone& k, double t) {
+  if (k.motion.empty()) return k.polygon;
+  const TrajectoryPoint p = sampleTrajectory(k.motion, t);
+  const geometry::Vec2 d(p.x - k.motion.front().x, p.y - k.motion.front().y);
+  std::vector<geometry::Vec2> v;
+  v.reserve(k.polygon.size());
+  for (const auto& q : k.polygon.vertices()) v.push_back(q + d);
+  return geometry::Polygon(v);
+}
 
 const char* toString(ScenarioClass c) {
   for (const auto& k : kClasses) {

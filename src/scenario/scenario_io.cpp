@@ -183,6 +183,11 @@ void writeMission(JsonWriter& w, const Mission& m) {
     if (k.alt_max) w.key("max").value(*k.alt_max);
     w.endObject();
     writeWindow(w, k.window);
+    if (!k.motion.empty()) {
+      w.key("motion").beginArray();
+      for (const auto& p : k.motion) w.numbers({p.t, p.x, p.y});
+      w.endArray();
+    }
     w.endObject();
   }
   w.endArray();
@@ -269,6 +274,7 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
   // growing a 100 KB buffer by doubling would copy it several times.
   std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;
   for (const auto& se : s.entities) points += se.trajectory.size() + 8;
+  for (const auto& a : s.aircraft) points += a.trajectory.size() + 4;
   w.clear(8192 + 64 * points);
   w.beginObject();
   writeHeader(w, "hameritt/sim_config", s.scenario_id, s.cls, s.seed);
@@ -304,6 +310,19 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
     w.endArray().endObject();
   }
   w.endArray();
+  // Only avoid scenarios carry the key: the other classes' files read as they always did.
+  if (!s.aircraft.empty()) {
+    w.key("aircraft").beginArray();
+    for (const auto& a : s.aircraft) {
+      w.beginObject();
+      w.key("id").value(a.id).key("model").value(a.model);
+      w.key("size").numbers({a.size.x(), a.size.y(), a.size.z()});
+      w.key("trajectory").beginArray();
+      for (const auto& p : a.trajectory) w.numbers({p.t, p.x, p.y, p.z, p.yaw});
+      w.endArray().endObject();
+    }
+    w.endArray();
+  }
 
   const Environment& env = s.environment;
   w.key("environment").beginObject();

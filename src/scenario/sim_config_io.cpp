@@ -218,6 +218,34 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
     s.groups.push_back(std::move(grp));
   }
 
+  if (root.has("aircraft")) {
+    const json& air = root.array("aircraft");
+    for (std::size_t i = 0; i < air.size(); ++i) {
+      Obj a(air[i], idx("aircraft", i), file);
+      Aircraft ac;
+      ac.id = a.string("id");
+      if (ac.id.empty()) throw ConfigError(file + ": " + a.at("id") + ": expected a non-empty id");
+      if (!ids.insert(ac.id).second) {
+        throw ConfigError(file + ": " + a.at("id") + ": duplicate id \"" + ac.id + "\"");
+      }
+      ac.model = a.string("model");
+      if (ac.model != "fixed_wing" && ac.model != "quadrotor") {
+        a.error("model", "expected \"fixed_wing\" or \"quadrotor\", got \"" + ac.model + "\"");
+      }
+      ac.size = vec3(a.get("size"), a.at("size"), file);
+      if (!(ac.size.minCoeff() > 0)) {
+        throw ConfigError(file + ": " + a.at("size") + ": expected positive sizes");
+      }
+      ac.trajectory = strict_json::trajectory(a.array("trajectory"), a.at("trajectory"), file);
+      if (ac.trajectory.size() < 2) {
+        a.error("trajectory",
+                "expected at least 2 samples, got " + std::to_string(ac.trajectory.size()));
+      }
+      a.finish();
+      s.aircraft.push_back(std::move(ac));
+    }
+  }
+
   {
     Obj env = root.object("environment");
     Environment& e = s.environment;

@@ -187,6 +187,9 @@ class Semantics {
   // Samples [t, x, y, z, yaw] of a timed path at `pointer`: t >= 0 and strictly increasing
   // (malformed samples are the schema's to report).
   void trajectoryOrder(const json& traj, const std::string& pointer);
+  // Consecutive [t, x, y, z, ...] samples no faster apart than max_speed (m/s); rule
+  // "trajectory_speed".
+  void trajectorySpeed(const json& traj, const std::string& pointer, double max_speed);
 
   // The perception-only flight: strictly increasing times from t >= 0, and every target it
   // claims to see is a target entity of this scenario.

@@ -33,6 +33,7 @@ void Semantics::mission() {
     if (const json* poly = member(kozs[i], "polygon")) polygon(*poly, p + "/polygon");
     if (const json* alt = member(kozs[i], "altitude")) altitude(*alt, p + "/altitude");
     timeWindow(kozs[i], p);
+    if (member(kozs[i], "motion")) trajectoryOrder(arrayOrEmpty(kozs[i], "motion"), p + "/motion");
   }
 
   priors(aoi_ids, aois);
@@ -72,6 +73,14 @@ void Semantics::mission() {
     if (i > 0 && stringAt(phases[i], "type") == std::optional<std::string>("search")) {
       add(p + "/type", "phase_order", "a search phase can only be the first phase");
     }
+  }
+  // An avoid mission says where to fly: an avoid phase with its goal and criteria.
+  if (stringAt(doc_, "class") == std::optional<std::string>("avoid")) {
+    bool has_avoid = false;
+    for (const auto& ph : phases) {
+      has_avoid = has_avoid || stringAt(ph, "type") == std::optional<std::string>("avoid");
+    }
+    if (!has_avoid) add("/phases", "avoid_phase", "an avoid mission needs an avoid phase");
   }
 }
 

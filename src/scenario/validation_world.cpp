@@ -16,7 +16,20 @@ void Semantics::simConfig() {
     has_target = has_target || stringAt(ents[i], "role") == std::optional<std::string>("target");
     trajectoryOrder(arrayOrEmpty(ents[i], "trajectory"), p + "/trajectory");
   }
-  if (!ents.empty() && !has_target) add("/entities", "role_target", "no entity has role 'target'");
+  const bool avoid = stringAt(doc_, "class") == std::optional<std::string>("avoid");
+  if (!ents.empty() && !has_target && !avoid) {
+    add("/entities", "role_target", "no entity has role 'target'");
+  }
+  // Aircraft share the entity id space; their trajectories are ordered and continuous (no
+  // jump faster than kMaxAircraftSpeed between samples).
+  const json& air = arrayOrEmpty(doc_, "aircraft");
+  for (std::size_t i = 0; i < air.size(); ++i) {
+    const std::string p = jsonPointerAppend("/aircraft", i);
+    ids.note(air[i], p);
+    const json& traj = arrayOrEmpty(air[i], "trajectory");
+    trajectoryOrder(traj, p + "/trajectory");
+    trajectorySpeed(traj, p + "/trajectory", kMaxAircraftSpeed);
+  }
 
   IdSet group_ids(this, "group id");
   const json& groups = arrayOrEmpty(doc_, "groups");
@@ -49,6 +62,29 @@ void Semantics::trajectoryOrder(const json& traj, const std::string& pointer) {
           "t = " + num(t) + " does not increase on the previous sample's t = " + num(prev));
     }
     prev = t;
+  }
+}
+
+void Semantics::trajectorySpeed(const json& traj, const std::string& pointer, double max_speed) {
+  auto sample = [](const json& v, double* out) {
+    if (!v.is_array() || v.size() < 4) return false;
+    for (int c = 0; c < 4; ++c) {
+      if (!v[static_cast<std::size_t>(c)].is_number()) return false;
+      out[c] = v[static_cast<std::size_t>(c)].get<double>();
+    }
+    return true;
+  };
+  double a[4], b[4];
+  for (std::size_t k = 1; k < traj.size(); ++k) {
+    if (!sample(traj[k - 1], a) || !sample(traj[k], b) || !(b[0] > a[0])) continue;
+    const double d = std::sqrt((b[1] - a[1]) * (b[1] - a[1]) + (b[2] - a[2]) * (b[2] - a[2]) +
+                               (b[3] - a[3]) * (b[3] - a[3]));
+    const double v = d / (b[0] - a[0]);
+    if (!(v <= max_speed)) {
+      add(jsonPointerAppend(pointer, k), "trajectory_speed",
+          "jumps " + num(d) + " m in " + num(b[0] - a[0]) + " s (" + num(v) + " m/s, more than " +
+              num(max_speed) + " m/s): the trajectory is not continuous");
+    }
   }
 }
 

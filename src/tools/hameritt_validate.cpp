@@ -6,6 +6,9 @@
 // subdirectory holding a sim_config.json): the spec's hard requirements are re-checked from
 // the scene (relations recomputed), "DIR: ok" or "DIR: MESSAGE" lines per scenario, then one
 // "soft 'REQUIREMENT': held in K of N scenarios" line per soft requirement and a total.
+// An avoid scenario's sim_config.json with a mission.json beside it is also checked against its
+// regenerated world (start and goal clear, the goal reachable, the stated shortest path, the
+// aircraft continuous and clear of obstacles): rule "avoid_scenario".
 // Exit codes: 0 all files valid, 2 any issue or bad usage.
 
 #include <algorithm>
@@ -16,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "hameritt/generation/avoid.h"
 #include "hameritt/generation/generator.h"
 #include "hameritt/generation/spec_sampler.h"
 #include "hameritt/scenario/mission_io.h"
@@ -59,6 +63,29 @@ std::vector<std::string> scenarioDirs(const std::vector<std::string>& args) {
     if (sub.empty()) throw ConfigError(a + ": no sim_config.json in it or in its subdirectories");
     std::sort(sub.begin(), sub.end());
     out.insert(out.end(), sub.begin(), sub.end());
+  }
+  return out;
+}
+
+// The avoid_scenario issues of a valid sim_config.json (none for other classes, or without a
+// mission.json beside it).
+std::vector<ValidationIssue> avoidIssues(const std::string& sim_file) {
+  const fs::path mission_file = fs::path(sim_file).parent_path() / "mission.json";
+  std::error_code ec;
+  if (fs::path(sim_file).filename() != "sim_config.json" || !fs::exists(mission_file, ec)) {
+    return {};
+  }
+  std::vector<ValidationIssue> out;
+  try {
+    const SimConfig sim = loadSimConfig(sim_file);
+    if (sim.cls != ScenarioClass::kAvoid) return {};
+    const Mission mission = loadMission(mission_file.string());
+    const World world = generateCheckedWorld(sim, sim_file);
+    for (const auto& m : checkAvoidScenario(world, mission, sim)) {
+      out.push_back({sim_file, "", "avoid_scenario", m});
+    }
+  } catch (const std::exception& e) {
+    out.push_back({sim_file, "", "avoid_scenario", e.what()});
   }
   return out;
 }
@@ -167,7 +194,8 @@ int main(int argc, char** argv) {
 
   bool all_ok = true;
   for (const auto& f : files) {
-    const std::vector<ValidationIssue> issues = validateFile(f, schema_dir);
+    std::vector<ValidationIssue> issues = validateFile(f, schema_dir);
+    if (issues.empty()) issues = avoidIssues(f);
     if (issues.empty()) {
       std::printf("%s: ok\n", f.c_str());
       continue;

@@ -345,5 +345,25 @@ TEST(ConstraintMonitor, IntervalsAgreeWithDenseSampling) {
   }
 }
 
+// A zone that escorts a vehicle moves with it: hovering at (5, 5) is inside the square while it
+// stands there and outside once it has moved 20 m east (it leaves at t = 7.5, when its left
+// edge at x = 2 t - 10 passes x = 5); the same hover against the zone held still stays
+// inside (the control).
+TEST(ConstraintMonitor, MovingZoneLeavesAHoveringVehicle) {
+  scenario::Mission m = squareMission();
+  m.kozs[0].motion = {
+      {0.0, 5.0, 5.0, 0.0, 0.0}, {5.0, 5.0, 5.0, 0.0, 0.0}, {15.0, 25.0, 5.0, 0.0, 0.0}};
+  std::vector<std::pair<double, Vec3>> hover;
+  for (int i = 0; i <= 200; ++i) hover.push_back({0.1 * i, Vec3(5, 5, 10)});
+  const auto v = fly(m, hover);
+  ASSERT_EQ(v.size(), 1u);
+  EXPECT_NEAR(v[0].t_enter, 0.0, 1e-12);
+  EXPECT_NEAR(v[0].t_exit, 7.5, 0.1);
+  EXPECT_FALSE(v[0].ongoing);
+  const auto still = fly(squareMission(), hover);
+  ASSERT_EQ(still.size(), 1u);
+  EXPECT_TRUE(still[0].ongoing);
+}
+
 }  // namespace
 }  // namespace hameritt::adk

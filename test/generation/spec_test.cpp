@@ -83,6 +83,9 @@ TEST(SpecParse, UnknownNamesListTheNearestValidOnes) {
   EXPECT_EQ(cls.substr(0, cls.find('\n')),
             "t.hspec:1:10: error: unknown mission class 'area_serch'; did you mean "
             "'area_search'?; classes: area_search, route_search, pursuit");
+  // avoid is a mission class but not one a spec can describe.
+  const std::string avoid = errorOf("scenario avoid\n");
+  EXPECT_EQ(avoid.substr(0, avoid.find(';')), "t.hspec:1:10: error: unknown mission class 'avoid'");
 }
 
 TEST(SpecParse, TypeErrors) {

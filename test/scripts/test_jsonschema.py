@@ -96,6 +96,100 @@ def expect_rejected(validators, name, doc, where):
         ok(name)
 
 
+def expect_beyond_schema(name, validators, validate, schema_dir, doc, path, want):
+    """doc (written to `path`) passes jsonschema, and hameritt_validate rejects the file with
+    exit 2 and stderr starting with `want`: a rule beyond what a schema can express."""
+    run = subprocess.run([validate, "--schema-dir", schema_dir, path], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, universal_newlines=True, timeout=60)
+    if errors_of(validators, doc):
+        fail(name, "jsonschema rejected it: %s" % errors_of(validators, doc))
+    elif run.returncode != 2 or not run.stderr.startswith(want):
+        fail(name, "hameritt_validate exit %d, stderr %r" % (run.returncode, run.stderr))
+    else:
+        ok(name)
+
+
+def expect_all_valid(name, validate, schema_dir, files):
+    """hameritt_validate accepts every file: exit 0 and one "FILE: ok" line each."""
+    run = subprocess.run([validate, "--schema-dir", schema_dir] + files, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
+    ok_lines = [l for l in run.stdout.splitlines() if l.endswith(": ok")]
+    if run.returncode != 0 or len(ok_lines) != len(files):
+        fail(name, "exit %d, %d of %d ok: %s" % (
+            run.returncode, len(ok_lines), len(files), run.stderr.strip()[:500]))
+    else:
+        ok(name)
+
+
+def check_avoid(validators, generate, validate, schema_dir, out, search_mission):
+    """Avoid scenarios (a class outside "all"): their files validate with jsonschema and
+    hameritt_validate; broken ones are rejected where they break, and an aircraft that jumps
+    (continuity, beyond a schema) passes jsonschema but not hameritt_validate."""
+    aout = os.path.join(out, "avoid")
+    run = subprocess.run([generate, "--class", "avoid", "--count", "4", "--seed", "7", "--out",
+                          aout, "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         universal_newlines=True, timeout=300)
+    if run.returncode != 0:
+        fail("hameritt_generate avoid", "exit %d: %s" % (run.returncode, run.stderr.strip()))
+        return
+    files = sorted(glob.glob(os.path.join(aout, "avoid-*", "*.json")))
+    docs = {}
+    for path in files:
+        with open(path) as f:
+            doc = json.load(f)
+        errs = errors_of(validators, doc)
+        if errs:
+            fail(os.path.relpath(path, out), "; ".join(errs[:5]))
+        else:
+            ok(os.path.relpath(path, out))
+        docs.setdefault(doc.get("schema"), doc)
+    if len(files) != 8:
+        fail("avoid batch", "expected 8 documents, found %d" % len(files))
+        return
+    ok("avoid batch")
+    expect_all_valid("hameritt_validate avoid", validate, schema_dir, files)
+    m, s = docs["hameritt/mission"], docs["hameritt/sim_config"]
+    if search_mission is not None:
+        b = copy.deepcopy(m)
+        b["objective"]["targets"] = copy.deepcopy(search_mission["objective"]["targets"])
+        expect_rejected(validators, "reach objective with targets", b, ["objective"])
+    b = copy.deepcopy(m)
+    moving = [i for i, k in enumerate(b["keep_out_zones"]) if "motion" in k]
+    if len(moving) != 1:
+        fail("avoid moving zone", "expected one zone with motion, found %d" % len(moving))
+    else:
+        b["keep_out_zones"][moving[0]]["motion"][0] = [0.0, 1.0]
+        expect_rejected(validators, "two-number motion sample", b,
+                        ["keep_out_zones", moving[0], "motion", 0])
+    b = copy.deepcopy(s)
+    b["aircraft"][0]["trajectory"] = b["aircraft"][0]["trajectory"][:1]
+    expect_rejected(validators, "one-sample aircraft trajectory", b, ["aircraft", 0, "trajectory"])
+    b = copy.deepcopy(s)
+    b["aircraft"][0]["model"] = "airship"
+    expect_rejected(validators, "unknown aircraft model", b, ["aircraft", 0, "model"])
+    b = copy.deepcopy(s)
+    b["aircraft"][0]["trajectory"][1][1] += 5000.0
+    broken = os.path.join(out, "jump_sim_config.json")
+    with open(broken, "w") as f:
+        json.dump(b, f)
+    expect_beyond_schema("aircraft jump", validators, validate, schema_dir, b, broken,
+                         broken + ": /aircraft/0/trajectory/1: trajectory_speed: ")
+    # Against the world (beyond the files): a stated shortest path shorter than the straight
+    # line passes jsonschema; hameritt_validate checks the sim_config with its mission.
+    src = os.path.dirname(files[0])
+    bad_dir = os.path.join(out, "short_path")
+    shutil.copytree(src, bad_dir)
+    with open(os.path.join(bad_dir, "mission.json")) as f:
+        b = json.load(f)
+    b["phases"][0]["shortest_path_m"] = 1.0
+    with open(os.path.join(bad_dir, "mission.json"), "w") as f:
+        json.dump(b, f)
+    bad_sim = os.path.join(bad_dir, "sim_config.json")
+    expect_beyond_schema("avoid short path", validators, validate, schema_dir, b, bad_sim,
+                         bad_sim + ": (root): avoid_scenario: mission.json: phases: avoid "
+                         "shortest_path_m 1 ")
+
+
 def main():
     bin_dir = env_dir("HAMERITT_BIN_DIR")
     source_dir = env_dir("HAMERITT_SOURCE_DIR")
@@ -220,14 +314,7 @@ def main():
 
         # The C++ validator agrees on the batch and also catches what a schema cannot express.
         validate = os.path.join(bin_dir, "hameritt_validate")
-        run = subprocess.run([validate, "--schema-dir", schema_dir] + files, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, universal_newlines=True, timeout=300)
-        ok_lines = [l for l in run.stdout.splitlines() if l.endswith(": ok")]
-        if run.returncode != 0 or len(ok_lines) != len(files):
-            fail("hameritt_validate batch", "exit %d, %d of %d ok: %s" % (
-                run.returncode, len(ok_lines), len(files), run.stderr.strip()[:500]))
-        else:
-            ok("hameritt_validate batch")
+        expect_all_valid("hameritt_validate batch", validate, schema_dir, files)
         area = [p for p in files if os.path.basename(os.path.dirname(p)).startswith("area_search")
                 and p.endswith("mission.json")]
         if not area:
@@ -241,17 +328,9 @@ def main():
             with open(broken, "w") as f:
                 json.dump(m, f)
             # Schemas cannot express geometry: jsonschema accepts it, hameritt_validate does not.
-            run = subprocess.run([validate, "--schema-dir", schema_dir, broken],
-                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                 universal_newlines=True, timeout=60)
-            want = broken + ": /areas_of_interest/0/polygon: polygon_simple: "
-            if errors_of(validators, m):
-                fail("bow-tie AOI", "jsonschema rejected it: %s" % errors_of(validators, m))
-            elif run.returncode != 2 or not run.stderr.startswith(want):
-                fail("bow-tie AOI", "hameritt_validate exit %d, stderr %r"
-                     % (run.returncode, run.stderr))
-            else:
-                ok("bow-tie AOI")
+            expect_beyond_schema("bow-tie AOI", validators, validate, schema_dir, m, broken,
+                                 broken + ": /areas_of_interest/0/polygon: polygon_simple: ")
+        check_avoid(validators, generate, validate, schema_dir, out, mission)
     finally:
         shutil.rmtree(out, ignore_errors=True)
 

@@ -367,5 +367,40 @@ TEST(Simulator, IdenticalInputsGiveBitIdenticalStatesAndResetReplays) {
   EXPECT_FALSE(sameBits(a.uav(), b.uav()));
 }
 
+// An avoid scenario's aircraft is a kinematic mover in ground truth (its trajectory gives the
+// body centre) and a contact with it is a crash into its id; the same aircraft passing 5 m
+// above the hovering UAV is not (the control).
+TEST(Simulator, AircraftAreMoversAndAContactIsACrash) {
+  auto run = [](double pass_z, std::vector<EntityState>* truth_at_4s) {
+    scenario::SimConfig c = calmConfig();
+    scenario::Aircraft a;
+    a.id = "aircraft_1";
+    a.model = "fixed_wing";
+    a.size = Vec3(1.2, 2.0, 2.0);  // tall: the hover height settles within +- 1 m
+    a.trajectory = {{0.0, -60.0, 0.0, pass_z, 0.0}, {12.0, 60.0, 0.0, pass_z, 0.0}};
+    c.aircraft.push_back(a);
+    c.duration = 20.0;
+    Simulator sim(emptyWorld(), c, sentinel(), SimSettings());
+    sim.setPositionSetpoint({0, 0, 10}, 0.0);
+    runUntil(sim, 4.0, [] { return false; });
+    *truth_at_4s = sim.scenarioEntities();
+    runUntil(sim, 8.0, [&] { return sim.uav().crashed; });
+    return sim.uav();
+  };
+  std::vector<EntityState> truth;
+  const UavState hit = run(10.0, &truth);
+  ASSERT_EQ(truth.size(), 1u);
+  EXPECT_EQ(truth[0].id, "aircraft_1");
+  EXPECT_EQ(truth[0].role, "aircraft");
+  EXPECT_EQ(truth[0].cls, scenario::EntityClass::kAircraft);
+  EXPECT_NEAR(truth[0].box.center.x(), -20.0, 0.05);
+  EXPECT_NEAR(truth[0].box.center.z(), 10.0, 1e-9);
+  EXPECT_NEAR(truth[0].velocity.x(), 10.0, 1e-9);
+  EXPECT_TRUE(hit.crashed);
+  EXPECT_EQ(hit.crashed_into, "aircraft_1");
+  const UavState clear = run(15.0, &truth);
+  EXPECT_FALSE(clear.crashed);
+}
+
 }  // namespace
 }  // namespace hameritt::sim

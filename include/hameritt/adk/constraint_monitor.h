@@ -25,7 +25,8 @@ std::vector<Interval> segmentInsidePolygon(const geometry::Polygon& polygon,
 
 // Time intervals within [ta, tb] during which the path from a (at ta) to b (at tb), linear in
 // time, is inside the keep-out zone's prism (polygon x altitude band; a missing bound is open;
-// boundary inside), ignoring the zone's time window. ta <= tb.
+// boundary inside), ignoring the zone's time window. ta <= tb. A moving zone is taken where
+// it stands at (ta + tb) / 2.
 std::vector<Interval> prismIntervals(const scenario::KeepOutZone& zone, const geometry::Vec3& a,
                                      const geometry::Vec3& b, double ta, double tb);
 

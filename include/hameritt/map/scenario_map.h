@@ -34,6 +34,10 @@ struct MapStyle {
 const cv::Scalar kTargetColor(40, 20, 215);
 // BGR fill colour of the confuser markers.
 const cv::Scalar kConfuserColor(0, 140, 255);
+// BGR colour of the other aircraft of an avoid scenario (paths and t = 0 markers).
+const cv::Scalar kAircraftColor(200, 160, 0);
+// BGR colour of an avoid goal's ring (its radius to scale) and centre dot.
+const cv::Scalar kGoalColor(40, 140, 20);
 // BGR tint of the keep-out zones (blended over the map, then hatched in a darker red).
 const cv::Scalar kKozColor(45, 35, 225);
 

@@ -31,6 +31,7 @@ enum class EntityClass {
   kBusStop,       // a bus shelter on an arterial sidewalk
   kBench,
   kStreetTree,  // a sidewalk tree in a pit at the kerb
+  kAircraft,    // another aircraft of an avoid scenario (SimConfig::aircraft)
 };
 
 // True for the classes that are driving or parking surfaces (street, driveway, parking_lot,

@@ -18,7 +18,7 @@ namespace hameritt::scenario {
 
 constexpr int kSchemaVersion = 1;
 
-enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit };
+enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit, kAvoid };
 const char* toString(ScenarioClass c);
 bool parseScenarioClass(const std::string& s, ScenarioClass* out);
 
@@ -47,7 +47,14 @@ struct KeepOutZone {
   std::optional<double> alt_max;
   geometry::TimeWindow window;
   std::string purpose;  // vantage_denial | access_denial | restricted
+  // A moving zone (one that escorts a hostile vehicle): its reference point over time
+  // ({t, x, y}; z and yaw unused). The polygon is given at the first sample and moves with the
+  // point (kozPolygonAt). Empty: the zone is static.
+  Trajectory motion;
 };
+
+// The zone's polygon at time t: translated by motion(t) - motion(first sample).
+geometry::Polygon kozPolygonAt(const KeepOutZone& k, double t);
 
 // One cell of an AOI's prior grid.
 struct PriorCell {
@@ -118,7 +125,7 @@ struct TargetDescription {
 };
 
 struct Objective {
-  std::string type;  // find | track
+  std::string type;  // find | track | reach (avoid: fly to the phase's goal)
   std::string text;
   std::vector<TargetDescription> targets;
 };
@@ -259,6 +266,18 @@ struct Perturbations {
   double motion_blur_px = 0.0;
 };
 
+// A non-cooperative aircraft of an avoid scenario on a scripted trajectory (the simulator
+// moves it kinematically along it). Size is the body's length, wingspan and height (m).
+// The fastest an aircraft may move between two trajectory samples (m/s): a faster step is a
+// jump, and the trajectory is not continuous.
+constexpr double kMaxAircraftSpeed = 60.0;
+struct Aircraft {
+  std::string id;
+  std::string model;  // fixed_wing | quadrotor
+  geometry::Vec3 size{1, 1, 0.3};
+  Trajectory trajectory;  // at least two samples, strictly increasing t
+};
+
 // Where a scenario generated from a spec came from: the spec file, the hash of its sources
 // (imports and --param overrides included), the sampler and the values drawn for it.
 struct SpecProvenance {
@@ -277,6 +296,7 @@ struct SimConfig {
   std::uint64_t world_fingerprint = 0;
   std::vector<ScenarioEntity> entities;
   std::vector<Group> groups;
+  std::vector<Aircraft> aircraft;  // avoid only; written only when there are any
   Environment environment;
   UavSpec uav;
   Perturbations perturbations;

@@ -3,8 +3,8 @@
 // drag torque km*w^2 with first-order motor lag, body drag against the air-relative velocity,
 // gravity) are integrated here with a fixed-step RK4 scheme; Bullet is used for collision
 // detection only: the static neighborhood (houses, garages, fences, tree trunks and canopies,
-// parked cars as oriented boxes) and the scenario's moving vehicles and pedestrians (kinematic
-// collision objects that follow their sim_config trajectories exactly) live in a
+// parked cars as oriented boxes) and the scenario's moving vehicles, pedestrians and aircraft
+// (kinematic collision objects that follow their sim_config trajectories exactly) live in a
 // btCollisionWorld with a btDbvtBroadphase, and the UAV's collision box is tested against the
 // broadphase candidates each step. Single-threaded and wall-clock free: the same scenario and
 // command sequence give the same trajectory bit for bit.
@@ -51,7 +51,9 @@ struct UavState {
 struct EntityState {
   std::string id;
   scenario::EntityClass cls = scenario::EntityClass::kCar;
-  std::string role;  // scenario role (target, confuser, traffic, pedestrian, vignette)
+  // scenario role (target, confuser, traffic, pedestrian, vignette, hostile), or "aircraft"
+  // for an avoid scenario's aircraft (SimConfig::aircraft, moved like the other movers)
+  std::string role;
   geometry::OrientedBox box;
   Vec3 velocity{0, 0, 0};
   double yaw_rate = 0.0;

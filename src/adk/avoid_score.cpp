@@ -1,0 +1,70 @@
+#include "hameritt/adk/avoid_score.h"
+
+#include <cmath>
+
+#include "hameritt/scenario/error.h"
+
+namespace hameritt::adk {
+
+namespace {
+void requirePositive(double v, const char* field) {
+  if (!(v > 0.0) || !std::isfinite(v)) {
+    throw scenario::ConfigError(std::string(field) + ": expected a positive number, got " +
+                                scenario::formatNumber(v));
+  }
+}
+}  // namespace
+
+AvoidScorer::AvoidScorer(const scenario::AvoidPhaseSpec& spec, double time_limit,
+                         double collision_radius)
+    : spec_(spec), time_limit_(time_limit) {
+  requirePositive(spec.goal_radius, "avoid.goal_radius");
+  requirePositive(spec.shortest_path_m, "avoid.shortest_path_m");
+  requirePositive(time_limit, "avoid.time_limit");
+  minimum_.horizontal = spec.min_horizontal_separation;
+  minimum_.vertical = spec.min_vertical_separation;
+  minimum_.collision_radius = collision_radius;
+  minimum_.validate();
+}
+
+void AvoidScorer::add(const TrafficSample& sample) {
+  if (reach_time_) return;
+  // Validate the sample against the previous one before keeping it.
+  std::vector<TrafficSample> pair;
+  if (!samples_.empty()) pair.push_back(samples_.back());
+  pair.push_back(sample);
+  scoreSeparation(pair, minimum_);
+  samples_.push_back(sample);
+  path_.push_back(sample.position);
+  if ((sample.position - spec_.goal).norm() <= spec_.goal_radius) reach_time_ = sample.t;
+}
+
+AvoidScore AvoidScorer::score(double koz_seconds) const {
+  AvoidScore s;
+  s.shortest_path_m = spec_.shortest_path_m;
+  s.koz_seconds = koz_seconds;
+  s.reach_time = reach_time_;
+  s.path_length_m = pathLength(path_);
+  if (!samples_.empty()) s.goal_distance_m = (samples_.back().position - spec_.goal).norm();
+  s.separation = scoreSeparation(samples_, minimum_);
+  if (!reach_time_) {
+    s.failure =
+        "did not come within " + scenario::formatNumber(spec_.goal_radius) + " m of the goal";
+  } else if (*reach_time_ > time_limit_) {
+    s.failure = "reached the goal after the time limit";
+  } else if (s.separation.contact) {
+    s.failure = "contact with " + s.separation.closest_aircraft;
+  } else if (s.separation.losses > 0) {
+    s.failure = "lost separation " + std::to_string(s.separation.losses) + " time(s), " +
+                scenario::formatNumber(s.separation.seconds_below_minimum) + " s in all";
+  }
+  s.success = s.failure.empty();
+  NavigationEpisode e;
+  e.success = s.success;
+  e.shortest_path_m = spec_.shortest_path_m;
+  e.path_length_m = s.path_length_m;
+  s.spl = splOf(e);
+  return s;
+}
+
+}  // namespace hameritt::adk
