@@ -7,15 +7,16 @@
 #include <set>
 #include <unordered_map>
 
+#include "hameritt/generation/target_slots.h"
 #include "hameritt/geometry/segment.h"
 #include "hameritt/planning/look_at.h"
 #include "hameritt/planning/validity.h"
 #include "hameritt/planning/vehicle_routes.h"
 #include "hameritt/scenario/catalog.h"
+#include "hameritt/scenario/city_traffic.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/trajectory.h"
-#include "hameritt/generation/target_slots.h"
 
 namespace hameritt::scenario {
 
@@ -72,8 +73,11 @@ class ScenarioBuilder {
       if (e.cls == EntityClass::kPedestrian) ++world_peds;
     }
     // Scenario ids are drawn from a shuffled pool so that neither order nor number reveals a role.
-    for (int i = 1; i <= 96; ++i) car_ids_.push_back(world_cars + i);
-    for (int i = 1; i <= 48; ++i) ped_ids_.push_back(world_peds + i);
+    const bool city = world.params().type == WorldType::kCity;
+    const int car_pool = 96 + (city ? cityCarBound(world) : 0);
+    const int ped_pool = 48 + (city ? cityPedestrianBound(world) : 0);
+    for (int i = 1; i <= car_pool; ++i) car_ids_.push_back(world_cars + i);
+    for (int i = 1; i <= ped_pool; ++i) ped_ids_.push_back(world_peds + i);
     rng_.shuffle(car_ids_);
     rng_.shuffle(ped_ids_);
   }
@@ -100,7 +104,11 @@ class ScenarioBuilder {
         break;
     }
     placeUavStart();
-    addTraffic();
+    if (world_.params().type == WorldType::kCity) {
+      addCityTraffic();
+    } else {
+      addTraffic();
+    }
     drawEnvironment();
     s.duration = m.time_limit;
     finalizeRelations();
@@ -1293,6 +1301,31 @@ class ScenarioBuilder {
       p.box = boxFromPose(Vec3(traj[0].x, traj[0].y, 0.0), traj[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.55, 1.9))));
       add(std::move(p), "pedestrian", std::move(traj));
     }
+  }
+
+  // The city's signalised ambient traffic and crowd (scenario/city_traffic.h), drawn from a
+  // stream of its own and simulated over the mission's time limit.
+  void addCityTraffic() {
+    CityTraffic traffic = simulateCityTraffic(world_, deriveSeed(seed_, 0x4349545954524146ULL),
+                                              sc_.mission.time_limit);
+    for (auto& car : traffic.cars) {
+      const TrajectoryPoint& p0 = car.trajectory.front();
+      Entity e = makeCar(*car.model, car.color, Vec3(p0.x, p0.y, p0.z), p0.yaw);
+      e.attributes.set("lane", car.lane);
+      add(std::move(e), "traffic", std::move(car.trajectory));
+    }
+    for (auto& ped : traffic.pedestrians) {
+      Entity p;
+      p.id = nextPedId();
+      p.cls = EntityClass::kPedestrian;
+      p.attributes.set("clothing_color", ped.clothing_color);
+      p.attributes.set("activity", ped.activity);
+      p.box =
+          boxFromPose(Vec3(ped.pose.x, ped.pose.y, 0.0), ped.pose.yaw, Vec3(0.5, 0.6, ped.height));
+      p.block = world_.blockAt(p.box.center2());
+      add(std::move(p), "pedestrian", std::move(ped.trajectory));
+    }
+    sc_.sim.signals = std::move(traffic.plan);
   }
 
   void drawEnvironment() {
