@@ -56,8 +56,9 @@ namespace {
 constexpr double kLaneWidth = 3.5;
 constexpr double kLoopRun = 30.0;     // straight run of a lane beyond the tile's last node (m)
 constexpr double kLoopSpread = 20.0;  // length over which the lane widens into its loop (m)
-constexpr double kLoopExtra = 8.0;    // the loop's radius exceeds the lane offset by this (m)
+constexpr double kLoopExtra = 8.0;    // the inner lane's loop radius exceeds its offset by this (m)
 constexpr double kStopBack = 1.0;     // stop line: this far before the crosswalk (m)
+constexpr double kGuard = 0.25;       // a car over its stop line on red stays this far short (m)
 
 bool isArterial(const World& w, const StreetEdge& e) {
   return e.width >= w.params().city.arterial_width - 1e-9;
@@ -148,10 +149,12 @@ std::vector<Vec2> offsetRight(const std::vector<Vec2>& p, double r) {
 
 // A left-turning loop beyond `end` (direction of travel `u`): from the lane `r` to the right of
 // the centreline to the opposite lane `r` to its left, widening first so that the turn radius
-// is r + kLoopExtra. The loop's first and last points are not included.
-void appendLoop(const Vec2& end, const Vec2& u, double r, std::vector<Vec2>* out) {
+// is r + kLoopExtra * (lane + 1): the loops of a street's two lanes move apart as they widen, so
+// that cars of neighbouring lanes keep their distance where the lanes bend. The loop's first
+// and last points are not included.
+void appendLoop(const Vec2& end, const Vec2& u, double r, int lane, std::vector<Vec2>* out) {
   const Vec2 n = leftOf(u);
-  const double big = r + kLoopExtra;
+  const double big = r + kLoopExtra * (lane + 1);
   out->push_back(end + kLoopRun * u - r * n);
   const Vec2 c = end + (kLoopRun + kLoopSpread) * u;
   constexpr int kSteps = 8;
@@ -381,13 +384,14 @@ CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, cons
         fwd_at.push_back(ring.pts.size());
         ring.pts.push_back(p);
       }
-      appendLoop(centre.back(), (centre.back() - centre[centre.size() - 2]).normalized(), r,
+      appendLoop(centre.back(), (centre.back() - centre[centre.size() - 2]).normalized(), r, lane,
                  &ring.pts);
       for (const auto& p : rev) {
         rev_at.push_back(ring.pts.size());
         ring.pts.push_back(p);
       }
-      appendLoop(back.back(), (back.back() - back[back.size() - 2]).normalized(), r, &ring.pts);
+      appendLoop(back.back(), (back.back() - back[back.size() - 2]).normalized(), r, lane,
+                 &ring.pts);
       ring.pts.push_back(ring.pts.front());
       ring.finish();
       ring.inside_length = 2.0 * inside;
@@ -535,6 +539,22 @@ CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, cons
           ds = std::max(0.0, dist);
           v1 = 0.0;
         }
+        // A car past its stop line but short of the box (it went on yellow and was slowed by the
+        // car ahead) stays kGuard short of the box while its signal is red at the end of the
+        // step (kGuard: more than the written trajectories' tolerance).
+        if (!ring.stops.empty()) {
+          const double fw = ring.wrap(front);
+          for (const StopLine& st : ring.stops) {
+            const double entry = st.stop + kStopBack, guard = entry - kGuard;
+            if (fw <= st.stop || fw > entry || fw + ds <= guard) continue;
+            const SignalState end_state =
+                plan.state(plan.intersections[st.intersection], st.axis, t + idm.step);
+            if (end_state == SignalState::kRed || end_state == SignalState::kLeftArrow) {
+              ds = std::max(0.0, guard - fw);
+              v1 = 0.0;
+            }
+          }
+        }
         Car& nx = next[i];
         nx = c;
         nx.s = c.s + ds;
@@ -580,8 +600,10 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
   };
   out.push_back(shifted(sampleTrajectory(tr, t0)));
   out.front().t = 0.0;
-  for (const auto& p : tr) {
-    if (p.t > t0 + 1e-6 && p.t < t0 + length - 1e-6) out.push_back(shifted(p));
+  const auto by_t = [](const TrajectoryPoint& p, double t) { return p.t < t; };
+  for (auto it = std::lower_bound(tr.begin(), tr.end(), t0 + 1e-6, by_t);
+       it != tr.end() && it->t < t0 + length - 1e-6; ++it) {
+    if (it->t > t0 + 1e-6) out.push_back(shifted(*it));
   }
   TrajectoryPoint last = shifted(sampleTrajectory(tr, t0 + length));
   last.t = roundMilli(length);
@@ -599,7 +621,7 @@ struct RunCache {
 // The car run of `world` over kCachedHorizon, computed once per world parameters in a process.
 std::shared_ptr<const CityTraffic> cachedRun(const World& world, const IdmParams& idm) {
   static RunCache cache;
-  char idm_key[160];
+  char idm_key[256];
   std::snprintf(idm_key, sizeof(idm_key), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g", idm.time_gap,
                 idm.min_gap, idm.max_accel, idm.comfort_decel, idm.yellow_stop_decel, idm.step,
                 idm.warm_up);

@@ -40,9 +40,14 @@ GeneratorConfig quickConfig() {
   return c;
 }
 
+// A generated city scenario whose sim config is read back from its written sim_config.json, so
+// that every check below judges what the file holds (rounding and all).
 const Scenario& cityScenario() {
-  static const Scenario s =
-      generateScenario(cityWorld(), quickConfig(), ScenarioClass::kAreaSearch, 7);
+  static const Scenario s = [] {
+    Scenario g = generateScenario(cityWorld(), quickConfig(), ScenarioClass::kAreaSearch, 7);
+    g.sim = parseSimConfig(simConfigJson(g.sim), "sim_config.json");
+    return g;
+  }();
   return s;
 }
 
@@ -247,6 +252,7 @@ TEST(CityTraffic, NoCarEntersAnIntersectionOnRed) {
   const EntryReport wrong = checkEntries(traffic, shiftedHalfACycle(plan), s.sim.duration, 0.05);
   EXPECT_GT(wrong.on_red, wrong.entries / 4);
   const EntryReport r = checkEntries(traffic, plan, s.sim.duration, 0.05);
+  EXPECT_GE(plan.intersections.size(), 20u);
   EXPECT_GT(r.entries, 500);
   EXPECT_EQ(r.on_red, 0);
   std::printf("intersections %zu, entries %d, on red %d (shifted plan: %d of %d)\n",
