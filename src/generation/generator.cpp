@@ -852,6 +852,7 @@ class ScenarioBuilder {
         break;
       }
     }
+    if (world_.params().type == WorldType::kCity) addBuildingKoz(tp);
 
     finishStaticTarget(target, {&m.aois.front()}, nullptr);
   }
@@ -1301,6 +1302,37 @@ class ScenarioBuilder {
       p.box = boxFromPose(Vec3(traj[0].x, traj[0].y, 0.0), traj[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.55, 1.9))));
       add(std::move(p), "pedestrian", std::move(traj));
     }
+  }
+
+  // In a city area search, half the time: a restricted KOZ that is a building's volume (its
+  // footprint grown by kBuildingStandoff, from the ground to kBuildingStandoff above the roof),
+  // a building of the target's AOI whose zone stays 15 m clear of the target. Drawn from a
+  // stream of its own, so that the rest of the scenario is unchanged.
+  void addBuildingKoz(const Vec2& target) {
+    constexpr double kBuildingStandoff = 5.0;
+    Rng r(deriveSeed(seed_, 0x424C44474B4F5AULL));
+    if (!r.bernoulli(0.5)) return;
+    const Polygon& aoi = sc_.mission.aois.front().polygon;
+    std::vector<const Entity*> fits;
+    for (const auto& e : world_.entities()) {
+      if (e.cls != EntityClass::kBuilding || !aoi.contains(e.box.center2())) continue;
+      const Polygon zone =
+          geometry::orientedRectangle(e.box.center2(), e.box.size.x() + 2 * kBuildingStandoff,
+                                      e.box.size.y() + 2 * kBuildingStandoff, e.box.yaw);
+      if (zone.contains(target) || zone.distance(target) < 15.0) continue;
+      fits.push_back(&e);
+    }
+    if (fits.empty()) return;
+    const Entity& b = *fits[static_cast<std::size_t>(
+        r.uniformInt(0, static_cast<long>(fits.size()) - 1))];
+    KeepOutZone k = makeKoz(
+        roundPolygon(geometry::orientedRectangle(b.box.center2(),
+                                                 b.box.size.x() + 2 * kBuildingStandoff,
+                                                 b.box.size.y() + 2 * kBuildingStandoff, b.box.yaw)),
+        "restricted");
+    k.alt_min = 0.0;
+    k.alt_max = std::ceil(b.box.maxZ() + kBuildingStandoff);
+    sc_.mission.kozs.push_back(k);
   }
 
   // The city's signalised ambient traffic and crowd (scenario/city_traffic.h), drawn from a
