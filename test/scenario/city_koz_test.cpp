@@ -18,14 +18,7 @@ namespace {
 using geometry::Vec2;
 using testing::shippedConfig;
 
-const World& cityWorld() {
-  static const World w = [] {
-    WorldParams p = loadWorldParams(defaultConfigDir() + "/world.json");
-    p.type = WorldType::kCity;
-    return generateWorld(p);
-  }();
-  return w;
-}
+const World& cityWorld() { return testing::shippedCityWorld(); }
 
 // The building whose volume the zone is (its footprint grown by 5 m, same centre and yaw), or
 // nullptr.

@@ -25,14 +25,7 @@ using geometry::OrientedBox;
 using geometry::Vec2;
 using testing::shippedConfig;
 
-const World& cityWorld() {
-  static const World w = [] {
-    WorldParams p = loadWorldParams(defaultConfigDir() + "/world.json");
-    p.type = WorldType::kCity;
-    return generateWorld(p);
-  }();
-  return w;
-}
+const World& cityWorld() { return testing::shippedCityWorld(); }
 
 GeneratorConfig quickConfig() {
   GeneratorConfig c = shippedConfig();
