@@ -14,6 +14,7 @@
 #include "hameritt/planning/validity.h"
 #include "hameritt/planning/vehicle_routes.h"
 #include "hameritt/scenario/catalog.h"
+#include "hameritt/scenario/city_traffic.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/trajectory.h"
@@ -82,8 +83,11 @@ class ScenarioBuilder {
       if (e.cls == EntityClass::kPedestrian) ++world_peds;
     }
     // Scenario ids are drawn from a shuffled pool so that neither order nor number reveals a role.
-    for (int i = 1; i <= 96; ++i) car_ids_.push_back(world_cars + i);
-    for (int i = 1; i <= 48; ++i) ped_ids_.push_back(world_peds + i);
+    const bool city = world.params().type == WorldType::kCity;
+    const int car_pool = 96 + (city ? cityCarBound(world) : 0);
+    const int ped_pool = 48 + (city ? cityPedestrianBound(world) : 0);
+    for (int i = 1; i <= car_pool; ++i) car_ids_.push_back(world_cars + i);
+    for (int i = 1; i <= ped_pool; ++i) ped_ids_.push_back(world_peds + i);
     rng_.shuffle(car_ids_);
     rng_.shuffle(ped_ids_);
   }
@@ -113,7 +117,11 @@ class ScenarioBuilder {
         break;
     }
     if (cls_ != ScenarioClass::kAvoid) placeUavStart();
-    addTraffic();
+    if (world_.params().type == WorldType::kCity) {
+      addCityTraffic();
+    } else {
+      addTraffic();
+    }
     drawEnvironment();
     s.duration = m.time_limit;
     finalizeRelations();
@@ -933,6 +941,7 @@ class ScenarioBuilder {
         break;
       }
     }
+    if (world_.params().type == WorldType::kCity) addBuildingKoz(tp);
 
     finishStaticTarget(target, {&m.aois.front()}, nullptr);
   }
@@ -1646,6 +1655,62 @@ class ScenarioBuilder {
       p.box = boxFromPose(Vec3(traj[0].x, traj[0].y, 0.0), traj[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.55, 1.9))));
       add(std::move(p), "pedestrian", std::move(traj));
     }
+  }
+
+  // In a city area search, half the time: a restricted KOZ that is a building's volume (its
+  // footprint grown by kBuildingStandoff, from the ground to kBuildingStandoff above the roof),
+  // a building of the target's AOI whose zone stays 15 m clear of the target. Drawn from a
+  // stream of its own, so that the rest of the scenario is unchanged.
+  void addBuildingKoz(const Vec2& target) {
+    constexpr double kBuildingStandoff = 5.0;
+    Rng r(deriveSeed(seed_, 0x424C44474B4F5AULL));
+    if (!r.bernoulli(0.5)) return;
+    const Polygon& aoi = sc_.mission.aois.front().polygon;
+    std::vector<const Entity*> fits;
+    for (const auto& e : world_.entities()) {
+      if (e.cls != EntityClass::kBuilding || !aoi.contains(e.box.center2())) continue;
+      const Polygon zone =
+          geometry::orientedRectangle(e.box.center2(), e.box.size.x() + 2 * kBuildingStandoff,
+                                      e.box.size.y() + 2 * kBuildingStandoff, e.box.yaw);
+      if (zone.contains(target) || zone.distance(target) < 15.0) continue;
+      fits.push_back(&e);
+    }
+    if (fits.empty()) return;
+    const Entity& b = *fits[static_cast<std::size_t>(
+        r.uniformInt(0, static_cast<long>(fits.size()) - 1))];
+    KeepOutZone k = makeKoz(
+        roundPolygon(geometry::orientedRectangle(b.box.center2(),
+                                                 b.box.size.x() + 2 * kBuildingStandoff,
+                                                 b.box.size.y() + 2 * kBuildingStandoff, b.box.yaw)),
+        "restricted");
+    k.alt_min = 0.0;
+    k.alt_max = std::ceil(b.box.maxZ() + kBuildingStandoff);
+    sc_.mission.kozs.push_back(k);
+  }
+
+  // The city's signalised ambient traffic and crowd (scenario/city_traffic.h), drawn from a
+  // stream of its own and simulated over the mission's time limit.
+  void addCityTraffic() {
+    CityTraffic traffic = simulateCityTraffic(world_, deriveSeed(seed_, 0x4349545954524146ULL),
+                                              sc_.mission.time_limit);
+    for (auto& car : traffic.cars) {
+      const TrajectoryPoint& p0 = car.trajectory.front();
+      Entity e = makeCar(*car.model, car.color, Vec3(p0.x, p0.y, p0.z), p0.yaw);
+      e.attributes.set("lane", car.lane);
+      add(std::move(e), "traffic", std::move(car.trajectory));
+    }
+    for (auto& ped : traffic.pedestrians) {
+      Entity p;
+      p.id = nextPedId();
+      p.cls = EntityClass::kPedestrian;
+      p.attributes.set("clothing_color", ped.clothing_color);
+      p.attributes.set("activity", ped.activity);
+      p.box =
+          boxFromPose(Vec3(ped.pose.x, ped.pose.y, 0.0), ped.pose.yaw, Vec3(0.5, 0.6, ped.height));
+      p.block = world_.blockAt(p.box.center2());
+      add(std::move(p), "pedestrian", std::move(ped.trajectory));
+    }
+    sc_.sim.signals = std::move(traffic.plan);
   }
 
   void drawEnvironment() {

@@ -51,6 +51,15 @@ const std::vector<CityField>& cityFieldTable() {
       {"tree_spacing", &CityParams::tree_spacing, 6.0, 40.0},
       {"bench_probability", &CityParams::bench_probability, 0.0, 1.0},
       {"bus_stop_probability", &CityParams::bus_stop_probability, 0.0, 1.0},
+      {"signal_green", &CityParams::signal_green, 5.0, 60.0},
+      {"signal_yellow", &CityParams::signal_yellow, 3.0, 6.0},
+      {"signal_left", &CityParams::signal_left, 0.0, 20.0},
+      {"signal_all_red", &CityParams::signal_all_red, 1.0, 5.0},
+      {"vehicles_per_km2", &CityParams::vehicles_per_km2, 0.0, 400.0},
+      {"pedestrians_per_km2", &CityParams::pedestrians_per_km2, 0.0, 2000.0},
+      {"crossing_share", &CityParams::crossing_share, 0.0, 1.0},
+      {"jaywalk_probability", &CityParams::jaywalk_probability, 0.0, 1.0},
+      {"bus_queue_share", &CityParams::bus_queue_share, 0.0, 0.5},
   };
   return k;
 }

@@ -377,6 +377,22 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
   w.key("salt_pepper_probability").value(s.perturbations.salt_pepper_probability);
   w.key("motion_blur_px").value(s.perturbations.motion_blur_px);
   w.endObject().endObject();
+  if (s.signals) {
+    const SignalPlan& sp = *s.signals;
+    w.key("signals").beginObject();
+    w.key("left").value(sp.left).key("green").value(sp.green).key("yellow").value(sp.yellow);
+    w.key("all_red").value(sp.all_red).key("sidewalk").value(sp.sidewalk);
+    w.key("cycle").value(sp.cycle());
+    w.key("intersections").beginArray();
+    for (const auto& i : sp.intersections) {
+      w.beginObject().key("id").value(i.id).key("x").value(i.position.x());
+      w.key("y").value(i.position.y()).key("offset").value(i.offset);
+      w.key("heading").numbers({i.heading[0], i.heading[1]});
+      w.key("width").numbers({i.width[0], i.width[1]});
+      w.endObject();
+    }
+    w.endArray().endObject();
+  }
   if (s.spec) {
     w.key("spec").beginObject();
     w.key("file").value(s.spec->file).key("hash").value(hex64(s.spec->hash));

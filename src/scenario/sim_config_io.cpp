@@ -307,6 +307,41 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
     n.finish();
     p.finish();
   }
+  if (root.has("signals")) {
+    Obj sg = root.object("signals");
+    SignalPlan plan;
+    plan.left = sg.numberIn("left", 0, 600);
+    plan.green = sg.numberIn("green", 0.001, 600);
+    plan.yellow = sg.numberIn("yellow", 0.001, 600);
+    plan.all_red = sg.numberIn("all_red", 0, 600);
+    plan.sidewalk = sg.numberIn("sidewalk", 0.001, 100);
+    const double cycle = sg.number("cycle");
+    if (std::abs(cycle - plan.cycle()) > 1e-6) {
+      sg.error("cycle", "expected 2 * (left + green + yellow + all_red) = " + fmt(plan.cycle()) +
+                            ", got " + fmt(cycle));
+    }
+    const json& list = sg.array("intersections");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      Obj o(list[i], idx("signals.intersections", i), file);
+      SignalizedIntersection si;
+      si.id = o.string("id");
+      si.position = geometry::Vec2(o.number("x"), o.number("y"));
+      si.offset = o.numberIn("offset", 0, plan.cycle());
+      for (const char* key : {"heading", "width"}) {
+        const json& a = o.get(key);
+        if (!a.is_array() || a.size() != 2 || !a[0].is_number() || !a[1].is_number()) {
+          o.fail(o.at(key), "expected an array of 2 numbers", a);
+        }
+        double* dst = std::string(key) == "heading" ? si.heading : si.width;
+        dst[0] = a[0].get<double>();
+        dst[1] = a[1].get<double>();
+      }
+      o.finish();
+      plan.intersections.push_back(si);
+    }
+    sg.finish();
+    s.signals = plan;
+  }
   if (root.has("spec")) {
     Obj sp = root.object("spec");
     SpecProvenance prov;

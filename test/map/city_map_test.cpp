@@ -35,11 +35,17 @@ const CityMap& cityMap() {
     const scenario::Scenario s =
         scenario::generateScenario(c.world, cfg, scenario::ScenarioClass::kAreaSearch, 3);
     json mission = json::parse(scenario::missionJson(s.mission));
-    const json sim = json::parse(scenario::simConfigJson(s.sim));
-    // Only the world: no overlays that would tint it.
+    json sim = json::parse(scenario::simConfigJson(s.sim));
+    // Only the world: no overlays that would tint it, and none of the city's traffic and crowd
+    // (their markers and paths cover the corners where the traffic lights stand).
     for (const char* k : {"areas_of_interest", "keep_out_zones", "area_priors", "routes"}) {
       mission[k] = json::array();
     }
+    json kept = json::array();
+    for (const auto& e : sim["entities"]) {
+      if (e["role"] != "traffic" && e["role"] != "pedestrian") kept.push_back(e);
+    }
+    sim["entities"] = kept;
     MapStyle style;
     style.crop_to_interest = false;
     c.img = drawScenarioMap(c.world, mission, sim, style);

@@ -25,6 +25,16 @@ inline const World& shippedWorld() {
   return w;
 }
 
+// The shipped world parameters with the city type.
+inline const World& shippedCityWorld() {
+  static const World w = [] {
+    WorldParams p = loadWorldParams(defaultConfigDir() + "/world.json");
+    p.type = WorldType::kCity;
+    return generateWorld(p);
+  }();
+  return w;
+}
+
 // What f throws as a ConfigError, or "(no error)".
 inline std::string messageOf(const std::function<void()>& f) {
   try {

@@ -287,6 +287,43 @@ struct SpecProvenance {
   std::vector<std::pair<std::string, std::variant<double, bool>>> values;
 };
 
+// The signal phase of one approach axis of a signalised intersection at a time.
+enum class SignalState {
+  kGreen,      // through traffic may enter
+  kYellow,     // through traffic may enter only when it cannot stop in time
+  kLeftArrow,  // protected left turns only; through traffic waits
+  kRed,        // nobody of this axis enters (the other axis moves, or all-red clearance)
+};
+// "green", "yellow", "left", "red".
+const char* toString(SignalState s);
+
+// One signalised intersection of the city's traffic plan: the street node, the direction and
+// right-of-way of its two streets (axis 0 runs roughly north-south, axis 1 east-west) and the
+// offset of its cycle.
+struct SignalizedIntersection {
+  std::string id;  // "signal_03"
+  geometry::Vec2 position{0, 0};
+  double heading[2] = {0.0, 0.0};  // direction of each axis' street at the node (rad)
+  double width[2] = {0.0, 0.0};    // right-of-way of each axis' street (m)
+  double offset = 0.0;             // the cycle starts at t = offset (s, in [0, cycle))
+};
+
+// The fixed-time signal plan of every signalised intersection (cycle: axis 0 protected left,
+// green, yellow, all-red, then the same for axis 1). Pedestrians cross an axis' street while the
+// other axis has green.
+struct SignalPlan {
+  double left = 7.0;
+  double green = 15.0;
+  double yellow = 4.0;
+  double all_red = 2.0;
+  double sidewalk = 3.0;  // sidewalk width: crosswalks run on the cross street's sidewalk band
+  std::vector<SignalizedIntersection> intersections;
+
+  double cycle() const { return 2.0 * (left + green + yellow + all_red); }
+  // The phase of `axis` (0 or 1) at intersection i at time t.
+  SignalState state(const SignalizedIntersection& i, int axis, double t) const;
+};
+
 struct SimConfig {
   std::string scenario_id;
   ScenarioClass cls = ScenarioClass::kAreaSearch;
@@ -301,6 +338,7 @@ struct SimConfig {
   UavSpec uav;
   Perturbations perturbations;
   std::optional<SpecProvenance> spec;  // written only for scenarios generated from a spec
+  std::optional<SignalPlan> signals;   // the city's signal plan; absent in the suburb
 };
 
 struct Scenario {

@@ -52,6 +52,16 @@ struct CityParams {
   double tree_spacing = 15.0;                // street trees along local-street kerbs, [6, 40]
   double bench_probability = 0.3;            // per block side, [0, 1]
   double bus_stop_probability = 0.6;         // per arterial block side, [0, 1]
+  // Signals and ambient traffic (generated per scenario into sim_config.json).
+  double signal_green = 15.0;          // through green of each axis (s), [5, 60]
+  double signal_yellow = 4.0;          // [3, 6]
+  double signal_left = 7.0;            // protected left arrow before each green (s), [0, 20]
+  double signal_all_red = 2.0;         // clearance after each yellow (s), [1, 5]
+  double vehicles_per_km2 = 170.0;     // ambient cars driving the arterials, [0, 400]
+  double pedestrians_per_km2 = 400.0;  // [0, 2000]
+  double crossing_share = 0.3;         // share of pedestrians who cross a street, [0, 1]
+  double jaywalk_probability = 0.15;   // a crossing is mid-block, off the signals, [0, 1]
+  double bus_queue_share = 0.08;       // share of pedestrians queueing at bus stops, [0, 0.5]
 
   // Throws ConfigError "world.city.KEY: expected LO to HI, got V" for the first bad field.
   void validate() const;

@@ -1,0 +1,811 @@
+// Signalised traffic and crowds of the city world type. Cars: every interior arterial is a
+// corridor; each of its four lanes, joined with the opposite lane by a turning loop beyond each
+// end of the tile, is a closed ring on which a fixed number of cars drive with the Intelligent
+// Driver Model, stopping at the signals' stop lines. Pedestrians: sidewalk strolls, crossings at
+// the signalised crosswalks while the crossed street is red, mid-block jaywalking across local
+// streets and queues at the bus stops.
+
+#include "hameritt/scenario/city_traffic.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+
+#include "hameritt/geometry/segment.h"
+#include "hameritt/scenario/error.h"
+#include "hameritt/scenario/rng.h"
+#include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/trajectory.h"
+
+namespace hameritt::scenario {
+
+using geometry::Vec2;
+
+const char* toString(SignalState s) {
+  switch (s) {
+    case SignalState::kGreen:
+      return "green";
+    case SignalState::kYellow:
+      return "yellow";
+    case SignalState::kLeftArrow:
+      return "left";
+    case SignalState::kRed:
+      return "red";
+  }
+  return "red";
+}
+
+SignalState SignalPlan::state(const SignalizedIntersection& i, int axis, double t) const {
+  const double c = cycle();
+  double tau = std::fmod(t - i.offset, c);
+  if (tau < 0) tau += c;
+  if (axis == 1) {
+    tau -= 0.5 * c;
+    if (tau < 0) tau += c;
+  }
+  if (tau < left) return SignalState::kLeftArrow;
+  if (tau < left + green) return SignalState::kGreen;
+  if (tau < left + green + yellow) return SignalState::kYellow;
+  return SignalState::kRed;
+}
+
+namespace {
+
+constexpr double kLaneWidth = 3.5;
+constexpr double kLoopRun = 30.0;     // straight run of a lane beyond the tile's last node (m)
+constexpr double kLoopSpread = 20.0;  // length over which the lane widens into its loop (m)
+constexpr double kLoopExtra = 8.0;    // the inner lane's loop radius exceeds its offset by this (m)
+constexpr double kStopBack = 1.0;     // stop line: this far before the crosswalk (m)
+constexpr double kGuard = 0.25;       // a car over its stop line on red stays this far short (m)
+
+bool isArterial(const World& w, const StreetEdge& e) {
+  return e.width >= w.params().city.arterial_width - 1e-9;
+}
+
+// 0: a street running roughly north-south, 1: east-west.
+int axisOf(const World& w, const StreetEdge& e) {
+  const Vec2 d = w.nodes()[e.b].position - w.nodes()[e.a].position;
+  return std::abs(d.x()) > std::abs(d.y()) ? 1 : 0;
+}
+
+bool onBoundary(const World& w, const Vec2& p) {
+  const auto b = w.bounds();
+  return p.x() <= b.min.x() + 1e-6 || p.x() >= b.max.x() - 1e-6 || p.y() <= b.min.y() + 1e-6 ||
+         p.y() >= b.max.y() - 1e-6;
+}
+
+Vec2 unit(double heading) { return {std::cos(heading), std::sin(heading)}; }
+Vec2 leftOf(const Vec2& u) { return {-u.y(), u.x()}; }
+
+// A stop line on a lane ring: the car's front stays at or before `stop` while its signal does
+// not let it enter; the intersection box it guards ends at `exit`.
+struct StopLine {
+  double stop = 0.0;
+  double exit = 0.0;
+  int intersection = -1;
+  int axis = 0;
+};
+
+// A closed lane polyline with arc lengths and its stop lines (sorted by `stop`).
+struct LaneRing {
+  std::string name;
+  std::vector<Vec2> pts;  // closed: last == first
+  std::vector<double> cum;
+  double length = 0.0;
+  double inside_length = 0.0;  // length within the tile (both directions)
+  std::vector<StopLine> stops;
+
+  void finish() {
+    cum.assign(1, 0.0);
+    for (std::size_t i = 1; i < pts.size(); ++i)
+      cum.push_back(cum.back() + (pts[i] - pts[i - 1]).norm());
+    length = cum.back();
+  }
+  double wrap(double s) const {
+    double m = std::fmod(s, length);
+    return m < 0 ? m + length : m;
+  }
+  // Index of the segment holding arc length s (wrapped).
+  std::size_t segment(double s) const {
+    const auto it = std::upper_bound(cum.begin(), cum.end(), wrap(s));
+    return std::min<std::size_t>(static_cast<std::size_t>(it - cum.begin()) - 1, pts.size() - 2);
+  }
+  Vec2 at(double s) const {
+    const std::size_t k = segment(s);
+    const double u = (wrap(s) - cum[k]) / std::max(1e-9, cum[k + 1] - cum[k]);
+    return pts[k] + u * (pts[k + 1] - pts[k]);
+  }
+  double yawAt(double s) const {
+    const Vec2 d = at(s + 1.5) - at(s - 1.5);
+    return std::atan2(d.y(), d.x());
+  }
+};
+
+// The polyline moved `r` to the right of its direction (mitred at the vertices).
+std::vector<Vec2> offsetRight(const std::vector<Vec2>& p, double r) {
+  std::vector<Vec2> out;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    Vec2 n(0, 0);
+    if (i > 0) {
+      const Vec2 d = (p[i] - p[i - 1]).normalized();
+      n += Vec2(d.y(), -d.x());
+    }
+    if (i + 1 < p.size()) {
+      const Vec2 d = (p[i + 1] - p[i]).normalized();
+      n += Vec2(d.y(), -d.x());
+    }
+    n.normalize();
+    double cosh = 1.0;
+    if (i + 1 < p.size()) {
+      const Vec2 d = (p[i + 1] - p[i]).normalized();
+      cosh = std::max(0.5, n.dot(Vec2(d.y(), -d.x())));
+    }
+    out.push_back(p[i] + (r / cosh) * n);
+  }
+  return out;
+}
+
+// A left-turning loop beyond `end` (direction of travel `u`): from the lane `r` to the right of
+// the centreline to the opposite lane `r` to its left, widening first so that the turn radius
+// is r + kLoopExtra * (lane + 1): the loops of a street's two lanes move apart as they widen, so
+// that cars of neighbouring lanes keep their distance where the lanes bend. The loop's first
+// and last points are not included.
+void appendLoop(const Vec2& end, const Vec2& u, double r, int lane, std::vector<Vec2>* out) {
+  const Vec2 n = leftOf(u);
+  const double big = r + kLoopExtra * (lane + 1);
+  out->push_back(end + kLoopRun * u - r * n);
+  const Vec2 c = end + (kLoopRun + kLoopSpread) * u;
+  constexpr int kSteps = 8;
+  for (int k = 0; k <= kSteps; ++k) {
+    const double phi = geometry::kPi * k / kSteps;
+    // -n rotated counter-clockwise by phi.
+    const Vec2 v = std::cos(phi) * (-n) + std::sin(phi) * u;
+    out->push_back(c + big * v);
+  }
+  out->push_back(end + kLoopRun * u + r * n);
+}
+
+struct Corridor {
+  int axis = 0;
+  std::vector<int> nodes;  // in increasing coordinate of the axis
+};
+
+std::vector<Corridor> arterialCorridors(const World& w) {
+  std::vector<Corridor> out;
+  const auto& edges = w.edges();
+  for (int axis = 0; axis < 2; ++axis) {
+    std::vector<std::vector<int>> at(w.nodes().size());
+    for (int e = 0; e < static_cast<int>(edges.size()); ++e) {
+      if (!isArterial(w, edges[e]) || axisOf(w, edges[e]) != axis) continue;
+      at[edges[e].a].push_back(e);
+      at[edges[e].b].push_back(e);
+    }
+    std::vector<char> used(edges.size(), 0);
+    for (int start = 0; start < static_cast<int>(at.size()); ++start) {
+      if (at[start].size() != 1 || used[at[start][0]]) continue;
+      Corridor c;
+      c.axis = axis;
+      int node = start, edge = at[start][0];
+      c.nodes.push_back(node);
+      while (edge >= 0) {
+        used[edge] = 1;
+        node = edges[edge].a == node ? edges[edge].b : edges[edge].a;
+        c.nodes.push_back(node);
+        int next = -1;
+        for (int e : at[node]) {
+          if (!used[e]) next = e;
+        }
+        edge = next;
+      }
+      const auto coord = [&](int n) {
+        const Vec2 p = w.nodes()[n].position;
+        return axis == 0 ? p.y() : p.x();
+      };
+      if (coord(c.nodes.front()) > coord(c.nodes.back()))
+        std::reverse(c.nodes.begin(), c.nodes.end());
+      bool interior = false;
+      for (int n : c.nodes) interior = interior || !onBoundary(w, w.nodes()[n].position);
+      if (interior && c.nodes.size() >= 3) out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+// A sample of a car's arc length s at time t.
+struct Sample {
+  double t = 0.0;
+  double s = 0.0;
+};
+
+// Simplifies a 1D motion s(t) sampled every `dt` (non-decreasing s): a sample is added where the
+// car passes a ring vertex, and the samples kept are those whose piecewise-linear interpolation
+// stays within `tol` of every sample and ends at every vertex sample (so that positions
+// interpolated between kept samples stay on the lane).
+std::vector<Sample> simplify(const std::vector<double>& s, double dt, const LaneRing& ring,
+                             double tol) {
+  std::vector<Sample> x{{0.0, s[0]}};
+  std::vector<char> hard{1};
+  const std::size_t nv = ring.cum.size();
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    if (s[k] > s[k - 1]) {
+      double base = std::floor(s[k - 1] / ring.length) * ring.length;
+      std::size_t j = ring.segment(s[k - 1]) + 1;
+      for (;;) {
+        const double v = base + ring.cum[j];
+        if (v >= s[k]) break;
+        if (v > s[k - 1]) {
+          const double t = dt * (static_cast<double>(k - 1) + (v - s[k - 1]) / (s[k] - s[k - 1]));
+          x.push_back({t, v});
+          hard.push_back(1);
+        }
+        if (++j == nv) {
+          base += ring.length;
+          j = 1;
+        }
+      }
+    }
+    x.push_back({dt * static_cast<double>(k), s[k]});
+    hard.push_back(0);
+  }
+  hard.back() = 1;
+  std::vector<Sample> keep{x[0]};
+  std::size_t a = 0;
+  while (a + 1 < x.size()) {
+    double lo = -1e300, hi = 1e300;
+    std::size_t e = a + 1;
+    for (std::size_t i = a + 1; i < x.size(); ++i) {
+      const double span = x[i].t - x[a].t;
+      const double slope = span > 0 ? (x[i].s - x[a].s) / span : 0.0;
+      if (i > a + 1 && (slope < lo || slope > hi)) break;
+      e = i;
+      if (hard[i] || span <= 0) break;
+      lo = std::max(lo, (x[i].s - tol - x[a].s) / span);
+      hi = std::min(hi, (x[i].s + tol - x[a].s) / span);
+    }
+    keep.push_back(x[e]);
+    a = e;
+  }
+  return keep;
+}
+
+struct Car {
+  double s = 0.0;  // unwrapped arc length of the centre
+  double v = 0.0;
+  double v0 = 12.0;
+  double length = 4.5;
+  int committed = -1;  // stop line the car crosses on yellow
+  std::size_t out = 0;
+};
+
+}  // namespace
+
+SignalPlan citySignalPlan(const World& world, std::uint64_t seed) {
+  const CityParams& c = world.params().city;
+  SignalPlan plan;
+  plan.left = c.signal_left;
+  plan.green = c.signal_green;
+  plan.yellow = c.signal_yellow;
+  plan.all_red = c.signal_all_red;
+  plan.sidewalk = c.sidewalk_width;
+  Rng rng(deriveSeed(seed, 0x5349474E414CULL));
+  const auto& edges = world.edges();
+  for (int n = 0; n < static_cast<int>(world.nodes().size()); ++n) {
+    const Vec2 p = world.nodes()[n].position;
+    if (onBoundary(world, p)) continue;
+    bool art = false;
+    Vec2 dir[2] = {Vec2(0, 0), Vec2(0, 0)};
+    double width[2] = {0, 0};
+    for (int e : world.adjacency()[n]) {
+      const StreetEdge& se = edges[e];
+      art = art || isArterial(world, se);
+      const int axis = axisOf(world, se);
+      Vec2 d = (world.nodes()[se.a == n ? se.b : se.a].position - p).normalized();
+      if ((axis == 0 && d.y() < 0) || (axis == 1 && d.x() < 0)) d = -d;
+      dir[axis] += d;
+      width[axis] = std::max(width[axis], se.width);
+    }
+    if (!art || width[0] <= 0 || width[1] <= 0) continue;
+    SignalizedIntersection si;
+    char id[32];
+    std::snprintf(id, sizeof(id), "signal_%02d", static_cast<int>(plan.intersections.size()) + 1);
+    si.id = id;
+    si.position = p;
+    for (int a = 0; a < 2; ++a) {
+      si.heading[a] = roundMilli(std::atan2(dir[a].y(), dir[a].x()));
+      si.width[a] = width[a];
+    }
+    si.offset = roundMilli(rng.uniform(0.0, plan.cycle()));
+    plan.intersections.push_back(si);
+  }
+  return plan;
+}
+
+namespace {
+
+double tileArea(const World& w) {
+  const auto b = w.bounds();
+  return (b.max.x() - b.min.x()) * (b.max.y() - b.min.y());
+}
+
+}  // namespace
+
+int cityCarBound(const World& world) {
+  return static_cast<int>(
+             std::ceil(2.0 * world.params().city.vehicles_per_km2 * tileArea(world) / 1e6)) +
+         8;
+}
+
+int cityPedestrianBound(const World& world) {
+  return static_cast<int>(
+             std::ceil(world.params().city.pedestrians_per_km2 * tileArea(world) / 1e6)) +
+         8;
+}
+
+namespace {
+
+// Every ring's cars simulated over [0, horizon] with the plan of `seed`.
+CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, const IdmParams& idm) {
+  const CityParams& cp = world.params().city;
+  CityTraffic out;
+  out.plan = citySignalPlan(world, seed);
+  const SignalPlan& plan = out.plan;
+  const double duration = horizon;
+  const double sw = cp.sidewalk_width;
+  const double area_km2 = tileArea(world) / 1e6;
+  Rng rng(deriveSeed(seed, 0x5452414646494355ULL));
+
+  // Signalised intersection of each node, or -1.
+  std::vector<int> signal_of(world.nodes().size(), -1);
+  for (int i = 0; i < static_cast<int>(plan.intersections.size()); ++i) {
+    for (int n = 0; n < static_cast<int>(world.nodes().size()); ++n) {
+      if ((world.nodes()[n].position - plan.intersections[i].position).norm() < 1e-9)
+        signal_of[n] = i;
+    }
+  }
+
+  // ---------------------------------------------------------------- lanes
+  std::vector<LaneRing> rings;
+  const std::vector<Corridor> corridors = arterialCorridors(world);
+  for (std::size_t ci = 0; ci < corridors.size(); ++ci) {
+    const Corridor& c = corridors[ci];
+    std::vector<Vec2> centre;
+    for (int n : c.nodes) centre.push_back(world.nodes()[n].position);
+    std::vector<Vec2> back(centre.rbegin(), centre.rend());
+    const double inside = geometry::polylineLength(centre);
+    for (int lane = 0; lane < 2; ++lane) {
+      const double r = (0.5 + lane) * kLaneWidth;
+      LaneRing ring;
+      ring.name = "lane_" + std::to_string(ci + 1) + "_" + std::to_string(lane + 1);
+      const std::vector<Vec2> fwd = offsetRight(centre, r), rev = offsetRight(back, r);
+      std::vector<std::size_t> fwd_at, rev_at;
+      for (const auto& p : fwd) {
+        fwd_at.push_back(ring.pts.size());
+        ring.pts.push_back(p);
+      }
+      appendLoop(centre.back(), (centre.back() - centre[centre.size() - 2]).normalized(), r, lane,
+                 &ring.pts);
+      for (const auto& p : rev) {
+        rev_at.push_back(ring.pts.size());
+        ring.pts.push_back(p);
+      }
+      appendLoop(back.back(), (back.back() - back[back.size() - 2]).normalized(), r, lane,
+                 &ring.pts);
+      ring.pts.push_back(ring.pts.front());
+      ring.finish();
+      ring.inside_length = 2.0 * inside;
+      const int other = 1 - c.axis;
+      for (std::size_t k = 0; k < c.nodes.size(); ++k) {
+        const int si = signal_of[c.nodes[k]];
+        if (si < 0) continue;
+        const double half = 0.5 * plan.intersections[si].width[other] + sw;
+        for (double s_node : {ring.cum[fwd_at[k]], ring.cum[rev_at[c.nodes.size() - 1 - k]]}) {
+          ring.stops.push_back({s_node - half - kStopBack, s_node + half, si, c.axis});
+        }
+      }
+      std::sort(ring.stops.begin(), ring.stops.end(),
+                [](const StopLine& a, const StopLine& b) { return a.stop < b.stop; });
+      rings.push_back(std::move(ring));
+    }
+  }
+  double inside_total = 0.0;
+  for (const auto& r : rings) inside_total += r.inside_length;
+
+  // ---------------------------------------------------------------- cars
+  const int car_bound = cityCarBound(world);
+  const double steps_warm = std::ceil(idm.warm_up / idm.step);
+  const std::size_t steps = static_cast<std::size_t>(std::ceil(duration / idm.step));
+  const double sqrt_ab = std::sqrt(idm.max_accel * idm.comfort_decel);
+  for (std::size_t ri = 0; ri < rings.size() && inside_total > 0; ++ri) {
+    const LaneRing& ring = rings[ri];
+    const double want = cp.vehicles_per_km2 * area_km2 * ring.length / inside_total;
+    int n = static_cast<int>(std::floor(want + rng.unit()));
+    n = std::min(n, static_cast<int>(ring.length / 15.0));
+    std::vector<Car> cars;
+    std::vector<const catalog::CarModel*> models;
+    std::vector<std::string> colors;
+    const double base = n > 0 ? ring.length / n : 0.0;
+    auto inZone = [&](double s, double half_len) {
+      for (const auto& st : ring.stops) {
+        if (ring.wrap(s) + half_len > st.stop - 0.5 && ring.wrap(s) - half_len < st.exit + 0.5)
+          return &st;
+      }
+      return static_cast<const StopLine*>(nullptr);
+    };
+    for (int i = 0; i < n; ++i) {
+      Car car;
+      const catalog::CarModel& m = catalog::pickModel(rng);
+      const std::string color = catalog::pick(rng, catalog::carColors());
+      car.length = m.length;
+      car.v0 = rng.uniform(11.0, 14.0);
+      car.s = i * base + rng.uniform(0.0, 0.4 * base);
+      if (const StopLine* st = inZone(car.s, 0.5 * car.length))
+        car.s = st->stop - 0.5 * car.length - 0.5;
+      if (!cars.empty() && car.s - cars.back().s < 0.5 * (car.length + cars.back().length) + 8.0)
+        continue;
+      cars.push_back(car);
+      models.push_back(&m);
+      colors.push_back(color);
+    }
+    if (cars.size() >= 2) {
+      const Car& f = cars.front();
+      const Car& l = cars.back();
+      if (f.s + ring.length - l.s < 0.5 * (f.length + l.length) + 8.0) {
+        cars.pop_back();
+        models.pop_back();
+        colors.pop_back();
+      }
+    }
+    const std::size_t nc = cars.size();
+    if (nc == 0) continue;
+    std::vector<std::vector<double>> track(nc);
+    std::vector<Car> next = cars;
+    for (std::size_t k = 0; k <= static_cast<std::size_t>(steps_warm) + steps; ++k) {
+      const double t = (static_cast<double>(k) - steps_warm) * idm.step;
+      if (t >= -1e-9) {
+        for (std::size_t i = 0; i < nc; ++i) track[i].push_back(cars[i].s);
+      }
+      if (k == static_cast<std::size_t>(steps_warm) + steps) break;
+      for (std::size_t i = 0; i < nc; ++i) {
+        const Car& c = cars[i];
+        const Car& lead = cars[(i + 1) % nc];
+        double lead_s = lead.s;
+        if (i + 1 == nc) lead_s += ring.length;
+        const double gap = nc == 1 ? 1e9 : lead_s - c.s - 0.5 * (c.length + lead.length);
+        const double lead_v = nc == 1 ? c.v : lead.v;
+        // The next stop line ahead of the front.
+        const double front = c.s + 0.5 * c.length;
+        double dist = 1e9;
+        int stop_idx = -1;
+        if (!ring.stops.empty()) {
+          const double fw = ring.wrap(front);
+          auto it = std::lower_bound(ring.stops.begin(), ring.stops.end(), fw,
+                                     [](const StopLine& s, double v) { return s.stop < v; });
+          double lap = 0.0;
+          if (it == ring.stops.end()) {
+            it = ring.stops.begin();
+            lap = ring.length;
+          }
+          stop_idx = static_cast<int>(it - ring.stops.begin());
+          dist = it->stop + lap - fw;
+        }
+        bool blocked = false;
+        int commit = c.committed;
+        if (stop_idx >= 0 && dist < 200.0) {
+          const StopLine& st = ring.stops[stop_idx];
+          const SignalState state = plan.state(plan.intersections[st.intersection], st.axis, t);
+          if (state == SignalState::kRed || state == SignalState::kLeftArrow) {
+            blocked = true;
+          } else if (state == SignalState::kYellow && commit != stop_idx) {
+            if (dist >= c.v * c.v / (2.0 * idm.yellow_stop_decel) - 1e-9) {
+              blocked = true;
+            } else {
+              commit = stop_idx;
+            }
+          }
+          // Do not enter the box without room behind the leader beyond it.
+          const double box = st.exit - st.stop;
+          if (!blocked && commit != stop_idx && nc > 1 && gap > dist &&
+              gap + 3.0 * lead_v < dist + box + c.length + idm.min_gap) {
+            blocked = true;
+          }
+        }
+        auto idmAccel = [&](double s_gap, double dv, double s0) {
+          const double s_star = s0 + std::max(0.0, c.v * idm.time_gap + c.v * dv / (2.0 * sqrt_ab));
+          const double g = std::max(s_gap, 0.01);
+          return -idm.max_accel * (s_star / g) * (s_star / g);
+        };
+        const double r = c.v / c.v0;
+        double acc = idm.max_accel * (1.0 - r * r * r * r);
+        if (nc > 1) acc += idmAccel(gap, c.v - lead_v, idm.min_gap);
+        if (blocked) {
+          acc = std::min(acc, idm.max_accel * (1.0 - r * r * r * r) + idmAccel(dist, c.v, 0.5));
+        }
+        acc = std::max(acc, -9.0);
+        double v1 = c.v + acc * idm.step;
+        double ds = 0.0;
+        if (v1 < 0) {
+          ds = acc < 0 ? c.v * c.v / (-2.0 * acc) : 0.0;
+          v1 = 0.0;
+        } else {
+          ds = 0.5 * (c.v + v1) * idm.step;
+        }
+        if (nc > 1 && ds > std::max(0.0, gap - idm.min_gap)) {
+          ds = std::max(0.0, gap - idm.min_gap);
+          v1 = std::min(v1, lead_v);
+        }
+        if (blocked && ds > std::max(0.0, dist)) {
+          ds = std::max(0.0, dist);
+          v1 = 0.0;
+        }
+        // A car past its stop line but short of the box (it went on yellow and was slowed by the
+        // car ahead) stays kGuard short of the box while its signal is red at the end of the
+        // step (kGuard: more than the written trajectories' tolerance).
+        if (!ring.stops.empty()) {
+          const double fw = ring.wrap(front);
+          for (const StopLine& st : ring.stops) {
+            const double entry = st.stop + kStopBack, guard = entry - kGuard;
+            if (fw <= st.stop || fw > entry || fw + ds <= guard) continue;
+            const SignalState end_state =
+                plan.state(plan.intersections[st.intersection], st.axis, t + idm.step);
+            if (end_state == SignalState::kRed || end_state == SignalState::kLeftArrow) {
+              ds = std::max(0.0, guard - fw);
+              v1 = 0.0;
+            }
+          }
+        }
+        Car& nx = next[i];
+        nx = c;
+        nx.s = c.s + ds;
+        nx.v = v1;
+        nx.committed = commit;
+      }
+      cars.swap(next);
+    }
+    for (std::size_t i = 0; i < nc; ++i) {
+      CityCar car;
+      car.model = models[i];
+      car.color = colors[i];
+      car.lane = ring.name;
+      for (const Sample& q : simplify(track[i], idm.step, ring, 0.1)) {
+        const Vec2 p = ring.at(q.s);
+        TrajectoryPoint tp;
+        tp.t = roundMilli(q.t);
+        if (!car.trajectory.empty() && tp.t <= car.trajectory.back().t) continue;
+        tp.x = roundMilli(p.x());
+        tp.y = roundMilli(p.y());
+        tp.yaw = roundMilli(geometry::wrapPi(ring.yawAt(q.s)));
+        car.trajectory.push_back(tp);
+      }
+      out.cars.push_back(std::move(car));
+    }
+  }
+  if (static_cast<int>(out.cars.size()) > car_bound) {
+    throw GenerationError("city traffic: " + std::to_string(out.cars.size()) +
+                          " cars exceed the bound " + std::to_string(car_bound));
+  }
+  return out;
+}
+
+// The part of `tr` (over [0, horizon]) within [t0, t0 + length], shifted to start at 0.
+Trajectory window(const Trajectory& tr, double t0, double length) {
+  Trajectory out;
+  auto shifted = [&](TrajectoryPoint p) {
+    p.t = roundMilli(p.t - t0);
+    p.x = roundMilli(p.x);
+    p.y = roundMilli(p.y);
+    p.yaw = roundMilli(p.yaw);
+    return p;
+  };
+  out.push_back(shifted(sampleTrajectory(tr, t0)));
+  out.front().t = 0.0;
+  const auto by_t = [](const TrajectoryPoint& p, double t) { return p.t < t; };
+  for (auto it = std::lower_bound(tr.begin(), tr.end(), t0 + 1e-6, by_t);
+       it != tr.end() && it->t < t0 + length - 1e-6; ++it) {
+    if (it->t > t0 + 1e-6) out.push_back(shifted(*it));
+  }
+  TrajectoryPoint last = shifted(sampleTrajectory(tr, t0 + length));
+  last.t = roundMilli(length);
+  if (last.t > out.back().t) out.push_back(last);
+  return out;
+}
+
+constexpr double kCachedHorizon = 1800.0;  // one run per world serves scenarios up to this long
+
+struct RunCache {
+  std::mutex mutex;
+  std::vector<std::pair<std::string, std::shared_ptr<const CityTraffic>>> runs;  // newest last
+};
+
+// The car run of `world` over kCachedHorizon, computed once per world parameters in a process.
+std::shared_ptr<const CityTraffic> cachedRun(const World& world, const IdmParams& idm) {
+  static RunCache cache;
+  char idm_key[256];
+  std::snprintf(idm_key, sizeof(idm_key), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g", idm.time_gap,
+                idm.min_gap, idm.max_accel, idm.comfort_decel, idm.yellow_stop_decel, idm.step,
+                idm.warm_up);
+  const std::string key = worldParamsJson(world.params()) + idm_key;
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  for (const auto& [k, run] : cache.runs) {
+    if (k == key) return run;
+  }
+  auto run = std::make_shared<const CityTraffic>(
+      runCars(world, deriveSeed(world.params().seed, 0x43415252554EULL), kCachedHorizon, idm));
+  if (cache.runs.size() >= 4) cache.runs.erase(cache.runs.begin());
+  cache.runs.emplace_back(key, run);
+  return run;
+}
+
+}  // namespace
+
+CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
+                                const IdmParams& idm) {
+  if (world.params().type != WorldType::kCity) {
+    throw GenerationError("city traffic needs a city world");
+  }
+  if (!(duration > 0)) throw GenerationError("city traffic needs a positive duration");
+  const CityParams& cp = world.params().city;
+  const double sw = cp.sidewalk_width;
+  const double area_km2 = tileArea(world) / 1e6;
+  Rng rng(deriveSeed(seed, 0x5045444553ULL));
+  CityTraffic out;
+  if (duration <= 0.5 * kCachedHorizon) {
+    // A window of the world's run, starting at a time drawn for this scenario; the signal
+    // offsets move with it.
+    const std::shared_ptr<const CityTraffic> run = cachedRun(world, idm);
+    const double t0 = idm.step * std::floor(rng.uniform(0.0, kCachedHorizon - duration) / idm.step);
+    out.plan = run->plan;
+    const double cyc = out.plan.cycle();
+    for (auto& i : out.plan.intersections) {
+      i.offset = roundMilli(std::fmod(std::fmod(i.offset - t0, cyc) + cyc, cyc));
+      if (i.offset >= cyc) i.offset = 0.0;
+    }
+    for (const auto& car : run->cars) {
+      CityCar c = car;
+      c.color = catalog::pick(rng, catalog::carColors());
+      c.trajectory = window(car.trajectory, t0, duration);
+      out.cars.push_back(std::move(c));
+    }
+  } else {
+    out = runCars(world, seed, duration, idm);
+  }
+  const SignalPlan& plan = out.plan;
+
+  // ---------------------------------------------------------------- pedestrians
+  std::vector<int> bus_stops, local_edges;
+  for (int e = 0; e < static_cast<int>(world.entities().size()); ++e) {
+    if (world.entities()[e].cls == EntityClass::kBusStop) bus_stops.push_back(e);
+  }
+  for (int e = 0; e < static_cast<int>(world.edges().size()); ++e) {
+    const StreetEdge& se = world.edges()[e];
+    const Vec2 a = world.nodes()[se.a].position, b = world.nodes()[se.b].position;
+    if (!isArterial(world, se) && (b - a).norm() > 50.0 &&
+        !(onBoundary(world, a) && onBoundary(world, b))) {
+      local_edges.push_back(e);
+    }
+  }
+  std::vector<int> queue_len(bus_stops.size(), 0);
+  const int n_peds = static_cast<int>(std::lround(cp.pedestrians_per_km2 * area_km2));
+  // Appends a timed point (strictly after the last one).
+  auto push = [](Trajectory* tr, double t, const Vec2& p, double yaw) {
+    TrajectoryPoint q;
+    q.t = roundMilli(t);
+    if (!tr->empty() && q.t <= tr->back().t) q.t = tr->back().t + 0.001;
+    q.x = roundMilli(p.x());
+    q.y = roundMilli(p.y());
+    q.yaw = roundMilli(geometry::wrapPi(yaw));
+    tr->push_back(q);
+  };
+  auto heading = [](const Vec2& a, const Vec2& b) {
+    return std::atan2(b.y() - a.y(), b.x() - a.x());
+  };
+  for (int i = 0; i < n_peds; ++i) {
+    CityPedestrian ped;
+    ped.clothing_color = catalog::pick(rng, catalog::clothingColors());
+    ped.height = roundMilli(rng.uniform(1.55, 1.9));
+    const double speed = rng.uniform(1.1, 1.6);
+    const double u = rng.unit();
+    if (u < cp.bus_queue_share && !bus_stops.empty()) {
+      const std::size_t k =
+          static_cast<std::size_t>(rng.uniformInt(0, static_cast<long>(bus_stops.size()) - 1));
+      if (queue_len[k] < 8) {
+        const Entity& stop = world.entities()[bus_stops[k]];
+        const Vec2 dir = unit(stop.box.yaw);
+        const Vec2 p =
+            stop.box.center2() + (0.5 * stop.box.size.x() + 0.6 + 0.7 * queue_len[k]) * dir;
+        ++queue_len[k];
+        ped.activity = "queuing";
+        ped.pose = {0.0, roundMilli(p.x()), roundMilli(p.y()), 0.0,
+                    roundMilli(geometry::wrapPi(stop.box.yaw + geometry::kPi))};
+        out.pedestrians.push_back(std::move(ped));
+        continue;
+      }
+    }
+    const double t_start = rng.uniform(0.0, std::max(1.0, 0.6 * duration));
+    const double d0 = rng.uniform(5.0, 40.0), d1 = rng.uniform(5.0, 40.0);
+    if (u < cp.bus_queue_share + cp.crossing_share) {
+      const bool jay = rng.bernoulli(cp.jaywalk_probability);
+      Vec2 start, a, b, end;
+      double t_cross = 0.0, cross_speed = speed;
+      if (jay && !local_edges.empty()) {
+        const StreetEdge& se = world.edges()[local_edges[static_cast<std::size_t>(
+            rng.uniformInt(0, static_cast<long>(local_edges.size()) - 1))]];
+        const Vec2 pa = world.nodes()[se.a].position, pb = world.nodes()[se.b].position;
+        const Vec2 ue = (pb - pa).normalized(), ne = leftOf(ue);
+        const Vec2 mid = pa + rng.uniform(0.35, 0.65) * (pb - pa);
+        const double side = rng.bernoulli(0.5) ? 1.0 : -1.0,
+                     along = rng.bernoulli(0.5) ? 1.0 : -1.0;
+        const double h = 0.5 * se.width + 0.5 * sw;
+        a = mid + side * h * ne;
+        b = mid - side * h * ne;
+        start = a - along * d0 * ue;
+        end = b + along * d1 * ue;
+        cross_speed = 1.25 * speed;
+        t_cross = t_start + d0 / speed;
+        ped.activity = "jaywalking";
+      } else if (!jay && !plan.intersections.empty()) {
+        const auto& si = plan.intersections[static_cast<std::size_t>(
+            rng.uniformInt(0, static_cast<long>(plan.intersections.size()) - 1))];
+        const int axis = static_cast<int>(rng.uniformInt(0, 1)), other = 1 - axis;
+        const double side = rng.bernoulli(0.5) ? 1.0 : -1.0, dir = rng.bernoulli(0.5) ? 1.0 : -1.0;
+        const Vec2 ua = unit(si.heading[axis]), na = leftOf(ua);
+        const double c = 0.5 * si.width[other] + 0.5 * sw, h = 0.5 * si.width[axis] + 0.5 * sw;
+        a = si.position + side * c * ua - dir * h * na;
+        b = si.position + side * c * ua + dir * h * na;
+        start = a - dir * d0 * na;
+        end = b + dir * d1 * na;
+        // Walk while the other axis is green; off the carriageway before this axis moves again.
+        const double cyc = plan.cycle(), half = 0.5 * cyc;
+        const double clear = plan.green + plan.yellow + plan.all_red;  // other green start -> ours
+        const double length = 2.0 * h;
+        cross_speed = std::max(speed, length / std::max(1.0, clear - 1.0));
+        const double walk_lo = plan.left,
+                     walk_hi = std::max(walk_lo,
+                                        std::min(plan.left + plan.green,
+                                                 plan.left + clear - length / cross_speed - 0.5));
+        // Phase of the other axis' cycle at arrival.
+        const double t_arrive = t_start + d0 / speed;
+        double tau = std::fmod(t_arrive - si.offset - (other == 1 ? half : 0.0), cyc);
+        if (tau < 0) tau += cyc;
+        double wait = 0.0;
+        if (tau < walk_lo) {
+          wait = walk_lo - tau;
+        } else if (tau > walk_hi) {
+          wait = cyc - tau + walk_lo;
+        }
+        t_cross = t_arrive + wait;
+        ped.activity = "crossing";
+      }
+      if (!ped.activity.empty()) {
+        Trajectory tr;
+        const double y0 = heading(start, a), y1 = heading(a, b), y2 = heading(b, end);
+        push(&tr, 0.0, start, y0);
+        if (t_start > 0) push(&tr, t_start, start, y0);
+        const double ta = t_start + d0 / speed;
+        push(&tr, ta, a, y0);
+        if (t_cross > ta + 1e-3) push(&tr, t_cross, a, y1);
+        const double tb = std::max(ta, t_cross) + (b - a).norm() / cross_speed;
+        push(&tr, tb, b, y1);
+        push(&tr, tb + d1 / speed, end, y2);
+        ped.pose = tr.front();
+        ped.trajectory = std::move(tr);
+        out.pedestrians.push_back(std::move(ped));
+        continue;
+      }
+    }
+    // A stroll along a block's sidewalk ring.
+    const Block& blk = world.blocks()[static_cast<std::size_t>(
+        rng.uniformInt(0, static_cast<long>(world.blocks().size()) - 1))];
+    const double len = geometry::polylineLength(blk.sidewalk);
+    const double s0 = rng.uniform(0.0, len);
+    const double dist = rng.uniform(60.0, 300.0) * (rng.bernoulli(0.5) ? 1.0 : -1.0);
+    ped.activity = "walking";
+    ped.trajectory = walkRing(blk.sidewalk, s0, s0 + dist, speed, t_start);
+    ped.pose = ped.trajectory.front();
+    out.pedestrians.push_back(std::move(ped));
+  }
+  return out;
+}
+
+}  // namespace hameritt::scenario

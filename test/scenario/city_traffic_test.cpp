@@ -1,0 +1,396 @@
+// The city's signalised traffic and crowd, judged on generated scenarios from the written
+// trajectories and signal plan alone: cars never overlap and keep the model's standstill gap,
+// no car enters an intersection box on red, pedestrians at the crosswalks are on the crossed
+// carriageway only while its traffic is red, the densities are met and the jaywalking share is
+// the configured probability. Every checker runs on a deliberately broken input first (the
+// negative controls) to show it can fail.
+
+#include "hameritt/scenario/city_traffic.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/sim_config_io.h"
+#include "hameritt/scenario/trajectory.h"
+#include "test_util.h"
+
+namespace hameritt::scenario {
+namespace {
+
+using geometry::OrientedBox;
+using geometry::Vec2;
+using testing::shippedConfig;
+
+const World& cityWorld() { return testing::shippedCityWorld(); }
+
+GeneratorConfig quickConfig() {
+  GeneratorConfig c = shippedConfig();
+  c.perception_paths = false;
+  return c;
+}
+
+// A generated city scenario whose sim config is read back from its written sim_config.json, so
+// that every check below judges what the file holds (rounding and all).
+const Scenario& cityScenario() {
+  static const Scenario s = [] {
+    Scenario g = generateScenario(cityWorld(), quickConfig(), ScenarioClass::kAreaSearch, 7);
+    g.sim = parseSimConfig(simConfigJson(g.sim), "sim_config.json");
+    return g;
+  }();
+  return s;
+}
+
+std::vector<const ScenarioEntity*> withRole(const Scenario& s, const std::string& role) {
+  std::vector<const ScenarioEntity*> out;
+  for (const auto& se : s.sim.entities) {
+    if (se.role == role) out.push_back(&se);
+  }
+  return out;
+}
+
+OrientedBox boxAt(const ScenarioEntity& se, double t) {
+  if (se.trajectory.empty()) return se.entity.box;
+  return poseBox(se.entity.box, sampleTrajectory(se.trajectory, t));
+}
+
+bool insideTile(const World& w, const Vec2& p) { return w.bounds().contains(p); }
+
+Vec2 unitOf(double a) { return {std::cos(a), std::sin(a)}; }
+
+struct OverlapReport {
+  int overlaps = 0;
+  int close_pairs = 0;   // same-lane pairs checked for the gap
+  double min_gap = 1e9;  // smallest bumper gap of a same-lane pair
+};
+
+// Overlaps of the cars' footprints, sampled every `dt`, and the smallest gap between cars of
+// one lane that follow each other (same heading).
+OverlapReport checkCars(const std::vector<ScenarioEntity>& cars, double duration, double dt) {
+  OverlapReport r;
+  std::vector<OrientedBox> boxes(cars.size());
+  for (double t = 0.0; t <= duration; t += dt) {
+    std::map<std::pair<int, int>, std::vector<int>> grid;
+    for (std::size_t i = 0; i < cars.size(); ++i) {
+      boxes[i] = boxAt(cars[i], t);
+      grid[{static_cast<int>(std::floor(boxes[i].center.x() / 10.0)),
+            static_cast<int>(std::floor(boxes[i].center.y() / 10.0))}]
+          .push_back(static_cast<int>(i));
+    }
+    for (const auto& [cell, members] : grid) {
+      for (int i : members) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          for (int dy = -1; dy <= 1; ++dy) {
+            const auto it = grid.find({cell.first + dx, cell.second + dy});
+            if (it == grid.end()) continue;
+            for (int j : it->second) {
+              if (j <= i) continue;
+              const OrientedBox &a = boxes[i], &b = boxes[j];
+              if (geometry::footprintsOverlap(a, b)) {
+                ++r.overlaps;
+                continue;
+              }
+              const bool same_lane =
+                  cars[i].entity.attributes.str("lane") == cars[j].entity.attributes.str("lane");
+              if (same_lane && std::cos(a.yaw - b.yaw) > 0.95) {
+                ++r.close_pairs;
+                r.min_gap = std::min(r.min_gap, geometry::footprintDistance(a, b));
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  return r;
+}
+
+// Where a point stands relative to intersection i for `axis`: along that axis' street from the
+// node and across it.
+void localCoords(const SignalizedIntersection& i, int axis, const Vec2& p, double* along,
+                 double* across) {
+  const Vec2 u = unitOf(i.heading[axis]), d = p - i.position;
+  *along = d.dot(u);
+  *across = u.x() * d.y() - u.y() * d.x();
+}
+
+struct EntryReport {
+  int entries = 0;
+  int on_red = 0;
+};
+
+// Entries of a car's front into an intersection box (its own carriageway, from the far side of
+// the crosswalk before the cross street to that after it), with the signal shown to the car's
+// axis at that moment.
+EntryReport checkEntries(const std::vector<ScenarioEntity>& cars, const SignalPlan& plan,
+                         double duration, double dt) {
+  EntryReport r;
+  for (const auto& car : cars) {
+    std::vector<char> was_in(plan.intersections.size() * 2, 0);
+    for (double t = 0.0; t <= duration; t += dt) {
+      const TrajectoryPoint q = sampleTrajectory(car.trajectory, t);
+      const Vec2 front = Vec2(q.x, q.y) + 0.5 * car.entity.box.size.x() * unitOf(q.yaw);
+      for (std::size_t k = 0; k < plan.intersections.size(); ++k) {
+        const auto& si = plan.intersections[k];
+        if ((front - si.position).squaredNorm() > 60.0 * 60.0) {
+          was_in[2 * k] = was_in[2 * k + 1] = 0;
+          continue;
+        }
+        for (int axis = 0; axis < 2; ++axis) {
+          if (std::abs(std::cos(q.yaw - si.heading[axis])) < 0.9) continue;
+          double along = 0, across = 0;
+          localCoords(si, axis, front, &along, &across);
+          const bool in = std::abs(along) < 0.5 * si.width[1 - axis] + plan.sidewalk &&
+                          std::abs(across) < 0.5 * si.width[axis];
+          if (in && !was_in[2 * k + axis]) {
+            ++r.entries;
+            const SignalState st = plan.state(si, axis, t);
+            if (st != SignalState::kGreen && st != SignalState::kYellow) ++r.on_red;
+          }
+          was_in[2 * k + axis] = in;
+        }
+      }
+    }
+  }
+  return r;
+}
+
+// Samples at which a pedestrian crossing at a signal stands on a signalised carriageway next to
+// the node while that carriageway's axis is not red.
+int crossingsOffRed(const std::vector<const ScenarioEntity*>& peds, const SignalPlan& plan,
+                    double duration, double dt, int* checked) {
+  int bad = 0;
+  for (const auto* p : peds) {
+    if (p->entity.attributes.str("activity") != "crossing") continue;
+    for (double t = 0.0; t <= duration; t += dt) {
+      const TrajectoryPoint q = sampleTrajectory(p->trajectory, t);
+      for (const auto& si : plan.intersections) {
+        if ((Vec2(q.x, q.y) - si.position).squaredNorm() > 50.0 * 50.0) continue;
+        for (int axis = 0; axis < 2; ++axis) {
+          double along = 0, across = 0;
+          localCoords(si, axis, Vec2(q.x, q.y), &along, &across);
+          if (std::abs(across) < 0.5 * si.width[axis] &&
+              std::abs(along) < 0.5 * si.width[1 - axis] + plan.sidewalk &&
+              std::abs(along) > 0.5 * si.width[1 - axis]) {
+            ++*checked;
+            if (plan.state(si, axis, t) != SignalState::kRed) ++bad;
+          }
+        }
+      }
+    }
+  }
+  return bad;
+}
+
+SignalPlan shiftedHalfACycle(SignalPlan plan) {
+  for (auto& i : plan.intersections)
+    i.offset = std::fmod(i.offset + 0.5 * plan.cycle(), plan.cycle());
+  return plan;
+}
+
+std::vector<ScenarioEntity> copies(const std::vector<const ScenarioEntity*>& v) {
+  std::vector<ScenarioEntity> out;
+  for (const auto* p : v) out.push_back(*p);
+  return out;
+}
+
+TEST(CityTraffic, SignalPhasesFollowTheCycle) {
+  SignalPlan plan;
+  SignalizedIntersection i;
+  i.offset = 10.0;
+  EXPECT_DOUBLE_EQ(plan.cycle(), 56.0);
+  EXPECT_EQ(plan.state(i, 0, 10.0), SignalState::kLeftArrow);
+  EXPECT_EQ(plan.state(i, 0, 17.0), SignalState::kGreen);
+  EXPECT_EQ(plan.state(i, 0, 32.0), SignalState::kYellow);
+  EXPECT_EQ(plan.state(i, 0, 36.0), SignalState::kRed);  // all-red
+  EXPECT_EQ(plan.state(i, 1, 36.0), SignalState::kRed);
+  EXPECT_EQ(plan.state(i, 1, 38.0), SignalState::kLeftArrow);
+  EXPECT_EQ(plan.state(i, 1, 45.0), SignalState::kGreen);
+  EXPECT_EQ(plan.state(i, 0, 45.0), SignalState::kRed);
+  EXPECT_EQ(plan.state(i, 0, 66.0), SignalState::kLeftArrow);  // the next cycle
+  EXPECT_EQ(plan.state(i, 0, 9.0), SignalState::kRed);         // before the offset
+}
+
+TEST(CityTraffic, CarsNeverOverlapAndKeepTheStandstillGap) {
+  const Scenario& s = cityScenario();
+  const auto traffic = copies(withRole(s, "traffic"));
+  ASSERT_GE(traffic.size(), 100u);
+  const IdmParams idm;
+  // Negative control: one car three seconds late is run into by the car behind it.
+  std::vector<ScenarioEntity> late = traffic;
+  for (auto& p : late[0].trajectory) p.t += 3.0;
+  late[0].trajectory.insert(late[0].trajectory.begin(), late[0].trajectory.front());
+  late[0].trajectory.front().t = 0.0;
+  EXPECT_GT(checkCars(late, s.sim.duration, 0.05).overlaps, 0);
+
+  const OverlapReport r = checkCars(traffic, s.sim.duration, 0.05);
+  EXPECT_EQ(r.overlaps, 0);
+  EXPECT_GT(r.close_pairs, 1000);
+  // The bumper gap of followers: the model's standstill gap, less the written trajectories'
+  // interpolation tolerance (positions within 0.1 m of the simulated ones, for each car).
+  EXPECT_GE(r.min_gap, idm.min_gap - 0.25);
+  std::printf("cars %zu over %.0f s: overlaps %d, same-lane pairs %d, smallest gap %.3f m\n",
+              traffic.size(), s.sim.duration, r.overlaps, r.close_pairs, r.min_gap);
+}
+
+TEST(CityTraffic, NoCarEntersAnIntersectionOnRed) {
+  const Scenario& s = cityScenario();
+  ASSERT_TRUE(s.sim.signals.has_value());
+  const SignalPlan& plan = *s.sim.signals;
+  const auto traffic = copies(withRole(s, "traffic"));
+  // Negative control: the same cars judged against the plan shifted by half a cycle.
+  const EntryReport wrong = checkEntries(traffic, shiftedHalfACycle(plan), s.sim.duration, 0.05);
+  EXPECT_GT(wrong.on_red, wrong.entries / 4);
+  const EntryReport r = checkEntries(traffic, plan, s.sim.duration, 0.05);
+  EXPECT_GE(plan.intersections.size(), 20u);
+  EXPECT_GT(r.entries, 500);
+  EXPECT_EQ(r.on_red, 0);
+  std::printf("intersections %zu, entries %d, on red %d (shifted plan: %d of %d)\n",
+              plan.intersections.size(), r.entries, r.on_red, wrong.on_red, wrong.entries);
+}
+
+TEST(CityTraffic, PedestriansCrossOnTheSignalsAndNeverUnderACar) {
+  const Scenario& s = cityScenario();
+  const SignalPlan& plan = *s.sim.signals;
+  const auto peds = withRole(s, "pedestrian");
+  int checked_wrong = 0, checked = 0;
+  EXPECT_GT(crossingsOffRed(peds, shiftedHalfACycle(plan), s.sim.duration, 0.1, &checked_wrong), 0);
+  EXPECT_EQ(crossingsOffRed(peds, plan, s.sim.duration, 0.1, &checked), 0);
+  EXPECT_GT(checked, 1000);
+  // No traffic car's footprint ever overlaps a pedestrian's.
+  const auto cars = withRole(s, "traffic");
+  int hits = 0;
+  for (double t = 0.0; t <= s.sim.duration; t += 0.2) {
+    std::map<std::pair<int, int>, std::vector<OrientedBox>> grid;
+    for (const auto* c : cars) {
+      const OrientedBox b = boxAt(*c, t);
+      grid[{static_cast<int>(std::floor(b.center.x() / 10)),
+            static_cast<int>(std::floor(b.center.y() / 10))}]
+          .push_back(b);
+    }
+    for (const auto* p : peds) {
+      const OrientedBox b = boxAt(*p, t);
+      const int cx = static_cast<int>(std::floor(b.center.x() / 10)),
+                cy = static_cast<int>(std::floor(b.center.y() / 10));
+      for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          const auto it = grid.find({cx + dx, cy + dy});
+          if (it == grid.end()) continue;
+          for (const auto& cb : it->second) hits += geometry::footprintsOverlap(cb, b) ? 1 : 0;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(hits, 0);
+  std::printf("crosswalk samples on a carriageway %d (shifted plan: %d off red)\n", checked,
+              checked_wrong);
+}
+
+TEST(CityTraffic, DensitiesJaywalkingAndBusQueues) {
+  const Scenario& s = cityScenario();
+  const World& w = cityWorld();
+  const CityParams& cp = w.params().city;
+  const auto b = w.bounds();
+  const double km2 = (b.max.x() - b.min.x()) * (b.max.y() - b.min.y()) / 1e6;
+  const auto cars = withRole(s, "traffic");
+  const auto peds = withRole(s, "pedestrian");
+  double moving_sum = 0, present_min = 1e9, ped_min = 1e9;
+  int samples = 0;
+  for (double t = 0.0; t + 1.0 <= s.sim.duration; t += 5.0) {
+    int present = 0, moving = 0, ped_in = 0;
+    for (const auto* c : cars) {
+      const TrajectoryPoint a = sampleTrajectory(c->trajectory, t),
+                            z = sampleTrajectory(c->trajectory, t + 1.0);
+      if (!insideTile(w, Vec2(a.x, a.y))) continue;
+      ++present;
+      if (std::hypot(z.x - a.x, z.y - a.y) > 0.5) ++moving;
+    }
+    for (const auto* p : peds) {
+      const TrajectoryPoint a =
+          p->trajectory.empty()
+              ? TrajectoryPoint{0, p->entity.box.center.x(), p->entity.box.center.y(), 0, 0}
+              : sampleTrajectory(p->trajectory, t);
+      if (insideTile(w, Vec2(a.x, a.y))) ++ped_in;
+    }
+    moving_sum += moving;
+    present_min = std::min(present_min, static_cast<double>(present));
+    ped_min = std::min(ped_min, static_cast<double>(ped_in));
+    ++samples;
+  }
+  const double moving_mean = moving_sum / samples / km2;
+  EXPECT_GE(moving_mean, 100.0);
+  EXPECT_GE(present_min / km2, 100.0);
+  EXPECT_GE(ped_min / km2, 300.0);
+
+  // Jaywalking: the share of street crossings made mid-block, within three standard deviations
+  // of the configured probability; every jaywalker crosses at least 15 m from a street node.
+  int crossings = 0, jay = 0, queuing = 0, near_node = 0, far_from_stop = 0;
+  std::vector<Vec2> stops;
+  for (const auto& e : w.entities()) {
+    if (e.cls == EntityClass::kBusStop) stops.push_back(e.box.center2());
+  }
+  for (const auto* p : peds) {
+    const std::string act = p->entity.attributes.str("activity");
+    if (act == "crossing" || act == "jaywalking") ++crossings;
+    if (act == "jaywalking") {
+      ++jay;
+      // The two middle samples bound the crossing itself.
+      const auto& tr = p->trajectory;
+      const Vec2 mid(0.5 * (tr[tr.size() - 2].x + tr[tr.size() - 3].x),
+                     0.5 * (tr[tr.size() - 2].y + tr[tr.size() - 3].y));
+      for (const auto& n : w.nodes()) near_node += (n.position - mid).norm() < 15.0 ? 1 : 0;
+    }
+    if (act == "queuing") {
+      ++queuing;
+      EXPECT_TRUE(p->trajectory.empty());
+      double best = 1e9;
+      for (const auto& st : stops) best = std::min(best, (st - p->entity.box.center2()).norm());
+      far_from_stop += best > 8.5 ? 1 : 0;
+    }
+  }
+  const double pj = cp.jaywalk_probability;
+  const double sigma = std::sqrt(pj * (1 - pj) / crossings);
+  const double share = static_cast<double>(jay) / crossings;
+  EXPECT_GT(crossings, 50);
+  EXPECT_LE(std::abs(share - pj), 3 * sigma);
+  // Negative control: the same count judged against a probability twice as high fails.
+  EXPECT_GT(std::abs(share - 2 * pj), 3 * std::sqrt(2 * pj * (1 - 2 * pj) / crossings));
+  EXPECT_EQ(near_node, 0);
+  EXPECT_GT(queuing, 0);
+  EXPECT_EQ(far_from_stop, 0);
+  std::printf(
+      "per km^2: moving cars %.1f (mean), cars present %.1f (min), pedestrians %.1f (min); "
+      "crossings %d, jaywalking %d (share %.3f, p %.2f, 3 sigma %.3f), queuing %d\n",
+      moving_mean, present_min / km2, ped_min / km2, crossings, jay, share, pj, 3 * sigma, queuing);
+}
+
+TEST(CityTraffic, DeterministicAndWrittenWithItsSignalPlan) {
+  const Scenario& s = cityScenario();
+  const Scenario again =
+      generateScenario(cityWorld(), quickConfig(), ScenarioClass::kAreaSearch, 7);
+  const std::string text = simConfigJson(s.sim);
+  EXPECT_EQ(text, simConfigJson(again.sim));
+  const SimConfig back = parseSimConfig(text, "sim_config.json");
+  ASSERT_TRUE(back.signals.has_value());
+  EXPECT_EQ(back.signals->intersections.size(), s.sim.signals->intersections.size());
+  EXPECT_EQ(simConfigJson(back), text);
+  // A cycle that disagrees with its phases is refused, naming the field.
+  std::string bad = text;
+  const auto at = bad.find("\"cycle\": ");
+  ASSERT_NE(at, std::string::npos);
+  bad.replace(at, 10, "\"cycle\": 9");
+  EXPECT_NE(
+      testing::messageOf([&] { parseSimConfig(bad, "sim_config.json"); }).find("signals.cycle"),
+      std::string::npos);
+  // The suburb writes no signal plan.
+  const Scenario suburb =
+      generateScenario(testing::shippedWorld(), quickConfig(), ScenarioClass::kAreaSearch, 7);
+  EXPECT_FALSE(suburb.sim.signals.has_value());
+  EXPECT_EQ(simConfigJson(suburb.sim).find("\"signals\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hameritt::scenario
