@@ -31,17 +31,25 @@ import tempfile
 import time
 
 
-def sample_recorder_cpu(seen, out):
-    """CPU seconds (user + system) so far of the rosbag recorder writing into `out`, by pid."""
-    tick = os.sysconf("SC_CLK_TCK")
+def processes():
+    """(pid, argv) of every process readable now (argv as bytes)."""
     for pid in os.listdir("/proc"):
         if not pid.isdigit():
             continue
         try:
             with open("/proc/%s/cmdline" % pid, "rb") as f:
-                argv = f.read().split(b"\0")
-            if not argv[0].endswith(b"rosbag/record") or not any(out.encode() in a for a in argv):
-                continue
+                yield pid, f.read().split(b"\0")
+        except OSError:
+            pass
+
+
+def sample_recorder_cpu(seen, out):
+    """CPU seconds (user + system) so far of the rosbag recorder writing into `out`, by pid."""
+    tick = os.sysconf("SC_CLK_TCK")
+    for pid, argv in processes():
+        if not argv[0].endswith(b"rosbag/record") or not any(out.encode() in a for a in argv):
+            continue
+        try:
             with open("/proc/%s/stat" % pid) as f:
                 fields = f.read().rsplit(")", 1)[1].split()
             seen[pid] = (int(fields[11]) + int(fields[12])) / tick
@@ -50,15 +58,11 @@ def sample_recorder_cpu(seen, out):
 
 
 def sample_simulator_rss(peak):
-    """The simulator node's peak resident set so far (VmHWM, MB) into peak[0], by pid."""
-    for pid in os.listdir("/proc"):
-        if not pid.isdigit():
+    """The simulator node's peak resident set so far (VmHWM, MB) into peak[0]."""
+    for pid, argv in processes():
+        if not argv[0].endswith(b"hameritt/simulator"):
             continue
         try:
-            with open("/proc/%s/cmdline" % pid, "rb") as f:
-                argv = f.read().split(b"\0")
-            if not argv[0].endswith(b"hameritt/simulator"):
-                continue
             with open("/proc/%s/status" % pid) as f:
                 for line in f:
                     if line.startswith("VmHWM:"):
