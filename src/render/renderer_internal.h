@@ -291,6 +291,8 @@ struct Renderer::Impl {
   CameraEffectsWorker effects_worker;
   std::vector<std::array<int, 4>> box_rect;
   std::vector<int> box_group, box_total;
+  std::vector<std::uint8_t> box_query;  // per touched instance: counted by an occlusion query
+  std::vector<GLuint> query_pool;       // GL_SAMPLES_PASSED queries, grown on demand
   std::vector<GpuInstance> box_upload;
   std::vector<GLuint> group_base;
   std::vector<GLsizei> group_count;

@@ -83,6 +83,9 @@ Renderer::Impl::~Impl() {
     glDeleteBuffers(1, &f->instance_buffer);
   }
   for (const auto& g : geometry) glDeleteProgram(g.id);
+  if (!query_pool.empty()) {
+    glDeleteQueries(static_cast<GLsizei>(query_pool.size()), query_pool.data());
+  }
   glDeleteProgram(sky_program);
   glDeleteProgram(particle_program);
   GLuint buffers[] = {vertex_buffer, element_buffer};

@@ -306,7 +306,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     si.semantic = scenario::semanticId(e.cls);
     si.scenario_entity = scenario_entity;
     si.mover = mover;
-    si.interest = e.cls == EntityClass::kCar || e.cls == EntityClass::kPedestrian;
+    si.cls = e.cls;
+    si.interest = hasBoundingBox(e.cls);
     si.box = e.box;
     double lift = 0.0;
     std::string color_key;
@@ -314,35 +315,43 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       case EntityClass::kStreet:
       case EntityClass::kAlley:
         si.model = procedural_.street;
+        si.convex = true;
         lift = streetTopZ(street_index++) - e.box.minZ();  // the slab's top face only
         break;
       case EntityClass::kBuilding:
         si.model = cityBox("building", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
         color_key = "color";
+        si.convex = true;
         break;
       case EntityClass::kParkingGarage:
         si.model =
             cityBox("parking_garage", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
         color_key = "color";
+        si.convex = true;
         break;
       case EntityClass::kParkingLot:
         si.model = procedural_.driveway;
         if (!paintColor("asphalt", &si.record.color)) {
           throw RenderError(attributeError(e, "material", "asphalt"));
         }
+        si.convex = true;
         break;
       case EntityClass::kLampPost:
         si.model = cityBox("lamp_post", MaterialKind::kPlain, srgbToLinear(70, 72, 76));
+        si.convex = true;
         break;
       case EntityClass::kTrafficLight:
         si.model = cityBox("traffic_light", MaterialKind::kPlain, srgbToLinear(30, 32, 30));
+        si.convex = true;
         break;
       case EntityClass::kBusStop:
         si.model = cityBox("bus_stop", MaterialKind::kPlain, srgbToLinear(120, 150, 170));
+        si.convex = true;
         break;
       case EntityClass::kBench:
         si.model = cityBox("bench", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
         color_key = "color";
+        si.convex = true;
         break;
       case EntityClass::kDriveway: {
         si.model = procedural_.driveway;

@@ -32,7 +32,12 @@ struct SceneInstance {
   int semantic = 0;
   int scenario_entity = -1;   // index into SimConfig::entities when it comes from the scenario
   bool mover = false;         // posed from its trajectory at the frame time
-  bool interest = false;      // car or pedestrian: gets a bounding box
+  bool interest = false;      // car, pedestrian or a city class: gets a bounding box
+  // A closed convex mesh (the city classes' procedural boxes, an alley's quad): drawn alone
+  // without a depth test it covers each of its pixels once, so an occlusion query counts its
+  // unoccluded pixels.
+  bool convex = false;
+  scenario::EntityClass cls = scenario::EntityClass::kCar;
   geometry::OrientedBox box;  // pose and size (scale of a normalized mesh)
   InstanceRecord record;      // at t = 0 for movers
   Eigen::Vector3f center{0, 0, 0};  // bounding sphere
