@@ -244,9 +244,13 @@ struct Renderer::Impl {
   RenderStats stats;
   std::unordered_multimap<std::string, int> by_id;
 
-  GeometryProgram geometry[2];  // objects, ground layers
+  GeometryProgram geometry[3];  // objects, ground layers, building facades
   GLuint bound_program = 0;
   GLuint sky_program = 0, particle_program = 0;
+  GLuint coverage_program = 0;  // boxes: the objects' positions, no shading
+  struct {
+    GLint view_proj, camera;
+  } coverage_loc{};
   struct {
     GLint world_R_optical, intrinsics, zenith, horizon, sun_dir, glow, far_clip, haze_color, haze_k;
   } sky_loc{};

@@ -164,17 +164,25 @@ void Renderer::Impl::boxes(Frame& f) {
     glDepthMask(GL_FALSE);
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    RenderStats counted;
+    glUseProgram(coverage_program);
+    bound_program = coverage_program;
+    glProgramUniformMatrix4fv(coverage_program, coverage_loc.view_proj, 1, GL_FALSE, f.view_proj);
+    const Eigen::Vector3f cam = f.camera.cast<float>();
+    glProgramUniform3fv(coverage_program, coverage_loc.camera, 1, cam.data());
     std::size_t q = 0;
     for (std::size_t a = 0; a < n; ++a) {
       if (!box_query[a]) continue;
       const auto rec =
           static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+      const auto m = static_cast<std::size_t>(f.model[rec]);
       glBeginQuery(GL_SAMPLES_PASSED, query_pool[q++]);
-      drawModel(f.model[rec], static_cast<GLuint>(f.slot[rec]), 1, &counted);
+      glDrawElementsInstancedBaseVertexBaseInstance(
+          GL_TRIANGLES, static_cast<GLsizei>(scene.drawnIndexCount(f.model[rec])), GL_UNSIGNED_INT,
+          reinterpret_cast<const void*>(model_first_element[m] * sizeof(std::uint32_t)), 1,
+          model_base_vertex[m], static_cast<GLuint>(f.slot[rec]));
       glEndQuery(GL_SAMPLES_PASSED);
+      ++f.stats.draw_calls;
     }
-    f.stats.draw_calls += counted.draw_calls;
     q = 0;
     for (std::size_t a = 0; a < n; ++a) {
       if (!box_query[a]) continue;

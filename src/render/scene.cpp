@@ -319,8 +319,14 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
         lift = streetTopZ(street_index++) - e.box.minZ();  // the slab's top face only
         break;
       case EntityClass::kBuilding:
-        si.model = cityBox("building", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        si.model = cityBox("building", MaterialKind::kFacade, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        procedural_.building = si.model;
         color_key = "color";
+        {
+          const std::int64_t storeys = e.attributes.integer("storeys", 0);
+          si.record.canopy =
+              static_cast<float>(storeys > 0 ? e.box.size.z() / static_cast<double>(storeys) : 3.5);
+        }
         si.convex = true;
         break;
       case EntityClass::kParkingGarage:

@@ -21,7 +21,7 @@ struct InstanceRecord {
   float row[3][4];          // rows of the 3x4 model matrix (mesh -> world)
   std::uint32_t color = 0;  // kPaint: display colour (RGB8, gamma 2); kFoliage: linear tint / 2
   std::uint32_t label = 0;  // semantic << 16 | instance
-  float canopy = 1.0f;      // canopy scale about the mesh's canopy centre
+  float canopy = 1.0f;      // canopy scale about the mesh's canopy centre; buildings: storey (m)
 };
 
 
@@ -71,6 +71,7 @@ struct LodView {
 // Model indices of the procedural parts.
 struct SceneModels {
   int ground = -1, sidewalks = -1, street = -1, driveway = -1, uav = -1;
+  int building = -1;  // city buildings (facade program); -1 in a scene without buildings
 };
 
 class Scene {

@@ -21,37 +21,17 @@ import rosbag
 import rospy
 import yaml
 from hameritt.msg import BoundingBox, BoundingBoxArray
-from sensor_msgs.msg import Image
 
-BIN = os.environ["HAMERITT_BIN_DIR"]
-SRC = os.environ["HAMERITT_SOURCE_DIR"]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from fault_util import BIN, SRC, Checks  # noqa: E402
+from synthetic_bag import image  # noqa: E402
+
 W, H = 64, 48
 # (entity id, class, instance id, rectangle x0, y0, x1, y1 inclusive) of every frame.
 THINGS = [("building_3", "building", 4, 0, 0, 20, 40), ("lamp_post_9", "lamp_post", 10, 24, 5, 25, 40),
           ("bus_stop_2", "bus_stop", 3, 30, 28, 44, 40), ("street_tree_5", "street_tree", 6, 48, 8, 60, 40),
           ("car_1", "car", 2, 30, 42, 40, 47)]
-fails = []
-checks = [0]
-
-
-def check(cond, what):
-    checks[0] += 1
-    if not cond:
-        fails.append(what)
-        print("FAIL:", what)
-    return cond
-
-
-def image(arr, encoding, stamp):
-    m = Image()
-    m.header.stamp = stamp
-    m.header.frame_id = "front_optical"
-    m.height, m.width = arr.shape[:2]
-    m.encoding = encoding
-    m.is_bigendian = 0
-    m.step = arr.strides[0]
-    m.data = arr.tobytes()
-    return m
+check = Checks()
 
 
 def write_bag(path, frames):
@@ -79,7 +59,7 @@ def write_bag(path, frames):
             depth = np.full((H, W), 50.0, np.float32)
             seg = np.zeros((H, W), np.uint8)
             bag.write(base + "boxes", msg, stamp)
-            bag.write(base + "image_raw", image(rgb, "rgb8", stamp), stamp)
+            bag.write(base + "image_raw", image(rgb, "bgr8", stamp), stamp)
             bag.write(base + "depth", image(depth, "32FC1", stamp), stamp)
             bag.write(base + "segmentation", image(seg, "mono8", stamp), stamp)
             bag.write(base + "instances", image(inst, "16UC1", stamp), stamp)
@@ -144,6 +124,12 @@ def judge_yolo(ds, table, names=None):
     return bad, lines
 
 
+def export(bag, out, fmt):
+    r = subprocess.run([os.path.join(BIN, "hameritt_export"), bag, "--format", fmt, "--out", out,
+                        "--split", "train=1"], capture_output=True, text=True)
+    check(r.returncode == 0, "%s export: %s" % (fmt, r.stderr))
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix="hameritt_city_export.")
     try:
@@ -153,9 +139,7 @@ def main():
         check(len(table) == 17 and table.get("building") == (11, 8) and table.get("street_tree") == (19, 16),
               "documented table %s" % table)
         coco = os.path.join(tmp, "coco")
-        r = subprocess.run([os.path.join(BIN, "hameritt_export"), bag, "--format", "coco", "--out", coco,
-                            "--split", "train=1"], capture_output=True, text=True)
-        check(r.returncode == 0, "coco export: %s" % r.stderr)
+        export(bag, coco, "coco")
         bad, doc = judge_coco(coco, table)
         check(not bad, "COCO: %s" % bad)
         n = len(doc["annotations"])
@@ -169,9 +153,7 @@ def main():
         check(judge_coco(coco, swapped)[0], "a swapped category table passes")
 
         yolo = os.path.join(tmp, "yolo")
-        r = subprocess.run([os.path.join(BIN, "hameritt_export"), bag, "--format", "yolo", "--out", yolo,
-                            "--split", "train=1"], capture_output=True, text=True)
-        check(r.returncode == 0, "yolo export: %s" % r.stderr)
+        export(bag, yolo, "yolo")
         bad, lines = judge_yolo(yolo, table)
         check(not bad, "YOLO: %s" % bad)
         check(lines == 3 * len(THINGS), "%d YOLO lines, expected %d" % (lines, 3 * len(THINGS)))
@@ -182,11 +164,7 @@ def main():
         check(judge_yolo(yolo, table, names[1:] + names[:1])[0], "shifted YOLO names pass")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    print("%d checks" % checks[0])
-    if fails:
-        print("FAIL: %d of %d checks" % (len(fails), checks[0]))
-        sys.exit(1)
-    print("PASS: city classes in the COCO and YOLO export")
+    sys.exit(check.summary("nowhere: the temporary directory is removed"))
 
 
 if __name__ == "__main__":
