@@ -275,6 +275,8 @@ struct Renderer::Impl {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> cell_range;  // [cell * models + model]
   std::vector<std::uint32_t> cell_items;
   std::vector<std::uint32_t> movers, always;
+  // Traffic-light masts (record) and the signalised intersection they stand at.
+  std::vector<std::pair<std::uint32_t, int>> signal_masts;
   std::vector<std::pair<Eigen::Vector3f, float>> mover_sphere;  // per record
   std::array<Plane, 6> planes{};
   Eigen::Vector3d camera{0, 0, 0};

@@ -253,6 +253,20 @@ void Renderer::Impl::buildCulling() {
   cell_hi.assign(static_cast<std::size_t>(cells), Eigen::Vector3f::Constant(-1e30f));
   for (std::size_t i = 0; i < inst.size(); ++i) {
     const auto& si = inst[i];
+    if (si.model == p.signal && config.signals && !si.mover) {
+      // The nearest signalised intersection within 30 m (a mast stands at one of its corners).
+      int best = -1;
+      double best_d = 30.0;
+      const auto& list = config.signals->intersections;
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const double d = (list[k].position - si.box.center2()).norm();
+        if (d < best_d) {
+          best_d = d;
+          best = static_cast<int>(k);
+        }
+      }
+      if (best >= 0) signal_masts.emplace_back(static_cast<std::uint32_t>(i), best);
+    }
     if (si.mover) {
       movers.push_back(static_cast<std::uint32_t>(i));
       continue;

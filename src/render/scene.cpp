@@ -153,6 +153,24 @@ bool paintColor(const std::string& name, std::uint32_t* srgb8) {
   return false;
 }
 
+std::uint32_t signalLamps(scenario::SignalState axis0, scenario::SignalState axis1,
+                          double heading0) {
+  auto lamp = [](scenario::SignalState s) -> std::uint32_t {
+    switch (s) {
+      case scenario::SignalState::kGreen:
+        return 2;
+      case scenario::SignalState::kYellow:
+        return 1;
+      default:
+        return 0;  // red, and the other axis' protected left arrow
+    }
+  };
+  const double turns = heading0 / (2.0 * M_PI);
+  const auto h = static_cast<std::uint32_t>(
+      static_cast<long>(std::lround((turns - std::floor(turns)) * 256.0)) & 255);
+  return lamp(axis0) | (lamp(axis1) << 2) | (h << 8);
+}
+
 void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]) {
   const double c = std::cos(box.yaw), s = std::sin(box.yaw);
   const double l = box.size.x(), w = box.size.y(), h = box.size.z();
@@ -347,7 +365,9 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
         si.convex = true;
         break;
       case EntityClass::kTrafficLight:
-        si.model = cityBox("traffic_light", MaterialKind::kPlain, srgbToLinear(30, 32, 30));
+        si.model = cityBox("traffic_light", MaterialKind::kSignal, srgbToLinear(30, 32, 30));
+        procedural_.signal = si.model;
+        si.record.color = kSignalDark;
         si.convex = true;
         break;
       case EntityClass::kBusStop:

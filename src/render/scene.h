@@ -72,6 +72,7 @@ struct LodView {
 struct SceneModels {
   int ground = -1, sidewalks = -1, street = -1, driveway = -1, uav = -1;
   int building = -1;  // city buildings (facade program); -1 in a scene without buildings
+  int signal = -1;    // traffic-light masts (facade program, lamps); -1 without any
 };
 
 class Scene {
@@ -139,6 +140,13 @@ class Scene {
 // red, blue, white, black, silver, grey, green, yellow, beige, brick, brown, orange, and the
 // driveway materials concrete and asphalt; false for an unknown name.
 bool paintColor(const std::string& name, std::uint32_t* srgb8);
+
+// InstanceRecord::color of a traffic-light mast: bits 0-1 the lamp lit towards axis 0's
+// traffic, 2-3 towards axis 1's (0 red, 1 yellow, 2 green, 3 none), 8-15 axis 0's heading in
+// 256ths of a turn.
+constexpr std::uint32_t kSignalDark = 3u | (3u << 2);
+std::uint32_t signalLamps(scenario::SignalState axis0, scenario::SignalState axis1,
+                          double heading0);
 
 // Model matrix rows of a normalized mesh placed at an entity box (bottom centre, yaw, size).
 void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]);

@@ -103,7 +103,14 @@ void main() {
   bool wall = abs(n.z) < 0.3, roof = n.z > 0.7;
   v_frame = vec4(i_row0.w, i_row1.w, i_row2.w, wall ? i_normal0.w : (roof ? -1.0 : 0.0));
   v_layout = vec4(-n.y, n.x, 1.4 + 1.4 * r0, 0.5 + 0.3 * r1);
-  if (roof) {
+  if (kind == 7u) {
+    // A traffic-light mast: the lamps of the axis its face looks along (i_ids.x: signalLamps).
+    float h0 = float((i_ids.x >> 8) & 255u) * (6.2831853 / 256.0);
+    bool along0 = abs(dot(n.xy, vec2(cos(h0), sin(h0)))) > 0.7;
+    uint lit = along0 ? (i_ids.x & 3u) : ((i_ids.x >> 2) & 3u);
+    v_frame = vec4(i_row0.w, i_row1.w, i_row2.w, wall ? -2.0 : 0.0);
+    v_layout = vec4(float(lit), i_row2.z, 0.0, 0.0);
+  } else if (roof) {
     // The roof: membrane, a parapet cap in the wall colour, a rooftop unit and a water tank.
     v_layout = vec4(vec2(i_row0.x, i_row1.x) / max(i_normal1.w, 1e-6), i_normal1.w, i_normal2.w);
     v_glass = (1.0 - cover) * keep * light * vec3(0.16, 0.16, 0.17) + snow;
@@ -233,6 +240,15 @@ void main() {
       else if (fz > 0.78) c = 0.55 * v_color;
     } else if (fz > 0.3 && fz < 0.82 && abs(fract(u / v_layout.z) - 0.5) < 0.5 * v_layout.w) {
       c = v_glass;
+    }
+  } else if (v_frame.w < -1.5) {
+    // Signal lamps in the top 1.2 m of a mast's face: red, yellow, green from the top.
+    float below = v_frame.z + v_layout.y - w.z;
+    if (below < 1.2) {
+      float band = min(floor(below / 0.4), 2.0);
+      vec3 lamp = band < 0.5 ? vec3(1.6, 0.1, 0.05)
+                             : (band < 1.5 ? vec3(1.6, 0.9, 0.05) : vec3(0.1, 1.5, 0.4));
+      c = abs(band - v_layout.x) < 0.5 ? lamp : 0.04 * lamp;
     }
   } else if (v_frame.w < 0.0) {
     vec2 d = w.xy - v_frame.xy;

@@ -255,23 +255,30 @@ TEST(CityRender, PartlyHiddenCityEntitiesHaveAFractionOfTheirPixelsVisible) {
   EXPECT_EQ(found.size(), 3u) << "in " << views << " views";
 }
 
-// Mean luminance of an entity's wall pixels binned by the phase of their world height in a
-// period, as (max - min) / mean over 12 bins: high when the colour repeats with that period.
-double bandContrast(const FrameSet& f, const RenderRequest& r, int instance, double period) {
-  std::array<double, 12> sum{}, n{};
+// Calls visit(pixel index, world height) for every pixel of an instance.
+template <typename Visit>
+void forEachPixelHeight(const FrameSet& f, const RenderRequest& r, int instance, Visit visit) {
   const Intrinsics& k = r.intrinsics;
   for (int v = 0; v < k.height; ++v) {
     for (int u = 0; u < k.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v * k.width + u);
       if (f.instance[i] != instance) continue;
       const Eigen::Vector3d ray((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
-      const double z = (r.world_T_optical * (f.depth[i] * ray)).z();
-      const double phase = z / period - std::floor(z / period);
-      const auto b = std::min<std::size_t>(11, static_cast<std::size_t>(phase * 12));
-      sum[b] += 0.2126 * f.rgb[3 * i] + 0.7152 * f.rgb[3 * i + 1] + 0.0722 * f.rgb[3 * i + 2];
-      n[b] += 1;
+      visit(i, (r.world_T_optical * (f.depth[i] * ray)).z());
     }
   }
+}
+
+// Mean luminance of an entity's wall pixels binned by the phase of their world height in a
+// period, as (max - min) / mean over 12 bins: high when the colour repeats with that period.
+double bandContrast(const FrameSet& f, const RenderRequest& r, int instance, double period) {
+  std::array<double, 12> sum{}, n{};
+  forEachPixelHeight(f, r, instance, [&](std::size_t i, double z) {
+    const double phase = z / period - std::floor(z / period);
+    const auto b = std::min<std::size_t>(11, static_cast<std::size_t>(phase * 12));
+    sum[b] += 0.2126 * f.rgb[3 * i] + 0.7152 * f.rgb[3 * i + 1] + 0.0722 * f.rgb[3 * i + 2];
+    n[b] += 1;
+  });
   double lo = 1e300, hi = -1e300, all = 0, count = 0;
   for (std::size_t b = 0; b < 12; ++b) {
     if (n[b] < 20) return 0.0;
@@ -324,6 +331,71 @@ TEST(CityRender, FacadesHaveWindowBandsWithTheStoreyPeriod) {
   const double garage = bandContrast(fg, rg, cityRenderer().instanceOf(g.id), 3.0);
   std::printf("%s: band contrast %.3f\n", g.id.c_str(), garage);
   EXPECT_LT(garage, 0.05) << g.id;
+}
+
+// Mean colour of an entity's pixels whose world height lies in [z0, z1).
+Eigen::Vector3d meanColour(const FrameSet& f, const RenderRequest& r, int instance, double z0,
+                           double z1) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  forEachPixelHeight(f, r, instance, [&](std::size_t i, double z) {
+    if (z < z0 || z >= z1) return;
+    sum += Eigen::Vector3d(f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]);
+    ++n;
+  });
+  EXPECT_GT(n, 30);
+  return sum / std::max(n, 1);
+}
+
+TEST(CityRender, TrafficLightLampsFollowTheSignalPlan) {
+  // One signalised intersection beside the first mast, its axis 0 along the mast's x axis.
+  const auto& mast = firstOf(EntityClass::kTrafficLight, 0.0);
+  scenario::SimConfig cfg = citySimConfig();
+  scenario::SignalPlan plan;
+  scenario::SignalizedIntersection is;
+  is.id = "signal_00";
+  is.position = mast.box.center2() + geometry::Vec2(5.0, 5.0);
+  is.heading[0] = mast.box.yaw;
+  is.heading[1] = mast.box.yaw + 0.5 * M_PI;
+  is.width[0] = is.width[1] = 20.0;
+  plan.intersections = {is};
+  cfg.signals = plan;
+  Renderer renderer(cityWorld(), cfg);
+  // Times when axis 0 shows red, then green.
+  double t_red = -1, t_green = -1;
+  for (double t = 0.25; t < plan.cycle(); t += 0.5) {
+    const auto st = plan.state(is, 0, t);
+    if (t_red < 0 && st == scenario::SignalState::kRed) t_red = t;
+    if (t_green < 0 && st == scenario::SignalState::kGreen) t_green = t;
+  }
+  ASSERT_GE(t_red, 0.0);
+  ASSERT_GE(t_green, 0.0);
+  // A close-up of the mast's head, looking along axis 0 at its +x face.
+  const Eigen::Vector3d x(std::cos(mast.box.yaw), std::sin(mast.box.yaw), 0.0);
+  const Eigen::Vector3d head(mast.box.center.x(), mast.box.center.y(), mast.box.maxZ() - 0.6);
+  RenderRequest r = request(head + 3.0 * x, head);
+  r.hidden_entities = allBut(mast.id);
+  const int id = renderer.instanceOf(mast.id);
+  const double top = mast.box.maxZ();
+  auto lamps = [&](double t) {
+    r.time = t;
+    const FrameSet f = renderer.render(r);
+    // Red lamp (top 0.4 m) and green lamp (0.8-1.2 m below the top), away from the band edges.
+    return std::make_pair(meanColour(f, r, id, top - 0.35, top - 0.05),
+                          meanColour(f, r, id, top - 1.15, top - 0.85));
+  };
+  const auto [red_at_red, green_at_red] = lamps(t_red);
+  const auto [red_at_green, green_at_green] = lamps(t_green);
+  std::printf("red lamp R %.0f at red, %.0f at green; green lamp G %.0f at red, %.0f at green\n",
+              red_at_red.x(), red_at_green.x(), green_at_red.y(), green_at_green.y());
+  EXPECT_GT(red_at_red.x(), 3.0 * red_at_green.x());
+  EXPECT_GT(green_at_green.y(), 3.0 * green_at_red.y());
+  EXPECT_GT(red_at_red.x(), 2.0 * red_at_red.y());          // red, not white
+  EXPECT_GT(green_at_green.y(), 2.0 * green_at_green.x());  // green
+  // Negative control: without a signal plan every lamp is dark at both times.
+  r.time = t_red;
+  const FrameSet f = cityRenderer().render(r);
+  EXPECT_LT(meanColour(f, r, id, top - 0.35, top - 0.05).x(), 0.5 * red_at_red.x());
 }
 
 }  // namespace
