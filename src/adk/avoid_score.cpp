@@ -1,6 +1,7 @@
 #include "hameritt/adk/avoid_score.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "hameritt/scenario/error.h"
 
@@ -55,8 +56,10 @@ AvoidScore AvoidScorer::score(double koz_seconds) const {
   } else if (s.separation.contact) {
     s.failure = "contact with " + s.separation.closest_aircraft;
   } else if (s.separation.losses > 0) {
-    s.failure = "lost separation " + std::to_string(s.separation.losses) + " time(s), " +
-                scenario::formatNumber(s.separation.seconds_below_minimum) + " s in all";
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "lost separation %zu time(s), %.2f s in all",
+                  s.separation.losses, s.separation.seconds_below_minimum);
+    s.failure = buf;
   }
   s.success = s.failure.empty();
   NavigationEpisode e;

@@ -146,6 +146,11 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   scorer_ = std::make_unique<adk::DetectionScorer>(mission_, sim_config_.entities, scoring);
   metrics_ = std::make_unique<adk::MetricsAccumulator>(mission_, objective);
   lifecycle_ = std::make_unique<adk::MissionLifecycle>(time_limit);
+  for (const auto& phase : mission_.phases) {
+    if (phase.type == scenario::PhaseType::kAvoid) {
+      avoid_ = std::make_unique<adk::AvoidScorer>(phase.avoid, time_limit);
+    }
+  }
 
   mission_pub_ = gate_->advertise<hameritt::Mission>(nh, "mission", 1, true);
   markers_pub_ = gate_->advertise<visualization_msgs::MarkerArray>(nh, "mission/markers", 1, true);
@@ -272,6 +277,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   try {
     for (const auto& e : monitor_->add(t, p)) gate_->publish(events_pub_, toMsg(e));
     metrics_->addState(t, p, v);
+    if (avoid_) avoid_->add(avoidSample(t, p, v));
   } catch (const adk::InputError& e) {
     HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", odom_sub_.getTopic().c_str(), e.what());
     return;
@@ -297,6 +303,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   // A target found before the mission started running ends it as soon as it runs.
   checkObjective(t);
+  checkAvoid(t);
   endAtSimulationEnd(false);
 }
 
@@ -382,6 +389,40 @@ void AdkRos::checkObjective(double t) {
   const std::string how = metrics_->targets().size() == 1 ? "target" : "every target";
   if (lifecycle_->succeed(
           t, how + (found_by_sighting_ ? " sighted" : " correctly claimed by the client"))) {
+    publishState();
+    finish();
+  }
+}
+
+adk::TrafficSample AdkRos::avoidSample(double t, const Eigen::Vector3d& p,
+                                       const Eigen::Vector3d& v) const {
+  adk::TrafficSample s;
+  s.t = t;
+  s.position = p;
+  s.velocity = v;
+  // The aircraft fly scripted trajectories (sim_config.json): their ground truth at t, the
+  // velocity from the trajectory over +-0.05 s.
+  for (const auto& a : sim_config_.aircraft) {
+    const auto at = [&](double u) {
+      const scenario::TrajectoryPoint q = scenario::sampleTrajectory(a.trajectory, u);
+      return Eigen::Vector3d(q.x, q.y, q.z);
+    };
+    adk::AircraftState st;
+    st.id = a.id;
+    st.position = at(t);
+    st.velocity = (at(t + 0.05) - at(t - 0.05)) / 0.1;
+    s.aircraft.push_back(st);
+  }
+  return s;
+}
+
+void AdkRos::checkAvoid(double t) {
+  if (!avoid_ || !avoid_->reached() || lifecycle_->state() != adk::MissionState::kRunning) return;
+  const adk::AvoidScore s = avoid_->score(monitor_->violationDuration());
+  char at[64];
+  std::snprintf(at, sizeof(at), "reached the goal at t = %.3f s", *s.reach_time);
+  if (s.success ? lifecycle_->succeed(t, at)
+                : lifecycle_->fail(t, std::string(at) + ", but " + s.failure)) {
     publishState();
     finish();
   }
@@ -479,9 +520,10 @@ void AdkRos::finish() {
                   watchdog_->lateStart());
     reason += late;
   }
-  const adk::MissionMetrics m = metrics_->finish(
-      adk::outcomeOf(lifecycle_->state()), reason, lifecycle_->startTime(), lifecycle_->endTime(),
-      lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+  adk::MissionMetrics m = metrics_->finish(adk::outcomeOf(lifecycle_->state()), reason,
+                                           lifecycle_->startTime(), lifecycle_->endTime(),
+                                           lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+  if (avoid_) m.avoid = avoid_->score(monitor_->violationDuration());
   std::string file;
   if (!output_dir_.empty()) {
     try {

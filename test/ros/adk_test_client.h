@@ -78,6 +78,14 @@ class FakeSimulator {
 
   // Publishes odometry at (t, p, v) on every namespace, then the clock.
   void publish(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
+    for (std::size_t i = 0; i < odom_pubs_.size(); ++i) publishOdometry(i, t, p, v);
+    clock(t);
+  }
+
+  // Odometry at (t, p, v) on the i-th namespace only, without the clock: for flights that
+  // differ per node (publish the clock after every namespace's odometry of the step).
+  void publishOdometry(std::size_t i, double t, const Eigen::Vector3d& p,
+                       const Eigen::Vector3d& v) {
     nav_msgs::Odometry o;
     o.header.stamp.fromSec(t);
     o.header.frame_id = "map";
@@ -89,8 +97,7 @@ class FakeSimulator {
     o.twist.twist.linear.x = v.x();
     o.twist.twist.linear.y = v.y();
     o.twist.twist.linear.z = v.z();
-    for (auto& pub : odom_pubs_) pub.publish(o);
-    clock(t);
+    odom_pubs_.at(i).publish(o);
   }
 
   void clock(double t) {
