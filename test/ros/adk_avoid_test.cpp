@@ -26,13 +26,6 @@ namespace {
 
 const std::string kRoot = "/tmp/hameritt_adk_avoid";
 
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream f(path);
-  EXPECT_TRUE(f.good()) << path << ": cannot read";
-  if (!f.good()) return nlohmann::json::object();
-  return nlohmann::json::parse(f);
-}
-
 struct Keyframes {
   std::string id;
   std::vector<std::array<double, 4>> k;  // t, x, y, z
@@ -102,8 +95,8 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
   std::string data;
   ASSERT_TRUE(ros::NodeHandle("~").getParam("data_dir", data)) << "~data_dir not set";
   data += "/";
-  const auto mission = readJson(data + "avoid_mission.json");
-  const auto sim = readJson(data + "avoid_sim_config.json");
+  const auto mission = hameritt::testing::readJsonFile(data + "avoid_mission.json");
+  const auto sim = hameritt::testing::readJsonFile(data + "avoid_sim_config.json");
   ASSERT_EQ(mission["phases"].size(), 1u);
   const auto& phase = mission["phases"][0];
   ASSERT_EQ(phase["type"], "avoid");
@@ -167,7 +160,7 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
   ASSERT_TRUE(clean_metrics.waitFor(1, 20)) << "no /clean/adk/metrics";
   ASSERT_TRUE(close_metrics.waitFor(1, 20)) << "no /close/adk/metrics";
 
-  const auto cm = readJson(kRoot + "/clean/metrics.json");
+  const auto cm = hameritt::testing::readJsonFile(kRoot + "/clean/metrics.json");
   ASSERT_TRUE(cm.contains("avoid")) << cm.dump(2);
   const auto& ca = cm["avoid"];
   EXPECT_EQ(cm["outcome"], "success") << cm["reason"];
@@ -185,7 +178,7 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
   EXPECT_NEAR(ca["min_separation"].get<double>(), jc.min_distance, 0.05);
   EXPECT_EQ(ca["shortest_path"].get<double>(), shortest);
 
-  const auto xm = readJson(kRoot + "/close/metrics.json");
+  const auto xm = hameritt::testing::readJsonFile(kRoot + "/close/metrics.json");
   ASSERT_TRUE(xm.contains("avoid")) << xm.dump(2);
   const auto& xa = xm["avoid"];
   EXPECT_EQ(xm["outcome"], "failed") << xm["reason"];

@@ -9,11 +9,21 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 namespace hameritt::testing {
+
+// A JSON file the ADK wrote; an empty object (and a test failure) when it cannot be read.
+inline nlohmann::json readJsonFile(const std::string& path) {
+  std::ifstream f(path);
+  EXPECT_TRUE(f.good()) << path << ": cannot read";
+  if (!f.good()) return nlohmann::json::object();
+  return nlohmann::json::parse(f);
+}
 
 // Serves callbacks until `done` holds or `seconds` of wall time have passed; returns done().
 inline bool spinUntil(const std::function<bool()>& done, double seconds) {
