@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "hameritt/AvoidStatus.h"
 #include "hameritt/ConstraintEvent.h"
 #include "hameritt/ConstraintStatus.h"
 #include "hameritt/DetectionScore.h"
@@ -149,6 +150,7 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   for (const auto& phase : mission_.phases) {
     if (phase.type == scenario::PhaseType::kAvoid) {
       avoid_ = std::make_unique<adk::AvoidScorer>(phase.avoid, time_limit);
+      avoid_phase_ = phase.id;
     }
   }
 
@@ -161,6 +163,7 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   scores_pub_ = gate_->advertise<hameritt::DetectionScore>(nh, "adk/detection_scores", 100);
   state_pub_ = gate_->advertise<hameritt::MissionState>(nh, "adk/state", 10, true);
   metrics_pub_ = gate_->advertise<hameritt::MissionMetrics>(nh, "adk/metrics", 1, true);
+  if (avoid_) avoid_pub_ = gate_->advertise<hameritt::AvoidStatus>(nh, "adk/avoid", 10, true);
 
   if (gate_->enabled()) {
     // Lock-step: the turn carries the sim time (README "Lock-step missions").
@@ -294,6 +297,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   if (t >= next_status_t_) {
     publishConstraints(t);
+    publishAvoid(t);
     next_status_t_ = t + status_period_;
   }
   judgeTrackAtLimit(t);
@@ -416,6 +420,28 @@ adk::TrafficSample AdkRos::avoidSample(double t, const Eigen::Vector3d& p,
   return s;
 }
 
+void AdkRos::publishAvoid(double t) {
+  if (!avoid_) return;
+  const adk::AvoidScore a = avoid_->score(monitor_->violationDuration());
+  hameritt::AvoidStatus m;
+  m.header.stamp = stampOf(t);
+  m.header.frame_id = "map";
+  m.phase = avoid_phase_;
+  m.reached = a.reach_time.has_value();
+  m.reach_time = a.reach_time ? *a.reach_time : std::nan("");
+  m.goal_distance = a.goal_distance_m;
+  m.path_length = a.path_length_m;
+  m.separation_lost = avoid_->separationLost();
+  m.min_separation = a.separation.min_distance_m;
+  m.closest_aircraft = a.separation.closest_aircraft;
+  m.seconds_below_minimum = a.separation.seconds_below_minimum;
+  m.separation_losses = static_cast<std::uint32_t>(a.separation.losses);
+  m.min_time_to_collision = a.separation.min_time_to_collision_s;
+  m.contact = a.separation.contact;
+  m.koz_seconds = a.koz_seconds;
+  gate_->publish(avoid_pub_, m);
+}
+
 void AdkRos::checkAvoid(double t) {
   if (!avoid_ || !avoid_->reached() || lifecycle_->state() != adk::MissionState::kRunning) return;
   const adk::AvoidScore s = avoid_->score(monitor_->violationDuration());
@@ -523,7 +549,10 @@ void AdkRos::finish() {
   adk::MissionMetrics m = metrics_->finish(adk::outcomeOf(lifecycle_->state()), reason,
                                            lifecycle_->startTime(), lifecycle_->endTime(),
                                            lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
-  if (avoid_) m.avoid = avoid_->score(monitor_->violationDuration());
+  if (avoid_) {
+    m.avoid = avoid_->score(monitor_->violationDuration());
+    publishAvoid(lifecycle_->endTime());
+  }
   std::string file;
   if (!output_dir_.empty()) {
     try {

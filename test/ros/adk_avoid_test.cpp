@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "adk_test_client.h"
+#include "hameritt/AvoidStatus.h"
 #include "hameritt/MissionMetrics.h"
 #include "hameritt/MissionState.h"
 
@@ -140,10 +141,13 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
   Collector<hameritt::MissionMetrics> clean_metrics(nh, "/clean/adk/metrics");
   Collector<hameritt::MissionMetrics> close_metrics(nh, "/close/adk/metrics");
   Collector<hameritt::MissionState> close_state(nh, "/close/adk/state");
+  Collector<hameritt::AvoidStatus> clean_live(nh, "/clean/adk/avoid");
+  Collector<hameritt::AvoidStatus> close_live(nh, "/close/adk/avoid");
   ASSERT_TRUE(fake.waitForSubscribers(30, 2)) << "adk nodes not subscribed";
   ASSERT_TRUE(spinUntil(
       [&] {
-        return clean_metrics.connected() && close_metrics.connected() && close_state.connected();
+        return clean_metrics.connected() && close_metrics.connected() && close_state.connected() &&
+               clean_live.connected() && close_live.connected();
       },
       30));
   const std::size_t n = std::max(clean.size(), close.size());
@@ -194,6 +198,22 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
   EXPECT_EQ(xa["closest_aircraft"], aircraft[0].id);
   EXPECT_FALSE(xa["contact"].get<bool>());
   EXPECT_EQ(xa["spl"].get<double>(), 0.0);
+
+  // The live score (adk/avoid, status rate): the close flight's shows the loss while it rides
+  // above the aircraft; the last message of each (at the end) says what metrics.json says.
+  ASSERT_TRUE(spinUntil([&] { return clean_live.last().reached && close_live.last().reached; }, 5));
+  bool lost_live = false;
+  for (const auto& m : close_live.all) {
+    if (m.header.stamp.toSec() <= 2.0 && m.separation_lost) lost_live = true;
+  }
+  EXPECT_TRUE(lost_live) << close_live.all.size() << " messages";
+  EXPECT_GT(close_live.all.size(), 10u);
+  for (const auto& m : clean_live.all) EXPECT_FALSE(m.separation_lost) << m.header.stamp.toSec();
+  EXPECT_EQ(close_live.last().separation_losses, xa["separation_losses"].get<unsigned>());
+  EXPECT_EQ(close_live.last().min_separation, xa["min_separation"].get<double>());
+  EXPECT_EQ(close_live.last().reach_time, xa["reach_time"].get<double>());
+  EXPECT_EQ(clean_live.last().path_length, ca["path_length"].get<double>());
+  EXPECT_EQ(clean_live.last().phase, "avoid_1");
 
   // Both files pass the published schema as python3-jsonschema reads it; a copy with an SPL
   // above 1 does not (the control).

@@ -79,6 +79,7 @@ class AdkRos {
   // Avoid missions: ends the mission once the goal is reached, succeeded when the avoid phase's
   // criteria hold (adk/avoid_score.h), failed otherwise.
   void checkAvoid(double t);
+  void publishAvoid(double t);
   adk::TrafficSample avoidSample(double t, const Eigen::Vector3d& p,
                                  const Eigen::Vector3d& v) const;
   // Track objectives are judged at the time limit: at t >= the limit, success when every
@@ -115,6 +116,7 @@ class AdkRos {
   std::unique_ptr<adk::MissionLifecycle> lifecycle_;
   // The avoid phase of an avoid mission: scored from the odometry and the scripted aircraft.
   std::unique_ptr<adk::AvoidScorer> avoid_;
+  std::string avoid_phase_;
   std::unique_ptr<adk::ClockWatchdog> watchdog_;
   adk::GroundTruthHistory truth_{10.0};
 
@@ -134,7 +136,7 @@ class AdkRos {
   ros::WallTime finished_at_;
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
-      perception_pub_, scores_pub_, state_pub_, metrics_pub_;
+      perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_;
   ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };
