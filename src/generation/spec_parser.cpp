@@ -1007,12 +1007,8 @@ class Parser {
       if (!r.eventually &&
           (r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar) && !r.negated) {
         // A positive relation to a car or pedestrian is constructed: the sampler parks a car or
-        // stands a pedestrian beside the target, one per spec, in every scenario.
-        if (r.probability < 1.0) {
-          errorAt(r.pos, requirement_src_[i],
-                  "a relation to a car or pedestrian is constructed (a parked car or a standing "
-                  "pedestrian is placed for it): use 'require', not 'prefer'");
-        }
+        // stands a pedestrian beside the target, one per spec (with 'prefer', in the scenarios
+        // drawn to meet it).
         if (placed_seen) {
           errorAt(r.pos, requirement_src_[i],
                   "one relation per spec may place a car or pedestrian beside the target; "

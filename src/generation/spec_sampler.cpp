@@ -598,7 +598,10 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   }
   // Requirements, hard ones first narrowing the set, soft ones split it.
   const scenario::RelationEvaluator eval(world, base.relations);
-  std::vector<std::vector<char>> soft_masks;
+  // Per soft requirement, the pairs where it can be drawn to hold and where it can be drawn to
+  // fail (complements, except for a soft placing requirement: where the world does not meet it,
+  // a placed entity can make it hold or nothing placed leaves it failing).
+  std::vector<std::vector<char>> soft_masks, soft_fail_masks;
   // The requirement that places a car or pedestrian goes last: it is tested on the places
   // that every other requirement left.
   std::vector<std::size_t> order;
@@ -611,7 +614,7 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   for (const std::size_t ri : order) {
     const Requirement& r = spec_.requirements[ri];
     if (r.eventually) continue;  // constructed by the pursuit's vignette
-    std::vector<char> mask(pairs.size());
+    std::vector<char> mask(pairs.size()), fail_mask(pairs.size());
     std::vector<int> candidates;  // per parking place: the pairs run place by place
     std::shared_ptr<const RelatedPlacer> placer;
     if (placesRelated(r)) {
@@ -633,27 +636,35 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
                                  base.relations.radius + 0.5 * max_diagonal);
       }
       const OrientedBox box = parkedBox(sl, models[static_cast<std::size_t>(pairs[k].second)]);
-      bool holds = in_world && holdsAmong(eval, world, r, box, candidates);
+      const bool in_scene = in_world && holdsAmong(eval, world, r, box, candidates);
+      bool holds = in_scene;
       // Constructed: a car or pedestrian that the generator places beside the target.
       if (!holds && placer) holds = !placer->options(box, true).empty();
       mask[k] = holds != r.negated;
+      fail_mask[k] = placer ? !in_scene : !mask[k];
     }
     if (r.probability < 1.0) {
+      if (placer) placer_soft_ = static_cast<int>(soft_.size());
       soft_.push_back(static_cast<int>(ri));
       soft_masks.push_back(std::move(mask));
+      soft_fail_masks.push_back(std::move(fail_mask));
       continue;
     }
     const long long before = count(pairs.size());
     std::vector<std::pair<int, int>> kept;
-    std::vector<std::vector<char>> kept_soft(soft_masks.size());
+    std::vector<std::vector<char>> kept_soft(soft_masks.size()), kept_fail(soft_masks.size());
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       if (!mask[k]) continue;
       kept.push_back(pairs[k]);
-      for (std::size_t j = 0; j < soft_masks.size(); ++j) kept_soft[j].push_back(soft_masks[j][k]);
+      for (std::size_t j = 0; j < soft_masks.size(); ++j) {
+        kept_soft[j].push_back(soft_masks[j][k]);
+        kept_fail[j].push_back(soft_fail_masks[j][k]);
+      }
     }
     if (kept.empty()) refuse(r.pos, r.text, before);
     pairs = std::move(kept);
     soft_masks = std::move(kept_soft);
+    soft_fail_masks = std::move(kept_fail);
     steps_.push_back({r.text, count(pairs.size())});
   }
   hard_ = pairs;
@@ -668,7 +679,7 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       bool ok = true;
       for (std::size_t j = 0; j < soft_.size() && ok; ++j) {
-        ok = (soft_masks[j][k] != 0) == (((bits >> j) & 1U) != 0);
+        ok = ((bits >> j) & 1U) != 0 ? soft_masks[j][k] != 0 : soft_fail_masks[j][k] != 0;
       }
       if (ok) combos_[bits].push_back(pairs[k]);
     }
@@ -733,7 +744,8 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
       return worldRelationHoldsPruned(*ev, ev->world(), r, box) == r.negated;
     };
   }
-  if (placer_) {
+  // A soft placing requirement drawn to fail places nothing (its pairs have no such entity).
+  if (placer_ && (placer_soft_ < 0 || ((bits >> placer_soft_) & 1U) != 0)) {
     d.plan.related = [p = placer_](const OrientedBox& box) {
       if (worldRelationHoldsPruned(p->eval, p->world, p->req, box)) {
         return std::vector<scenario::RelatedOption>{};

@@ -65,6 +65,7 @@ class CompiledSpec {
   bool placed_ = false;  // the target is parked (area_search, pursuit)
   // The requirement that places a car or pedestrian beside the target, if any.
   std::shared_ptr<const RelatedPlacer> placer_;
+  int placer_soft_ = -1;  // its index in soft_ when it is soft ('prefer'); -1: hard
   // The world's relations, for the requirement that tells look-alikes apart.
   std::shared_ptr<const scenario::RelationEvaluator> told_eval_;
 };
