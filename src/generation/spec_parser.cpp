@@ -981,18 +981,30 @@ class Parser {
     bool placed_seen = false;
     for (std::size_t i = 0; i < spec_.requirements.size(); ++i) {
       const Requirement& r = spec_.requirements[i];
-      if (route) {
+      const bool mover = r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar;
+      if (route && mover) {
         errorAt(r.pos, requirement_src_[i],
-                "route_search targets drive from the start: relation requirements apply to "
-                "area_search and pursuit targets");
+                "a route_search target relates to the neighborhood (street, house, building, "
+                "...): relations to cars and pedestrians apply to parked targets");
       }
-      if (r.eventually &&
-          !(pursuit && r.related == EntityClass::kPedestrian &&
-            r.op == scenario::RelationOp::kNextTo && !r.negated && r.probability == 1.0)) {
+      const bool runners =
+          pursuit && r.related == EntityClass::kPedestrian && r.op == scenario::RelationOp::kNextTo;
+      if (r.eventually && !route && !pursuit) {
         errorAt(r.pos, requirement_src_[i],
-                "EVENTUALLY_* requirements: the sampler constructs 'require pedestrian "
-                "EVENTUALLY_NEXT_TO target' (the pursuit's running pedestrians); other "
-                "EVENTUALLY_* requirements are not supported");
+                "EVENTUALLY_* applies to a moving target (route_search, pursuit); an area_search "
+                "target is parked: drop EVENTUALLY_");
+      }
+      if (r.eventually && mover && !runners) {
+        errorAt(r.pos, requirement_src_[i],
+                "EVENTUALLY_* relates a moving target to the neighborhood (street, house, "
+                "building, ...), or a pursuit target to its running pedestrians ('pedestrian "
+                "EVENTUALLY_NEXT_TO target')");
+      }
+      if (r.eventually && (r.negated || r.probability < 1.0)) {
+        errorAt(r.pos, requirement_src_[i],
+                "EVENTUALLY_* is constructed where the target drives: expected 'require' "
+                "without 'not' (a negation or a 'prefer' would have to hold over the whole "
+                "drive)");
       }
       if (r.eventually) {
         for (const auto& a : r.attributes) {

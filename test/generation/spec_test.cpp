@@ -114,7 +114,9 @@ TEST(SpecParse, TypeErrors) {
   EXPECT_EQ(moving.substr(0, moving.find('\n')),
             "t.hspec:2:1: error: an area_search target is parked; expected 'parked'");
   const std::string ev = errorOf(std::string(kHead) + "require tree EVENTUALLY_NEXT_TO target\n");
-  EXPECT_NE(ev.find("t.hspec:2:1: error: EVENTUALLY_* requirements"), std::string::npos) << ev;
+  EXPECT_EQ(ev.substr(0, ev.find('\n')),
+            "t.hspec:2:1: error: EVENTUALLY_* applies to a moving target (route_search, "
+            "pursuit); an area_search target is parked: drop EVENTUALLY_");
 }
 
 TEST(SpecParse, DistributionsDrawInsideTheirSupport) {
@@ -508,6 +510,147 @@ TEST(SpecRelated, TypeCheckerRules) {
                         "target car parked\nrequire car NEXT_TO target\n"
                         "require not car IN_FRONT_OF target\nrequire not pedestrian NEXT_TO "
                         "target\n"));
+}
+
+// Relations of a moving target: at t = 0 (where a route-search car starts), and EVENTUALLY_* at
+// a later sample of its trajectory with an entity not so related at t = 0.
+const char* kRoute =
+    "scenario route_search\ntarget car {vehicle_class: sedan} moving\n"
+    "require house LEFT_OF target\nrequire garage EVENTUALLY_RIGHT_OF target\n";
+
+TEST(SpecMoving, TypeCheckerRules) {
+  auto first = [](const std::string& e) { return e.substr(0, e.find('\n')); };
+  const char* kRouteHead = "scenario route_search\ntarget car moving\n";
+  EXPECT_EQ(first(errorOf(std::string(kRouteHead) + "require car LEFT_OF target\n")),
+            "t.hspec:3:1: error: a route_search target relates to the neighborhood (street, "
+            "house, building, ...): relations to cars and pedestrians apply to parked targets");
+  EXPECT_EQ(first(errorOf("scenario pursuit\ntarget car\nrequire car EVENTUALLY_NEXT_TO target\n")),
+            "t.hspec:3:1: error: EVENTUALLY_* relates a moving target to the neighborhood "
+            "(street, house, building, ...), or a pursuit target to its running pedestrians "
+            "('pedestrian EVENTUALLY_NEXT_TO target')");
+  const std::string expect_require =
+      "EVENTUALLY_* is constructed where the target drives: expected 'require' without 'not' (a "
+      "negation or a 'prefer' would have to hold over the whole drive)";
+  EXPECT_EQ(
+      first(errorOf(std::string(kRouteHead) + "require not house EVENTUALLY_LEFT_OF target\n")),
+      "t.hspec:3:1: error: " + expect_require);
+  EXPECT_EQ(
+      first(errorOf(std::string(kRouteHead) + "prefer 0.4 house EVENTUALLY_LEFT_OF target\n")),
+      "t.hspec:3:1: error: " + expect_require);
+  // Accepted: every operator in its EVENTUALLY_ form on the neighborhood, static ones too.
+  EXPECT_NO_THROW(parse(std::string(kRouteHead) +
+                        "require street ON_TOP_OF target\nrequire not tree NEXT_TO target\n"
+                        "require house EVENTUALLY_IN_FRONT_OF target\n"
+                        "require garage EVENTUALLY_ORTHOGONAL_TO target\n"
+                        "require driveway EVENTUALLY_NOT_ON_TOP_OF target\n"));
+}
+
+TEST(SpecMoving, RouteSearchRelationsAreMetAndChecked) {
+  const Spec s = parse(kRoute);
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  ASSERT_EQ(c.steps().size(), 4u);
+  EXPECT_EQ(c.steps()[0].label, "route starts x looks");
+  EXPECT_EQ(c.steps()[1].label, "vehicle_class sedan");
+  EXPECT_EQ(c.steps()[2].label, "house LEFT_OF target");
+  EXPECT_EQ(c.steps()[3].label, "garage EVENTUALLY_RIGHT_OF target");
+  // Each requirement narrows the set, and the last count is the feasible set (x colours).
+  EXPECT_LT(c.steps()[3].count, c.steps()[2].count);
+  EXPECT_LT(c.steps()[2].count, c.steps()[1].count);
+  EXPECT_GT(c.feasibleCount(), 0u);
+  int listed = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+    const scenario::Scenario sc =
+        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
+    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
+    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    const scenario::ScenarioEntity* lead = nullptr;
+    for (const auto& se : sc.sim.entities) {
+      if (!lead && se.role == "target") lead = &se;
+    }
+    ASSERT_TRUE(lead);
+    for (const auto& r : sc.mission.relations) {
+      if (r.target_id == lead->entity.id && r.eventually && r.related_class == "garage" &&
+          r.op == scenario::RelationOp::kRightOf) {
+        ++listed;
+        EXPECT_GT(r.time, 0.0);
+      }
+    }
+    // Negative controls: the lead car frozen at its start (nothing comes to its right later),
+    // moved 2 km off (nothing beside it at all), and the eventual relation left out of the
+    // mission.
+    scenario::SimConfig frozen = sc.sim;
+    for (auto& se : frozen.entities) {
+      if (se.entity.id != lead->entity.id) continue;
+      const scenario::TrajectoryPoint p0 = se.trajectory.front();
+      se.trajectory = {p0, p0};
+      se.trajectory.back().t = 1.0;
+    }
+    const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, frozen, nullptr);
+    ASSERT_EQ(f1.size(), 1u) << seed;
+    EXPECT_EQ(f1[0], "requirement 'garage EVENTUALLY_RIGHT_OF target' does not hold for target " +
+                         lead->entity.id + " (recomputed from the scene)");
+    scenario::SimConfig away = sc.sim;
+    for (auto& se : away.entities) {
+      if (se.entity.id != lead->entity.id) continue;
+      for (auto& p : se.trajectory) p.x += 2000.0;
+    }
+    const auto f2 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, away, nullptr);
+    ASSERT_EQ(f2.size(), 2u) << seed;
+    EXPECT_NE(f2[0].find("requirement 'house LEFT_OF target' does not hold"), std::string::npos);
+    scenario::Mission unlisted = sc.mission;
+    unlisted.relations.erase(
+        std::remove_if(unlisted.relations.begin(), unlisted.relations.end(),
+                       [](const scenario::SceneRelation& r) { return r.eventually; }),
+        unlisted.relations.end());
+    const auto f3 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, unlisted, sc.sim, nullptr);
+    ASSERT_EQ(f3.size(), 1u) << seed;
+    EXPECT_EQ(f3[0],
+              "requirement 'garage EVENTUALLY_RIGHT_OF target' holds but the mission does "
+              "not list it");
+  }
+  EXPECT_EQ(listed, 8);
+  // The same spec and seed give the same scenario.
+  const ScenarioDraw d = c.draw(3, 3, 1, SamplerKind::kRandom);
+  const scenario::Scenario a =
+      scenario::generateScenario(shippedWorld(), d.config, s.cls, 3, &d.plan);
+  const scenario::Scenario b =
+      scenario::generateScenario(shippedWorld(), d.config, s.cls, 3, &d.plan);
+  EXPECT_EQ(scenario::missionJson(a.mission), scenario::missionJson(b.mission));
+  EXPECT_EQ(scenario::simConfigJson(a.sim), scenario::simConfigJson(b.sim));
+}
+
+TEST(SpecMoving, PursuitEventuallyIsMetAfterItDrivesOff) {
+  const Spec s = parse(
+      "scenario pursuit\ntarget car\nrequire pedestrian EVENTUALLY_NEXT_TO target\n"
+      "require house EVENTUALLY_LEFT_OF target\n");
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+    const scenario::Scenario sc =
+        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
+    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
+    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    // Negative control: the target never leaves its kerb.
+    scenario::SimConfig parked = sc.sim;
+    for (auto& se : parked.entities) {
+      if (se.role != "target") continue;
+      const scenario::TrajectoryPoint p0 = se.trajectory.front();
+      se.trajectory = {p0, p0};
+      se.trajectory.back().t = 1.0;
+    }
+    const auto f = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, parked, nullptr);
+    bool reported = false;
+    for (const auto& m : f) {
+      reported = reported ||
+                 m.find("'house EVENTUALLY_LEFT_OF target' does not hold") != std::string::npos;
+    }
+    EXPECT_TRUE(reported) << seed;
+  }
 }
 
 TEST(SpecWithin, TheTargetParksNearALandmarkAndIsChecked) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hameritt/generation/target_slots.h"
 #include "hameritt/scenario/generator_config.h"
 
 namespace hameritt::scenario {
@@ -54,6 +55,17 @@ struct ScenarioPlan {
   std::optional<double> confuser_within;
   // True when a look-alike parked with this box fails the requirement that tells it apart.
   std::function<bool(const geometry::OrientedBox&)> confuser_told_apart;
+  // route_search: the lead target's feasible starts; `placements` then holds (index here,
+  // catalog model) pairs, tried in a seeded order until one has a route.
+  const std::vector<RouteStart>* route_starts = nullptr;
+  // An EVENTUALLY_* requirement on a moving target against the world's entities: the mission
+  // lists the first trajectory sample at which a matching entity, not so related at t = 0,
+  // stands in the relation.
+  struct Eventual {
+    RelationOp op = RelationOp::kNextTo;
+    std::function<bool(EntityClass, const Attributes&)> matches;
+  };
+  std::vector<Eventual> eventually;
 };
 
 // Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give

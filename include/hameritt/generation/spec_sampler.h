@@ -63,6 +63,8 @@ class CompiledSpec {
   std::vector<std::vector<std::pair<int, int>>> combos_;
   std::vector<NarrowingStep> steps_;
   bool placed_ = false;  // the target is parked (area_search, pursuit)
+  // route_search with requirements: the lead car's starts (the pairs' first members index it).
+  std::vector<scenario::RouteStart> route_starts_;
   // The requirement that places a car or pedestrian beside the target, if any.
   std::shared_ptr<const RelatedPlacer> placer_;
   // The world's relations, for the requirement that tells look-alikes apart.
