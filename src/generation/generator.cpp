@@ -115,6 +115,7 @@ class ScenarioBuilder {
         buildAvoid();  // places the UAV itself, at the start of its reference flight
         break;
     }
+    if (plan_ && !plan_->kozs.empty()) addSpecKozs();
     if (cls_ != ScenarioClass::kAvoid) placeUavStart();
     if (world_.params().type == WorldType::kCity) {
       addCityTraffic();
@@ -1182,6 +1183,27 @@ class ScenarioBuilder {
     }
   }
 
+  // A spec's keep-out zones, after the class's own (specKozPolygons).
+  void addSpecKozs() {
+    const ScenarioEntity* target = nullptr;
+    for (const auto& se : sc_.sim.entities) {
+      if (!target && se.role == "target") target = &se;
+    }
+    if (!target) return;
+    OrientedBox box = target->entity.box;
+    if (!target->trajectory.empty()) box = poseBox(box, sampleTrajectory(target->trajectory, 0.0));
+    for (const auto& z : plan_->kozs) {
+      for (const Polygon& poly : specKozPolygons(world_, z, box)) {
+        KeepOutZone k = makeKoz(poly, z.purpose);
+        k.alt_min = z.alt_min;
+        k.alt_max = z.alt_max;
+        k.window.net = z.net;
+        k.window.nlt = z.nlt;
+        sc_.mission.kozs.push_back(k);
+      }
+    }
+  }
+
   void buildPursuit() {
     Mission& m = sc_.mission;
     m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_pursuit));
@@ -1891,6 +1913,31 @@ Scenario generateScenario(const World& world, const GeneratorConfig& config, Sce
   } catch (const GenerationError& e) {
     throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " + e.what());
   }
+}
+
+std::vector<Polygon> specKozPolygons(const World& world, const ScenarioPlan::Koz& koz,
+                                     const OrientedBox& target) {
+  std::vector<Polygon> out;
+  if (koz.over == "target") {
+    out.push_back(roundPolygon(
+        geometry::orientedRectangle(target.center2(), koz.size, koz.size, target.yaw)));
+    return out;
+  }
+  EntityClass cls;
+  if (!parseEntityClass(koz.over, &cls)) return out;
+  std::vector<std::pair<double, int>> near;
+  for (int i = 0; i < static_cast<int>(world.entities().size()); ++i) {
+    const Entity& e = world.entities()[static_cast<std::size_t>(i)];
+    if (e.cls == cls) near.emplace_back((e.box.center2() - target.center2()).norm(), i);
+  }
+  std::sort(near.begin(), near.end());
+  for (std::size_t k = 0; k < near.size() && static_cast<int>(k) < koz.count; ++k) {
+    const Entity& e = world.entities()[static_cast<std::size_t>(near[k].second)];
+    out.push_back(
+        roundPolygon(geometry::orientedRectangle(e.box.center2(), e.box.size.x() + 2 * koz.margin,
+                                                 e.box.size.y() + 2 * koz.margin, e.box.yaw)));
+  }
+  return out;
 }
 
 }  // namespace hameritt::scenario

@@ -566,6 +566,25 @@ void applySetting(const std::string& key, double v, ScenarioClass cls, scenario:
   }
 }
 
+// A koz statement with the values drawn for its settings (absent: the defaults).
+scenario::ScenarioPlan::Koz drawnKoz(const KozSpec& k, const std::map<std::string, double>& v) {
+  scenario::ScenarioPlan::Koz z;
+  z.purpose = k.purpose;
+  z.over = k.over;
+  auto get = [&](const char* name) -> std::optional<double> {
+    auto it = v.find(k.key + "." + name);
+    return it == v.end() ? std::nullopt : std::optional<double>(it->second);
+  };
+  if (auto c = get("count")) z.count = static_cast<int>(std::lround(*c));
+  if (auto x = get("size")) z.size = *x;
+  if (auto x = get("margin")) z.margin = *x;
+  z.alt_min = get("alt_min");
+  z.alt_max = get("alt_max");
+  z.net = get("net");
+  z.nlt = get("nlt");
+  return z;
+}
+
 }  // namespace
 
 bool worldRelationHolds(const scenario::RelationEvaluator& eval, const scenario::World& world,
@@ -846,12 +865,15 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
   prov.file = spec_.file;
   prov.hash = spec_.hash;
   prov.sampler = sampler == SamplerKind::kHalton ? "halton" : "random";
+  std::map<std::string, double> drawn;
   for (const auto& [key, dist] : spec_.settings) {
     double v = dist.draw(unit());
     if (!dist.integer) v = scenario::roundMilli(v);
     applySetting(key, v, spec_.cls, &d.config, &d.plan);
     prov.values.emplace_back(key, v);
+    drawn[key] = v;
   }
+  for (const auto& k : spec_.kozs) d.plan.kozs.push_back(drawnKoz(k, drawn));
   std::size_t bits = 0;
   for (std::size_t j = 0; j < soft_.size(); ++j) {
     const auto& r = spec_.requirements[static_cast<std::size_t>(soft_[j])];
@@ -1128,6 +1150,61 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
       }
     }
   }
+  // Keep-out zones: each koz statement's zones, recomputed from the scene (the target's
+  // position at t = 0, the world's entities) with the values the sampler recorded, must be in
+  // the mission with their purpose, altitude band and window.
+  std::size_t spec_zones = 0;  // of mission.kozs: the koz statements' (not the class's own)
+  if (!spec.kozs.empty()) {
+    std::map<std::string, double> recorded;
+    if (sim.spec) {
+      for (const auto& [name, v] : sim.spec->values) {
+        if (std::holds_alternative<double>(v)) recorded[name] = std::get<double>(v);
+      }
+    }
+    auto same = [](const std::optional<double>& a, const std::optional<double>& b) {
+      return a.has_value() == b.has_value() && (!a || std::abs(*a - *b) <= 1e-3);
+    };
+    for (const auto& k : spec.kozs) {
+      const scenario::ScenarioPlan::Koz z = drawnKoz(k, recorded);
+      const std::string what = "koz " + k.purpose + " over " + k.over;
+      const auto want = scenario::specKozPolygons(world, z, box);
+      if (want.empty()) fail(what + ": no " + k.over + " in this world");
+      spec_zones += want.size();
+      for (const auto& poly : want) {
+        bool found = false;
+        for (const auto& m : mission.kozs) {
+          if (found || m.purpose != k.purpose || !same(m.alt_min, z.alt_min) ||
+              !same(m.alt_max, z.alt_max) || !same(m.window.net, z.net) ||
+              !same(m.window.nlt, z.nlt) || m.polygon.size() != poly.size())
+            continue;
+          bool match = true;
+          for (std::size_t i = 0; i < poly.size() && match; ++i) {
+            match = (m.polygon.vertices()[i] - poly.vertices()[i]).norm() <= 0.01;
+          }
+          found = match;
+        }
+        if (!found) {
+          const Vec2 c = poly.bounds().min * 0.5 + poly.bounds().max * 0.5;
+          char buf[96];
+          std::snprintf(buf, sizeof(buf), " (zone centred at %.2f, %.2f)", c.x(), c.y());
+          fail(what + ": no such keep-out zone in the mission" + buf);
+        }
+      }
+      for (const char* name : {"count", "size", "margin", "alt_min", "alt_max", "net", "nlt"}) {
+        const std::string key = k.key + "." + name;
+        const Distribution* d = spec.setting(key);
+        if (!d) continue;
+        auto it = recorded.find(key);
+        if (it == recorded.end()) {
+          fail(what + ": " + name + " not recorded in the spec block");
+        } else if (!d->contains(it->second)) {
+          char buf[64];
+          std::snprintf(buf, sizeof(buf), "%.6g", it->second);
+          fail(what + ": " + name + " " + buf + " is outside " + d->text());
+        }
+      }
+    }
+  }
   // Drawn values inside their distributions' supports.
   auto inSupport = [&](const std::string& key, double v, double tol) {
     const Distribution* d = spec.setting(key);
@@ -1157,7 +1234,7 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
   inSupport("mission.time_limit", mission.time_limit, 0.5);
   if (spec.cls == ScenarioClass::kAreaSearch) {
     atMost("aois.count", mission.aois.size());
-    atMost("kozs.count", mission.kozs.size());
+    atMost("kozs.count", mission.kozs.size() - std::min(spec_zones, mission.kozs.size()));
     for (const auto& a : mission.aois) {
       const auto& v = a.polygon.vertices();
       if (v.size() != 4) continue;

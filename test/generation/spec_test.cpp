@@ -653,6 +653,85 @@ TEST(SpecMoving, PursuitEventuallyIsMetAfterItDrivesOff) {
   }
 }
 
+TEST(SpecKoz, TypeCheckerRules) {
+  auto first = [](const std::string& e) { return e.substr(0, e.find('\n')); };
+  const std::string head = std::string(kHead) + "target car parked\n";
+  EXPECT_EQ(first(errorOf(head + "koz restricetd over garage\n")),
+            "t.hspec:3:5: error: unknown purpose 'restricetd'; did you mean 'restricted'?; "
+            "purposes: vantage_denial, access_denial, restricted");
+  EXPECT_EQ(first(errorOf(head + "koz restricted garage\n")),
+            "t.hspec:3:16: error: expected 'over' after the purpose, got 'garage'");
+  const std::string cover = first(errorOf(head + "koz restricted over garag\n"));
+  EXPECT_EQ(cover.rfind("t.hspec:3:21: error: unknown zone cover 'garag'; did you mean 'garage'?; "
+                        "a zone covers: target, ",
+                        0),
+            0u)
+      << cover;
+  EXPECT_EQ(first(errorOf(head + "koz restricted over target { count: 2 }\n")),
+            "t.hspec:3:30: error: unknown setting 'count' of a zone over target; settings: alt, "
+            "net, nlt, size");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { alt: [range(0, 50), 40] }\n")),
+            "t.hspec:3:50: error: alt: expected the top of the band above its bottom, whatever "
+            "is drawn (40 vs range(0, 50))");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { net: 100, nlt: 60..120 }\n")),
+            "t.hspec:3:45: error: nlt: expected NLT after NET, whatever is drawn (60..120 vs "
+            "100)");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { alt: 0 }\n")),
+            "t.hspec:3:35: error: expected '[' to open the altitude band: alt: [bottom, top] (m), "
+            "got '0'");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { count: 9 }\n")),
+            "t.hspec:3:37: error: koz1.count: expected values within [1, 5], got 9");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { net: 1, net: 2 }\n")),
+            "t.hspec:3:43: error: 'net' given twice in this koz");
+}
+
+TEST(SpecKoz, ZonesAreAddedAndChecked) {
+  const Spec s = parse(
+      "scenario route_search\ntarget car moving\n"
+      "koz restricted over garage { count: 2, margin: range(3, 6), alt: [0, range(40, 60)], "
+      "net: 30..60, nlt: range(300, 400) }\n"
+      "koz vantage_denial over target { size: 50 }\n");
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+    const scenario::Scenario sc =
+        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
+    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
+    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    // Three zones after the class's own: two over garages, one over the target.
+    const auto& k = sc.mission.kozs;
+    ASSERT_GE(k.size(), 3u);
+    EXPECT_EQ(k[k.size() - 3].purpose, "restricted");
+    EXPECT_EQ(k[k.size() - 2].purpose, "restricted");
+    EXPECT_EQ(k.back().purpose, "vantage_denial");
+    ASSERT_TRUE(k[k.size() - 3].alt_max && k[k.size() - 3].window.net);
+    EXPECT_GE(*k[k.size() - 3].alt_max, 40.0);
+    EXPECT_LE(*k[k.size() - 3].alt_max, 60.0);
+    EXPECT_FALSE(k.back().alt_max.has_value());
+    // Negative controls: a band raised, a zone moved 3 m, a zone dropped.
+    scenario::Mission raised = sc.mission;
+    *raised.kozs[k.size() - 3].alt_max += 5.0;
+    const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, raised, sc.sim, nullptr);
+    ASSERT_EQ(f1.size(), 1u) << seed;
+    EXPECT_EQ(f1[0].rfind("koz restricted over garage: no such keep-out zone in the mission", 0),
+              0u)
+        << f1[0];
+    scenario::Mission moved = sc.mission;
+    std::vector<geometry::Vec2> v = moved.kozs.back().polygon.vertices();
+    for (auto& p : v) p.x() += 3.0;
+    moved.kozs.back().polygon = geometry::Polygon(v);
+    const auto f2 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, moved, sc.sim, nullptr);
+    ASSERT_EQ(f2.size(), 1u) << seed;
+    EXPECT_EQ(f2[0].rfind("koz vantage_denial over target: no such keep-out zone", 0), 0u) << f2[0];
+    scenario::Mission dropped = sc.mission;
+    dropped.kozs.erase(dropped.kozs.end() - 2);
+    EXPECT_EQ(checkScenarioAgainstSpec(s, shippedWorld(), cfg, dropped, sc.sim, nullptr).size(),
+              1u);
+  }
+}
+
 TEST(SpecWithin, TheTargetParksNearALandmarkAndIsChecked) {
   const Spec s = parse(std::string(kHead) + "target car parked within 25 of intersection\n");
   int far = 0;
