@@ -788,24 +788,14 @@ class Parser {
     KozSpec k;
     k.pos = pos(kw);
     k.key = "koz" + std::to_string(spec_.kozs.size() + 1);
-    const std::vector<std::string> purposes = {"vantage_denial", "access_denial", "restricted"};
-    const Token p = expectIdent("a purpose (" + joinList(purposes) + ")");
-    if (std::find(purposes.begin(), purposes.end(), p.text) == purposes.end()) {
-      error("unknown purpose '" + p.text + "'" + nearestHint(p.text, purposes) +
-                "; purposes: " + joinList(purposes),
-            &p);
-    }
-    k.purpose = p.text;
+    k.purpose = expectOneOf({"vantage_denial", "access_denial", "restricted"}, "a purpose",
+                            "purpose", "purposes")
+                    .text;
     if (!isWord("over")) error("expected 'over' after the purpose, got " + describe(peek()));
     take();
     std::vector<std::string> overs = {"target"};
     for (const auto& c : world_classes_) overs.push_back(c);
-    const Token o = expectIdent("what the zone covers (" + joinList(overs) + ")");
-    if (std::find(overs.begin(), overs.end(), o.text) == overs.end()) {
-      error("unknown zone cover '" + o.text + "'" + nearestHint(o.text, overs) +
-                "; a zone covers: " + joinList(overs),
-            &o);
-    }
+    const Token o = expectOneOf(overs, "what the zone covers", "zone cover", "a zone covers");
     k.over = o.text;
     const std::vector<std::string> keys =
         o.text == "target" ? std::vector<std::string>{"alt", "net", "nlt", "size"}
@@ -835,6 +825,18 @@ class Parser {
     }
     spec_.kozs.push_back(k);
     koz_src_.push_back(src_);
+  }
+
+  // A name among `valid`: else "unknown NOUN 'x'; did you mean ...; LIST: ...".
+  Token expectOneOf(const std::vector<std::string>& valid, const std::string& what,
+                    const std::string& noun, const std::string& list) {
+    const Token t = expectIdent(what + " (" + joinList(valid) + ")");
+    if (std::find(valid.begin(), valid.end(), t.text) == valid.end()) {
+      error("unknown " + noun + " '" + t.text + "'" + nearestHint(t.text, valid) + "; " + list +
+                ": " + joinList(valid),
+            &t);
+    }
+    return t;
   }
 
   void kozSetting(const std::string& key, const PendingValue& v) {

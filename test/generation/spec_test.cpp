@@ -512,6 +512,27 @@ TEST(SpecRelated, TypeCheckerRules) {
                         "target\n"));
 }
 
+// The shipped generator configuration without perception paths (not checked by a spec).
+scenario::GeneratorConfig specConfig() {
+  scenario::GeneratorConfig c = shippedConfig();
+  c.perception_paths = false;
+  return c;
+}
+
+// Scenario `seed` of a compiled spec, as hameritt_generate --spec makes it, and the checker's
+// verdict on it (empty: every requirement holds).
+struct SpecScene {
+  scenario::Scenario sc;
+  std::vector<std::string> fails;
+};
+SpecScene specScene(const Spec& s, const CompiledSpec& c, const scenario::GeneratorConfig& cfg,
+                    std::uint64_t seed) {
+  const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+  SpecScene out{scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan), {}};
+  out.fails = checkScenarioAgainstSpec(s, shippedWorld(), cfg, out.sc.mission, out.sc.sim, nullptr);
+  return out;
+}
+
 // Relations of a moving target: at t = 0 (where a route-search car starts), and EVENTUALLY_* at
 // a later sample of its trajectory with an entity not so related at t = 0.
 const char* kRoute =
@@ -547,8 +568,7 @@ TEST(SpecMoving, TypeCheckerRules) {
 
 TEST(SpecMoving, RouteSearchRelationsAreMetAndChecked) {
   const Spec s = parse(kRoute);
-  scenario::GeneratorConfig cfg = shippedConfig();
-  cfg.perception_paths = false;
+  const scenario::GeneratorConfig cfg = specConfig();
   const CompiledSpec c(s, shippedWorld(), cfg);
   ASSERT_EQ(c.steps().size(), 4u);
   EXPECT_EQ(c.steps()[0].label, "route starts x looks");
@@ -561,11 +581,9 @@ TEST(SpecMoving, RouteSearchRelationsAreMetAndChecked) {
   EXPECT_GT(c.feasibleCount(), 0u);
   int listed = 0;
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
-    const scenario::Scenario sc =
-        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
-    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
-    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    const SpecScene g = specScene(s, c, cfg, seed);
+    const scenario::Scenario& sc = g.sc;
+    EXPECT_TRUE(g.fails.empty()) << seed << ": " << g.fails.front();
     const scenario::ScenarioEntity* lead = nullptr;
     for (const auto& se : sc.sim.entities) {
       if (!lead && se.role == "target") lead = &se;
@@ -626,15 +644,12 @@ TEST(SpecMoving, PursuitEventuallyIsMetAfterItDrivesOff) {
   const Spec s = parse(
       "scenario pursuit\ntarget car\nrequire pedestrian EVENTUALLY_NEXT_TO target\n"
       "require house EVENTUALLY_LEFT_OF target\n");
-  scenario::GeneratorConfig cfg = shippedConfig();
-  cfg.perception_paths = false;
+  const scenario::GeneratorConfig cfg = specConfig();
   const CompiledSpec c(s, shippedWorld(), cfg);
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
-    const scenario::Scenario sc =
-        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
-    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
-    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    const SpecScene g = specScene(s, c, cfg, seed);
+    const scenario::Scenario& sc = g.sc;
+    EXPECT_TRUE(g.fails.empty()) << seed << ": " << g.fails.front();
     // Negative control: the target never leaves its kerb.
     scenario::SimConfig parked = sc.sim;
     for (auto& se : parked.entities) {
@@ -691,15 +706,12 @@ TEST(SpecKoz, ZonesAreAddedAndChecked) {
       "koz restricted over garage { count: 2, margin: range(3, 6), alt: [0, range(40, 60)], "
       "net: 30..60, nlt: range(300, 400) }\n"
       "koz vantage_denial over target { size: 50 }\n");
-  scenario::GeneratorConfig cfg = shippedConfig();
-  cfg.perception_paths = false;
+  const scenario::GeneratorConfig cfg = specConfig();
   const CompiledSpec c(s, shippedWorld(), cfg);
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
-    const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
-    const scenario::Scenario sc =
-        scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan);
-    const auto ok = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, nullptr);
-    EXPECT_TRUE(ok.empty()) << seed << ": " << ok.front();
+    const SpecScene g = specScene(s, c, cfg, seed);
+    const scenario::Scenario& sc = g.sc;
+    EXPECT_TRUE(g.fails.empty()) << seed << ": " << g.fails.front();
     // Three zones after the class's own: two over garages, one over the target.
     const auto& k = sc.mission.kozs;
     ASSERT_GE(k.size(), 3u);
