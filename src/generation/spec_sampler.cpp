@@ -191,32 +191,48 @@ class EventualOnLane {
   bool holds(const OrientedBox& box0, const scenario::LaneDrive& drive) {
     Lane& lane = laneFor(drive, box0.size);
     const scenario::Subject t0 = specTarget(box0);
-    const auto first = static_cast<std::size_t>(std::max(0.0, std::ceil(drive.begin / kStep)));
-    const std::size_t n = lane.on.empty() ? 0 : lane.on.front().size();
+    const auto first = static_cast<long>(std::max(0.0, std::ceil(drive.begin / kStep)));
     for (std::size_t k = 0; k < lane.entities.size(); ++k) {
+      if (lastWindow(&lane, k, drive, box0.size) < first) continue;
       const int i = lane.entities[k];
       const scenario::Entity& e = world_.entities()[static_cast<std::size_t>(i)];
-      if (eval_.holds(r_.op, eval_.measure(t0, scenario::worldSubject(world_, i)), e.cls)) continue;
-      // A run of need_ samples where it holds: test each window from its end, and on a miss
-      // move the window past it.
-      std::size_t j = first;
-      while (j + need_ <= n) {
-        std::size_t p = j + need_;
-        while (p > j && at(&lane, k, p - 1, drive, box0.size)) --p;
-        if (p == j) return true;
-        j = p;
-      }
+      if (!eval_.holds(r_.op, eval_.measure(t0, scenario::worldSubject(world_, i)), e.cls))
+        return true;
     }
     return false;
   }
 
  private:
   // Per entity near the lane: whether the relation holds at each 0.25 m of it (-1: not yet
-  // measured).
+  // measured), and the start of the last run of need_ samples where it holds (-2: not yet
+  // sought, -1: none).
   struct Lane {
     std::vector<int> entities;
     std::vector<std::vector<signed char>> on;
+    std::vector<long> last;
   };
+
+  // The last window of need_ samples where the relation holds with entity k: sought from the
+  // lane's end, each window tested from its start, and on a miss at q the next window ends
+  // before q. A start at sample j has a window ahead iff j <= this.
+  long lastWindow(Lane* lane, std::size_t k, const scenario::LaneDrive& d, const Vec3& size) {
+    long& last = lane->last[k];
+    if (last != -2) return last;
+    last = -1;
+    const auto n = static_cast<long>(lane->on[k].size());
+    const auto need = static_cast<long>(need_);
+    long p = n - need;
+    while (p >= 0) {
+      long q = p;
+      while (q < p + need && at(lane, k, static_cast<std::size_t>(q), d, size)) ++q;
+      if (q == p + need) {
+        last = p;
+        break;
+      }
+      p = q - need;
+    }
+    return last;
+  }
 
   bool at(Lane* lane, std::size_t k, std::size_t j, const scenario::LaneDrive& d,
           const Vec3& size) {
@@ -249,6 +265,7 @@ class EventualOnLane {
     const auto n = static_cast<std::size_t>(std::max(0.0, std::floor(d.end / kStep)) + 1);
     lane.entities = relatedNear(world_, r_, mid, reach);
     lane.on.assign(lane.entities.size(), std::vector<signed char>(n, -1));
+    lane.last.assign(lane.entities.size(), -2);
     return cache_.emplace(key, std::move(lane)).first->second;
   }
 
