@@ -1170,8 +1170,9 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
   // Keep-out zones: each koz statement's zones, recomputed from the scene (the target's
   // position at t = 0, the world's entities) with the values the sampler recorded, must be in
   // the mission with their purpose, altitude band and window.
+  // (Not for a rejection sampler's judgement, require_listed false: zones are added, not found.)
   std::size_t spec_zones = 0;  // of mission.kozs: the koz statements' (not the class's own)
-  if (!spec.kozs.empty()) {
+  if (!spec.kozs.empty() && require_listed) {
     std::map<std::string, double> recorded;
     if (sim.spec) {
       for (const auto& [name, v] : sim.spec->values) {

@@ -90,8 +90,8 @@ struct RequirementCheck {
 // and look, relations recomputed with the relation code, and every drawn value inside its
 // distribution's support. Returns one message per violated hard requirement (empty: all hold);
 // `soft` receives whether each soft requirement held. `require_listed`: a hard requirement must
-// also be listed in the mission's relations (false: the scene alone counts, as a rejection
-// sampler would judge an unconstrained scene).
+// also be listed in the mission's relations and the koz statements' zones be in the mission
+// (false: the scene alone counts, as a rejection sampler would judge an unconstrained scene).
 std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenario::World& world,
                                                   const scenario::GeneratorConfig& base,
                                                   const scenario::Mission& mission,
