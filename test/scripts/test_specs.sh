@@ -213,5 +213,33 @@ printf 'scenario area_search\ntarget car parked within 10 of intersection\n' >"$
 out=$("$V" --spec "$T/w10.hspec" "$T/w40" 2>/dev/null | tail -1)
 [[ "$out" =~ ^30\ scenarios,\ ([0-9]+)\ meet\ the\ spec,\ ([0-9]+)\ fail$ && ${BASH_REMATCH[2]} -gt 0 ]] && ok || bad "within 10 on within-40 scenes: $out"
 
+# A moving target and keep-out zones: malformed statements exit 2 naming the place, nothing
+# written; a route_landmarks scene whose mission drops the garage's EVENTUALLY_RIGHT_OF, and one
+# whose restricted zone is raised 10 m, fail (exit 2).
+printf 'scenario area_search\ntarget car parked\nrequire garage EVENTUALLY_RIGHT_OF target\n' >"$T/ev.hspec"
+expect 2 "ev.hspec:3:1: error: EVENTUALLY_\* applies to a moving target" "$G" --spec "$T/ev.hspec" --count 3 --seed 1 --out "$T/x10"
+printf 'scenario route_search\ntarget car moving\nkoz restricted over hosue\n' >"$T/koz.hspec"
+expect 2 "koz.hspec:3:21: error: unknown zone cover 'hosue'; did you mean 'house'" "$G" --spec "$T/koz.hspec" --count 3 --seed 1 --out "$T/x11"
+for x in x10 x11; do
+  [[ ! -e "$T/$x" ]] && ok || bad "a refused run wrote $T/$x"
+done
+r1="$(ls -d "$OUT/route_landmarks"/*/ | head -1)"
+cp -r "$r1" "$T/r2"
+/usr/bin/python3 - "$r1/mission.json" "$T/r2/mission.json" <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+n = len(d["scene_relations"])
+d["scene_relations"] = [r for r in d["scene_relations"] if r["operator"] != "EVENTUALLY_RIGHT_OF"
+                        or r["related"]["class"] != "garage"]
+assert len(d["scene_relations"]) < n, "no garage EVENTUALLY_RIGHT_OF listed"
+json.dump(d, open(sys.argv[1], "w"), indent=2)
+d = json.load(open(sys.argv[2]))
+z = [k for k in d["keep_out_zones"] if k["purpose"] == "restricted"]
+z[-1]["altitude"]["max"] += 10.0
+json.dump(d, open(sys.argv[2], "w"), indent=2)
+EOF2
+expect 2 "requirement 'garage EVENTUALLY_RIGHT_OF target' holds but the mission does not list it" "$V" --spec "$S/route_landmarks.hspec" "$r1"
+expect 2 "koz restricted over house: no such keep-out zone in the mission" "$V" --spec "$S/route_landmarks.hspec" "$T/r2"
+
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]
