@@ -52,7 +52,8 @@ class ExampleClient:
         self.gate.every(1.0, self.start_search)
 
     def on_state(self, s):
-        if s.state in ("succeeded", "timeout", "crashed", "aborted") and not rospy.is_shutdown():
+        over = ("succeeded", "timeout", "crashed", "aborted", "ended", "failed")
+        if s.state in over and not rospy.is_shutdown():
             rospy.loginfo("example_client: mission %s (%s); exiting", s.state, s.reason)
             rospy.signal_shutdown("mission over")
 

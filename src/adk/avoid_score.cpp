@@ -1,6 +1,7 @@
 #include "hameritt/adk/avoid_score.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "hameritt/scenario/error.h"
 
@@ -13,29 +14,29 @@ void requirePositive(double v, const char* field) {
                                 scenario::formatNumber(v));
   }
 }
+
+SeparationMinimum minimumOf(const scenario::AvoidPhaseSpec& spec, double collision_radius) {
+  SeparationMinimum m;
+  m.horizontal = spec.min_horizontal_separation;
+  m.vertical = spec.min_vertical_separation;
+  m.collision_radius = collision_radius;
+  return m;  // validated by the tracker
+}
 }  // namespace
 
 AvoidScorer::AvoidScorer(const scenario::AvoidPhaseSpec& spec, double time_limit,
                          double collision_radius)
-    : spec_(spec), time_limit_(time_limit) {
+    : spec_(spec), time_limit_(time_limit), separation_(minimumOf(spec, collision_radius)) {
   requirePositive(spec.goal_radius, "avoid.goal_radius");
   requirePositive(spec.shortest_path_m, "avoid.shortest_path_m");
   requirePositive(time_limit, "avoid.time_limit");
-  minimum_.horizontal = spec.min_horizontal_separation;
-  minimum_.vertical = spec.min_vertical_separation;
-  minimum_.collision_radius = collision_radius;
-  minimum_.validate();
 }
 
 void AvoidScorer::add(const TrafficSample& sample) {
   if (reach_time_) return;
-  // Validate the sample against the previous one before keeping it.
-  std::vector<TrafficSample> pair;
-  if (!samples_.empty()) pair.push_back(samples_.back());
-  pair.push_back(sample);
-  scoreSeparation(pair, minimum_);
-  samples_.push_back(sample);
-  path_.push_back(sample.position);
+  separation_.add(sample);  // validates before keeping anything
+  if (last_position_) path_length_ += (sample.position - *last_position_).norm();
+  last_position_ = sample.position;
   if ((sample.position - spec_.goal).norm() <= spec_.goal_radius) reach_time_ = sample.t;
 }
 
@@ -44,9 +45,9 @@ AvoidScore AvoidScorer::score(double koz_seconds) const {
   s.shortest_path_m = spec_.shortest_path_m;
   s.koz_seconds = koz_seconds;
   s.reach_time = reach_time_;
-  s.path_length_m = pathLength(path_);
-  if (!samples_.empty()) s.goal_distance_m = (samples_.back().position - spec_.goal).norm();
-  s.separation = scoreSeparation(samples_, minimum_);
+  s.path_length_m = path_length_;
+  if (last_position_) s.goal_distance_m = (*last_position_ - spec_.goal).norm();
+  s.separation = separation_.score();
   if (!reach_time_) {
     s.failure =
         "did not come within " + scenario::formatNumber(spec_.goal_radius) + " m of the goal";
@@ -55,8 +56,10 @@ AvoidScore AvoidScorer::score(double koz_seconds) const {
   } else if (s.separation.contact) {
     s.failure = "contact with " + s.separation.closest_aircraft;
   } else if (s.separation.losses > 0) {
-    s.failure = "lost separation " + std::to_string(s.separation.losses) + " time(s), " +
-                scenario::formatNumber(s.separation.seconds_below_minimum) + " s in all";
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "lost separation %zu time(s), %.2f s in all",
+                  s.separation.losses, s.separation.seconds_below_minimum);
+    s.failure = buf;
   }
   s.success = s.failure.empty();
   NavigationEpisode e;

@@ -71,6 +71,8 @@ const char* toString(Outcome o) {
       return "aborted";
     case Outcome::kEnded:
       return "ended";
+    case Outcome::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -315,6 +317,30 @@ std::string metricsJson(const MissionMetrics& m) {
   }
   c["areas_of_interest"] = areas;
   j["coverage"] = c;
+  if (m.avoid) {
+    const AvoidScore& a = *m.avoid;
+    auto finiteOrNull = [](double v) -> ordered_json {
+      return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr);
+    };
+    ordered_json o;
+    o["success"] = a.success;
+    o["failure"] = a.failure;
+    o["reach_time"] = opt(a.reach_time);
+    o["goal_distance"] = a.goal_distance_m;
+    o["path_length"] = a.path_length_m;
+    o["shortest_path"] = a.shortest_path_m;
+    o["spl"] = a.spl;
+    o["min_separation"] = finiteOrNull(a.separation.min_distance_m);
+    o["closest_aircraft"] = a.separation.closest_aircraft;
+    o["min_separation_time"] = a.separation.min_distance_t;
+    o["seconds_below_minimum"] = a.separation.seconds_below_minimum;
+    o["separation_losses"] = a.separation.losses;
+    o["min_time_to_collision"] = finiteOrNull(a.separation.min_time_to_collision_s);
+    o["time_to_collision_aircraft"] = a.separation.time_to_collision_aircraft;
+    o["contact"] = a.separation.contact;
+    o["koz_seconds"] = a.koz_seconds;
+    j["avoid"] = o;
+  }
   return j.dump(2) + "\n";
 }
 
@@ -338,6 +364,8 @@ const char* toString(MissionState s) {
       return "aborted";
     case MissionState::kEnded:
       return "ended";
+    case MissionState::kFailed:
+      return "failed";
   }
   return "?";
 }
@@ -352,6 +380,8 @@ Outcome outcomeOf(MissionState s) {
       return Outcome::kCrashed;
     case MissionState::kEnded:
       return Outcome::kEnded;
+    case MissionState::kFailed:
+      return Outcome::kFailed;
     default:
       return Outcome::kAborted;
   }
@@ -399,6 +429,10 @@ bool MissionLifecycle::succeed(double t, const std::string& reason) {
 
 bool MissionLifecycle::crash(double t, const std::string& reason) {
   return end(MissionState::kCrashed, t, reason);
+}
+
+bool MissionLifecycle::fail(double t, const std::string& reason) {
+  return end(MissionState::kFailed, t, reason);
 }
 
 bool MissionLifecycle::abort(double t, const std::string& reason) {

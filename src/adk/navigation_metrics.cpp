@@ -81,45 +81,53 @@ double timeToCollision(const Vec3& p, const Vec3& v, double radius) {
   return (-b - std::sqrt(disc)) / a;
 }
 
+SeparationTracker::SeparationTracker(const SeparationMinimum& minimum) : minimum_(minimum) {
+  minimum_.validate();
+}
+
+void SeparationTracker::add(const TrafficSample& x) {
+  requireIncreasing(x.t, count_ ? last_t_ : 0.0, count_);
+  const std::string at = "sample " + std::to_string(count_);
+  requireFinite(x.position, at + ": position");
+  requireFinite(x.velocity, at + ": velocity");
+  std::set<std::string> ids;
+  for (const auto& a : x.aircraft) {
+    if (!ids.insert(a.id).second) throw InputError(at + ": aircraft " + a.id + " occurs twice");
+    requireFinite(a.position, at + ": aircraft " + a.id + " position");
+    requireFinite(a.velocity, at + ": aircraft " + a.id + " velocity");
+  }
+  // Valid: now kept. The previous sample's loss holds until this one (sample-and-hold).
+  if (count_ > 0 && last_lost_) score_.seconds_below_minimum += x.t - last_t_;
+  bool lost = false;
+  for (const auto& a : x.aircraft) {
+    const Vec3 p = a.position - x.position;
+    const double d = p.norm();
+    if (d < score_.min_distance_m) {
+      score_.min_distance_m = d;
+      score_.closest_aircraft = a.id;
+      score_.min_distance_t = x.t;
+    }
+    if (d < minimum_.collision_radius) score_.contact = true;
+    if (p.head<2>().norm() < minimum_.horizontal && std::fabs(p.z()) < minimum_.vertical) {
+      lost = true;
+    }
+    const double ttc = timeToCollision(p, a.velocity - x.velocity, minimum_.collision_radius);
+    if (ttc < score_.min_time_to_collision_s) {
+      score_.min_time_to_collision_s = ttc;
+      score_.time_to_collision_aircraft = a.id;
+    }
+  }
+  if (lost && !last_lost_) ++score_.losses;
+  last_lost_ = lost;
+  last_t_ = x.t;
+  ++count_;
+}
+
 SeparationScore scoreSeparation(const std::vector<TrafficSample>& samples,
                                 const SeparationMinimum& minimum) {
-  minimum.validate();
-  SeparationScore s;
-  bool was_lost = false;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const auto& x = samples[i];
-    requireIncreasing(x.t, i ? samples[i - 1].t : 0.0, i);
-    const std::string at = "sample " + std::to_string(i);
-    requireFinite(x.position, at + ": position");
-    requireFinite(x.velocity, at + ": velocity");
-    std::set<std::string> ids;
-    bool lost = false;
-    for (const auto& a : x.aircraft) {
-      if (!ids.insert(a.id).second) throw InputError(at + ": aircraft " + a.id + " occurs twice");
-      requireFinite(a.position, at + ": aircraft " + a.id + " position");
-      requireFinite(a.velocity, at + ": aircraft " + a.id + " velocity");
-      const Vec3 p = a.position - x.position;
-      const double d = p.norm();
-      if (d < s.min_distance_m) {
-        s.min_distance_m = d;
-        s.closest_aircraft = a.id;
-        s.min_distance_t = x.t;
-      }
-      if (d < minimum.collision_radius) s.contact = true;
-      if (p.head<2>().norm() < minimum.horizontal && std::fabs(p.z()) < minimum.vertical) {
-        lost = true;
-      }
-      const double ttc = timeToCollision(p, a.velocity - x.velocity, minimum.collision_radius);
-      if (ttc < s.min_time_to_collision_s) {
-        s.min_time_to_collision_s = ttc;
-        s.time_to_collision_aircraft = a.id;
-      }
-    }
-    if (lost && !was_lost) ++s.losses;
-    if (lost && i + 1 < samples.size()) s.seconds_below_minimum += samples[i + 1].t - x.t;
-    was_lost = lost;
-  }
-  return s;
+  SeparationTracker tracker(minimum);
+  for (const auto& x : samples) tracker.add(x);
+  return tracker.score();
 }
 
 void FollowEnvelope::validate() const {

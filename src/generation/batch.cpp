@@ -128,6 +128,7 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
           s = generateScenario(world, config, e.cls, e.seed);
         }
         e.id = s.mission.scenario_id;
+        if (req.check) req.check(s);
         writeScenarioDir(req.out_dir, s);
         written[static_cast<std::size_t>(i)] = 1;
       } catch (...) {

@@ -44,7 +44,6 @@ std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index) {
 // now taken in the order g++ evaluated them (right to left), which the golden files pin.
 namespace {
 
-constexpr double kLaneOffsetFromKerb = 3.45;  // lane centre = half width - this
 constexpr int kMaxAttempts = 200;
 // Avoid: the goal's distance from the start (m), its radius, the fraction of the top speed that
 // sets the time limit (the reference flight at this speed, plus a minute), and the escorted
@@ -116,6 +115,7 @@ class ScenarioBuilder {
         buildAvoid();  // places the UAV itself, at the start of its reference flight
         break;
     }
+    if (plan_ && !plan_->kozs.empty()) addSpecKozs();
     if (cls_ != ScenarioClass::kAvoid) placeUavStart();
     if (world_.params().type == WorldType::kCity) {
       addCityTraffic();
@@ -971,23 +971,50 @@ class ScenarioBuilder {
     Vec2 lane_dir(1, 0);
     std::uint64_t route_seed = 0;
     int goal = -1;
-    for (int attempt = 0; attempt < kMaxAttempts && nodes.empty(); ++attempt) {
-      const int n0 = randomNode();
-      const auto& adj = world_.adjacency()[static_cast<std::size_t>(n0)];
-      if (adj.empty()) continue;
-      const auto& e = world_.edges()[static_cast<std::size_t>(rng_.pick(adj))];
-      const int n1 = e.a == n0 ? e.b : e.a;
-      const Vec2 a = world_.nodes()[static_cast<std::size_t>(n0)].position;
-      const Vec2 b = world_.nodes()[static_cast<std::size_t>(n1)].position;
-      const double len = (b - a).norm();
-      // Some way along the first street, so that a trailing car 12 m behind still starts on it
-      // and well inside the band (not on its end cap).
-      const double s0 = 20.0 + rng_.uniform(0.0, 0.2) * len;
-      route_seed = rng_.next();
-      goal = nodeAtHops(n1, n0, want - 1);
-      if (goal < 0 || s0 > len - rs.corner_clearance - 2.0) continue;
-      lane_dir = (b - a) / len;
-      const TrajectoryPoint start = lanePose(a, lane_dir, s0, rs.lane_offset, 0.0);
+    // A spec's feasible starts (constructive: the next one in a seeded order until one has a
+    // route), else random ones.
+    const bool from_spec = plan_ && plan_->route_starts && plan_->placements;
+    std::vector<std::size_t> order;
+    int attempts = kMaxAttempts;
+    if (from_spec) {
+      for (std::size_t i = 0; i < plan_->placements->size(); ++i) order.push_back(i);
+      rng_.shuffle(order);
+      attempts = static_cast<int>(std::min<std::size_t>(order.size(), 60));
+    }
+    int lead_model = -1;
+    for (int attempt = 0; attempt < attempts && nodes.empty(); ++attempt) {
+      int n0, n1;
+      TrajectoryPoint start;
+      if (from_spec) {
+        const auto& pl = (*plan_->placements)[order[static_cast<std::size_t>(attempt)]];
+        const RouteStart& st = (*plan_->route_starts)[static_cast<std::size_t>(pl.first)];
+        const LaneDrive drive = routeStartDrive(world_, st);
+        n0 = st.from;
+        n1 = st.to;
+        lead_model = pl.second;
+        route_seed = rng_.next();
+        goal = nodeAtHops(n1, n0, want - 1);
+        if (goal < 0) continue;
+        lane_dir = drive.dir;
+        start = drive.pose(st.s);
+      } else {
+        n0 = randomNode();
+        const auto& adj = world_.adjacency()[static_cast<std::size_t>(n0)];
+        if (adj.empty()) continue;
+        const auto& e = world_.edges()[static_cast<std::size_t>(rng_.pick(adj))];
+        n1 = e.a == n0 ? e.b : e.a;
+        const Vec2 a = world_.nodes()[static_cast<std::size_t>(n0)].position;
+        const Vec2 b = world_.nodes()[static_cast<std::size_t>(n1)].position;
+        const double len = (b - a).norm();
+        // Some way along the first street, so that a trailing car 12 m behind still starts on
+        // it and well inside the band (not on its end cap).
+        const double s0 = 20.0 + rng_.uniform(0.0, 0.2) * len;
+        route_seed = rng_.next();
+        goal = nodeAtHops(n1, n0, want - 1);
+        if (goal < 0 || s0 > len - rs.corner_clearance - 2.0) continue;
+        lane_dir = (b - a) / len;
+        start = lanePose(a, lane_dir, s0, rs.lane_offset, 0.0);
+      }
       planning::RouteGoal g;
       g.node = goal;
       lead = planning::planVehicleRoute(world_, start, g, route_seed, speed, rs);
@@ -1048,6 +1075,8 @@ class ScenarioBuilder {
       const catalog::CarModel* model;
       std::string color;
       drawTargetLook(&model, &color);
+      if (i == 0 && lead_model >= 0)
+        model = &catalog::carModels()[static_cast<std::size_t>(lead_model)];
       const Trajectory& traj = trajs[static_cast<std::size_t>(i)];
       Entity e = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
       targets.push_back(e);
@@ -1095,6 +1124,7 @@ class ScenarioBuilder {
     }
     for (int i = 0; i < n_targets; ++i) {
       movingTargetRelations(targets[static_cast<std::size_t>(i)], trajs[static_cast<std::size_t>(i)], {});
+      if (i == 0) listEventually(targets[0], trajs[0]);
       addConfusers(targets[static_cast<std::size_t>(i)], {}, {}, &route.band, 40.0);
     }
   }
@@ -1112,6 +1142,66 @@ class ScenarioBuilder {
     ensureListed(&rels, at_start);
     for (auto& r : eventuallyRelations(target, traj, at_start, n_ev)) rels.push_back(r);
     for (auto& r : rels) sc_.mission.relations.push_back(r);
+  }
+
+  // A spec's EVENTUALLY_* requirements on the world's entities: for each, the first sample
+  // (every eventually_dt, up to the time limit) at which a matching world entity that is not so
+  // related at t = 0 stands in the relation, added to the mission's relations unless listed.
+  void listEventually(const Entity& target, const Trajectory& traj) {
+    if (!plan_ || plan_->eventually.empty()) return;
+    const double dt = cfg_.relations.eventually_dt;
+    const double end = std::min(sc_.mission.time_limit, traj.back().t + dt);
+    Subject s0 = subjectOf(target);
+    s0.box = poseBox(target.box, sampleTrajectory(traj, 0.0));
+    for (const auto& ev : plan_->eventually) {
+      for (int k = 1; k * dt <= end; ++k) {
+        Subject s = s0;
+        s.box = poseBox(target.box, sampleTrajectory(traj, k * dt));
+        std::optional<SceneRelation> found;
+        for (const auto& [i, d] : eval_.nearbyWorldDistances(s.box)) {
+          const Entity& e = world_.entities()[static_cast<std::size_t>(i)];
+          if (!operatorApplies(ev.op, e.cls) || !ev.matches(e.cls, e.attributes)) continue;
+          const Subject rel = worldSubject(world_, i);
+          const RelationFacts f = eval_.measure(s, rel);
+          if (!eval_.holds(ev.op, f, e.cls) || eval_.holds(ev.op, eval_.measure(s0, rel), e.cls)) {
+            continue;
+          }
+          found = makeRelation(s, rel, ev.op, f);
+          break;
+        }
+        if (!found) continue;
+        found->eventually = true;
+        found->time = k * dt;
+        bool have = false;
+        for (const auto& r : sc_.mission.relations) {
+          have = have || (r.eventually && r.op == found->op && r.target_id == found->target_id &&
+                          r.related_id == found->related_id);
+        }
+        if (!have) sc_.mission.relations.push_back(*found);
+        break;
+      }
+    }
+  }
+
+  // A spec's keep-out zones, after the class's own (specKozPolygons).
+  void addSpecKozs() {
+    const ScenarioEntity* target = nullptr;
+    for (const auto& se : sc_.sim.entities) {
+      if (!target && se.role == "target") target = &se;
+    }
+    if (!target) return;
+    OrientedBox box = target->entity.box;
+    if (!target->trajectory.empty()) box = poseBox(box, sampleTrajectory(target->trajectory, 0.0));
+    for (const auto& z : plan_->kozs) {
+      for (const Polygon& poly : specKozPolygons(world_, z, box)) {
+        KeepOutZone k = makeKoz(poly, z.purpose);
+        k.alt_min = z.alt_min;
+        k.alt_max = z.alt_max;
+        k.window.net = z.net;
+        k.window.nlt = z.nlt;
+        sc_.mission.kozs.push_back(k);
+      }
+    }
   }
 
   void buildPursuit() {
@@ -1263,6 +1353,7 @@ class ScenarioBuilder {
 
     // Pedestrian subjects at the moment they are nearest the car, for EVENTUALLY_NEXT_TO.
     movingTargetRelations(target, traj, {});
+    listEventually(target, traj);
     // The runners reach the car: EVENTUALLY_NEXT_TO with the first runner, at the first
     // grid time they are next to it.
     for (const auto& se : sc_.sim.entities) {
@@ -1822,6 +1913,31 @@ Scenario generateScenario(const World& world, const GeneratorConfig& config, Sce
   } catch (const GenerationError& e) {
     throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " + e.what());
   }
+}
+
+std::vector<Polygon> specKozPolygons(const World& world, const ScenarioPlan::Koz& koz,
+                                     const OrientedBox& target) {
+  std::vector<Polygon> out;
+  if (koz.over == "target") {
+    out.push_back(roundPolygon(
+        geometry::orientedRectangle(target.center2(), koz.size, koz.size, target.yaw)));
+    return out;
+  }
+  EntityClass cls;
+  if (!parseEntityClass(koz.over, &cls)) return out;
+  std::vector<std::pair<double, int>> near;
+  for (int i = 0; i < static_cast<int>(world.entities().size()); ++i) {
+    const Entity& e = world.entities()[static_cast<std::size_t>(i)];
+    if (e.cls == cls) near.emplace_back((e.box.center2() - target.center2()).norm(), i);
+  }
+  std::sort(near.begin(), near.end());
+  for (std::size_t k = 0; k < near.size() && static_cast<int>(k) < koz.count; ++k) {
+    const Entity& e = world.entities()[static_cast<std::size_t>(near[k].second)];
+    out.push_back(
+        roundPolygon(geometry::orientedRectangle(e.box.center2(), e.box.size.x() + 2 * koz.margin,
+                                                 e.box.size.y() + 2 * koz.margin, e.box.yaw)));
+  }
+  return out;
 }
 
 }  // namespace hameritt::scenario

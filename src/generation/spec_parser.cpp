@@ -9,6 +9,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "hameritt/generation/spec.h"
 #include "hameritt/scenario/catalog.h"
@@ -241,6 +242,25 @@ struct KeyLimits {
   bool integer;
 };
 
+// A koz statement's settings ("koz1.count" -> "count").
+const std::map<std::string, KeyLimits>& kozLimits() {
+  static const std::map<std::string, KeyLimits> k = {
+      {"count", {1, 5, true}},      {"size", {10, 200, false}},   {"margin", {0, 30, false}},
+      {"alt_min", {0, 400, false}}, {"alt_max", {5, 500, false}}, {"net", {0, 3600, false}},
+      {"nlt", {1, 3600, false}},
+  };
+  return k;
+}
+
+const std::map<std::string, KeyLimits>& keyLimits();
+
+const KeyLimits& limitsOf(const std::string& key) {
+  if (key.rfind("koz", 0) == 0 && key.size() > 3 &&
+      std::isdigit(static_cast<unsigned char>(key[3])))
+    return kozLimits().at(key.substr(key.find('.') + 1));
+  return keyLimits().at(key);
+}
+
 const std::map<std::string, KeyLimits>& keyLimits() {
   static const std::map<std::string, KeyLimits> k = {
       {"mission.time_limit", {60, 3600, false}},
@@ -398,6 +418,7 @@ class Parser {
                       "area_search', 'scenario route_search' or 'scenario pursuit'");
     }
     checkClassRules();
+    checkKozs();
     spec_.hash = hash_;
     return std::move(spec_);
   }
@@ -458,9 +479,10 @@ class Parser {
     if (t.text == "scenario") return scenarioStatement();
     if (t.text == "target") return targetStatement();
     if (t.text == "require" || t.text == "prefer") return requirement();
+    if (t.text == "koz") return kozStatement();
     if (specSections().count(t.text)) return section();
     std::vector<std::string> words = {"import",  "param",  "scenario", "target",
-                                      "require", "prefer", "world"};
+                                      "require", "prefer", "world",    "koz"};
     for (const auto& kv : specSections()) words.push_back(kv.first);
     error("unknown statement '" + t.text + "'" + nearestHint(t.text, words) +
           "; statements: " + joinList(words));
@@ -759,6 +781,99 @@ class Parser {
     take();
   }
 
+  // koz PURPOSE over (target | CLASS) { count: N, size: M, margin: M, alt: [LO, HI], net: S,
+  // nlt: S }: its settings become "kozN.<name>" (alt: alt_min and alt_max).
+  void kozStatement() {
+    const Token kw = take();
+    KozSpec k;
+    k.pos = pos(kw);
+    k.key = "koz" + std::to_string(spec_.kozs.size() + 1);
+    k.purpose = expectOneOf({"vantage_denial", "access_denial", "restricted"}, "a purpose",
+                            "purpose", "purposes")
+                    .text;
+    if (!isWord("over")) error("expected 'over' after the purpose, got " + describe(peek()));
+    take();
+    std::vector<std::string> overs = {"target"};
+    for (const auto& c : world_classes_) overs.push_back(c);
+    const Token o = expectOneOf(overs, "what the zone covers", "zone cover", "a zone covers");
+    k.over = o.text;
+    const std::vector<std::string> keys =
+        o.text == "target" ? std::vector<std::string>{"alt", "net", "nlt", "size"}
+                           : std::vector<std::string>{"alt", "count", "margin", "net", "nlt"};
+    if (isPunct("{")) {
+      take();
+      while (!isPunct("}")) {
+        const Token n = expectIdent("a setting of 'koz' or '}'");
+        if (std::find(keys.begin(), keys.end(), n.text) == keys.end()) {
+          error("unknown setting '" + n.text + "' of a zone over " + o.text +
+                    nearestHint(n.text, keys) + "; settings: " + joinList(keys),
+                &n);
+        }
+        expectPunct(":", "after '" + n.text + "'");
+        if (n.text == "alt") {
+          expectPunct("[", "to open the altitude band: alt: [bottom, top] (m)");
+          kozSetting(k.key + ".alt_min", expression());
+          expectPunct(",", "between the bottom and the top of the altitude band");
+          kozSetting(k.key + ".alt_max", expression());
+          expectPunct("]", "to close the altitude band");
+        } else {
+          kozSetting(k.key + "." + n.text, expression());
+        }
+        if (isPunct(",")) take();
+      }
+      take();
+    }
+    spec_.kozs.push_back(k);
+    koz_src_.push_back(src_);
+  }
+
+  // A name among `valid`: else "unknown NOUN 'x'; did you mean ...; LIST: ...".
+  Token expectOneOf(const std::vector<std::string>& valid, const std::string& what,
+                    const std::string& noun, const std::string& list) {
+    const Token t = expectIdent(what + " (" + joinList(valid) + ")");
+    if (std::find(valid.begin(), valid.end(), t.text) == valid.end()) {
+      error("unknown " + noun + " '" + t.text + "'" + nearestHint(t.text, valid) + "; " + list +
+                ": " + joinList(valid),
+            &t);
+    }
+    return t;
+  }
+
+  void kozSetting(const std::string& key, const PendingValue& v) {
+    for (auto& kv : settings_) {
+      if (kv.first == key)
+        errorAt(v.pos, v.src, "'" + key.substr(key.find('.') + 1) + "' given twice in this koz");
+    }
+    settings_.emplace_back(key, v);
+  }
+
+  // A zone's band and window: the top above the bottom, NLT after NET, whatever is drawn.
+  void checkKozs() {
+    if (spec_.kozs.size() > 8) {
+      errorAt(spec_.kozs[8].pos, koz_src_[8], "at most 8 koz statements per spec");
+    }
+    auto pending = [&](const std::string& key) -> const PendingValue* {
+      for (const auto& kv : settings_) {
+        if (kv.first == key) return &kv.second;
+      }
+      return nullptr;
+    };
+    for (const auto& k : spec_.kozs) {
+      for (const auto& [lo, hi, what] :
+           {std::make_tuple("alt_min", "alt_max",
+                            "alt: expected the top of the band above its "
+                            "bottom, whatever is drawn"),
+            std::make_tuple("net", "nlt", "nlt: expected NLT after NET, whatever is drawn")}) {
+        const Distribution* a = spec_.setting(k.key + "." + lo);
+        const Distribution* b = spec_.setting(k.key + "." + hi);
+        if (a && b && !(b->minValue() > a->maxValue())) {
+          const PendingValue* v = pending(k.key + "." + hi);
+          errorAt(v->pos, v->src, std::string(what) + " (" + b->text() + " vs " + a->text() + ")");
+        }
+      }
+    }
+  }
+
   // confusers { share: [KEY, ...] } and { told_apart_by: "REQUIREMENT" }.
   void confuserSetting(const Token& k) {
     expectPunct(":", "after '" + k.text + "'");
@@ -932,7 +1047,7 @@ class Parser {
   }
 
   void checkLimits(const std::string& key, const Distribution& d, const PendingValue& v) {
-    const KeyLimits& lim = keyLimits().at(key);
+    const KeyLimits& lim = limitsOf(key);
     if (d.minValue() < lim.min || d.maxValue() > lim.max) {
       errorAt(v.pos, v.src,
               key + ": expected values within [" + fmtNum(lim.min) + ", " + fmtNum(lim.max) +
@@ -981,18 +1096,30 @@ class Parser {
     bool placed_seen = false;
     for (std::size_t i = 0; i < spec_.requirements.size(); ++i) {
       const Requirement& r = spec_.requirements[i];
-      if (route) {
+      const bool mover = r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar;
+      if (route && mover) {
         errorAt(r.pos, requirement_src_[i],
-                "route_search targets drive from the start: relation requirements apply to "
-                "area_search and pursuit targets");
+                "a route_search target relates to the neighborhood (street, house, building, "
+                "...): relations to cars and pedestrians apply to parked targets");
       }
-      if (r.eventually &&
-          !(pursuit && r.related == EntityClass::kPedestrian &&
-            r.op == scenario::RelationOp::kNextTo && !r.negated && r.probability == 1.0)) {
+      const bool runners =
+          pursuit && r.related == EntityClass::kPedestrian && r.op == scenario::RelationOp::kNextTo;
+      if (r.eventually && !route && !pursuit) {
         errorAt(r.pos, requirement_src_[i],
-                "EVENTUALLY_* requirements: the sampler constructs 'require pedestrian "
-                "EVENTUALLY_NEXT_TO target' (the pursuit's running pedestrians); other "
-                "EVENTUALLY_* requirements are not supported");
+                "EVENTUALLY_* applies to a moving target (route_search, pursuit); an area_search "
+                "target is parked: drop EVENTUALLY_");
+      }
+      if (r.eventually && mover && !runners) {
+        errorAt(r.pos, requirement_src_[i],
+                "EVENTUALLY_* relates a moving target to the neighborhood (street, house, "
+                "building, ...), or a pursuit target to its running pedestrians ('pedestrian "
+                "EVENTUALLY_NEXT_TO target')");
+      }
+      if (r.eventually && (r.negated || r.probability < 1.0)) {
+        errorAt(r.pos, requirement_src_[i],
+                "EVENTUALLY_* is constructed where the target drives: expected 'require' "
+                "without 'not' (a negation or a 'prefer' would have to hold over the whole "
+                "drive)");
       }
       if (r.eventually) {
         for (const auto& a : r.attributes) {
@@ -1007,12 +1134,8 @@ class Parser {
       if (!r.eventually &&
           (r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar) && !r.negated) {
         // A positive relation to a car or pedestrian is constructed: the sampler parks a car or
-        // stands a pedestrian beside the target, one per spec, in every scenario.
-        if (r.probability < 1.0) {
-          errorAt(r.pos, requirement_src_[i],
-                  "a relation to a car or pedestrian is constructed (a parked car or a standing "
-                  "pedestrian is placed for it): use 'require', not 'prefer'");
-        }
+        // stands a pedestrian beside the target, one per spec (with 'prefer', in the scenarios
+        // drawn to meet it).
         if (placed_seen) {
           errorAt(r.pos, requirement_src_[i],
                   "one relation per spec may place a car or pedestrian beside the target; "
@@ -1086,6 +1209,7 @@ class Parser {
   std::map<std::string, PendingValue> params_;
   std::vector<std::pair<std::string, PendingValue>> settings_;
   std::vector<const Source*> requirement_src_;
+  std::vector<const Source*> koz_src_;
   const Source* target_src_ = nullptr;
   const Source* class_src_ = nullptr;
   SourcePos class_pos_;

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <optional>
+#include <tuple>
 #include <variant>
 
 #include "hameritt/generation/target_slots.h"
@@ -159,6 +161,122 @@ std::string withinText(const TargetSpec& t) {
   std::snprintf(buf, sizeof(buf), "%g", t.within);
   return std::string("within ") + buf + " of " + t.within_of;
 }
+
+// The target's box at a route start, as the generator poses the lead car there.
+OrientedBox routeStartBox(const scenario::World& world, const scenario::RouteStart& st,
+                          const scenario::catalog::CarModel& m) {
+  const scenario::TrajectoryPoint p = scenario::routeStartDrive(world, st).pose(st.s);
+  return scenario::boxFromPose(Vec3(p.x, p.y, p.z), scenario::roundMilli(geometry::wrapPi(p.yaw)),
+                               Vec3(m.length, m.width, m.height));
+}
+
+// EVENTUALLY_* on a car that stands with `box0` at t = 0 and later drives `drive` (at most
+// `vmax` m/s, its pose sampled every `dt` s): some world entity of the requirement's class and
+// look that is not so related at t = 0 comes to stand in the relation along a stretch of the
+// lane at least vmax * dt + 1 m long (relation measured every 0.25 m), so that a sample falls
+// inside it whatever the speed. Per lane and car size, the relation along the lane is measured
+// once (`cache`) and serves every start on it.
+class EventualOnLane {
+ public:
+  static constexpr double kStep = 0.25;
+  EventualOnLane(const scenario::RelationEvaluator& eval, const scenario::World& world,
+                 const Requirement& r, double vmax)
+      : eval_(eval),
+        world_(world),
+        r_(r),
+        need_(static_cast<std::size_t>(
+                  std::ceil((vmax * eval.config().eventually_dt + 1.0) / kStep)) +
+              1) {}
+
+  bool holds(const OrientedBox& box0, const scenario::LaneDrive& drive) {
+    Lane& lane = laneFor(drive, box0.size);
+    const scenario::Subject t0 = specTarget(box0);
+    const auto first = static_cast<long>(std::max(0.0, std::ceil(drive.begin / kStep)));
+    for (std::size_t k = 0; k < lane.entities.size(); ++k) {
+      if (lastWindow(&lane, k, drive, box0.size) < first) continue;
+      const int i = lane.entities[k];
+      const scenario::Entity& e = world_.entities()[static_cast<std::size_t>(i)];
+      if (!eval_.holds(r_.op, eval_.measure(t0, scenario::worldSubject(world_, i)), e.cls))
+        return true;
+    }
+    return false;
+  }
+
+ private:
+  // Per entity near the lane: whether the relation holds at each 0.25 m of it (-1: not yet
+  // measured), and the start of the last run of need_ samples where it holds (-2: not yet
+  // sought, -1: none).
+  struct Lane {
+    std::vector<int> entities;
+    std::vector<std::vector<signed char>> on;
+    std::vector<long> last;
+  };
+
+  // The last window of need_ samples where the relation holds with entity k: sought from the
+  // lane's end, each window tested from its start, and on a miss at q the next window ends
+  // before q. A start at sample j has a window ahead iff j <= this.
+  long lastWindow(Lane* lane, std::size_t k, const scenario::LaneDrive& d, const Vec3& size) {
+    long& last = lane->last[k];
+    if (last != -2) return last;
+    last = -1;
+    const auto n = static_cast<long>(lane->on[k].size());
+    const auto need = static_cast<long>(need_);
+    long p = n - need;
+    while (p >= 0) {
+      long q = p;
+      while (q < p + need && at(lane, k, static_cast<std::size_t>(q), d, size)) ++q;
+      if (q == p + need) {
+        last = p;
+        break;
+      }
+      p = q - need;
+    }
+    return last;
+  }
+
+  bool at(Lane* lane, std::size_t k, std::size_t j, const scenario::LaneDrive& d,
+          const Vec3& size) {
+    signed char& v = lane->on[k][j];
+    if (v >= 0) return v != 0;
+    const int i = lane->entities[k];
+    const scenario::Entity& e = world_.entities()[static_cast<std::size_t>(i)];
+    const auto& [c, sn] = world_.footprints().trig(i);
+    const scenario::TrajectoryPoint p = d.pose(static_cast<double>(j) * kStep);
+    const OrientedBox box = scenario::boxFromPose(
+        Vec3(p.x, p.y, p.z), scenario::roundMilli(geometry::wrapPi(p.yaw)), size);
+    const double dist = geometry::footprintDistance(box, e.box, c, sn);
+    v = couldHold(eval_.config(), r_.op, box, e.box, dist) &&
+        eval_.holds(r_.op, eval_.measure(specTarget(box), scenario::worldSubject(world_, i)),
+                    e.cls);
+    return v != 0;
+  }
+
+  Lane& laneFor(const scenario::LaneDrive& d, const Vec3& size) {
+    const auto key = std::make_tuple(std::llround(d.from.x() * 1e3), std::llround(d.from.y() * 1e3),
+                                     std::llround(d.dir.x() * 1e6), std::llround(d.dir.y() * 1e6),
+                                     std::llround(size.x() * 1e3), std::llround(size.y() * 1e3),
+                                     std::llround(size.z() * 1e3));
+    auto it = cache_.find(key);
+    if (it != cache_.end()) return it->second;
+    Lane lane;
+    const double half = 0.5 * d.end;
+    const Vec2 mid = d.from + d.dir * half;
+    const double reach = half + d.lane_offset + eval_.config().radius + 0.5 * size.head<2>().norm();
+    const auto n = static_cast<std::size_t>(std::max(0.0, std::floor(d.end / kStep)) + 1);
+    lane.entities = relatedNear(world_, r_, mid, reach);
+    lane.on.assign(lane.entities.size(), std::vector<signed char>(n, -1));
+    lane.last.assign(lane.entities.size(), -2);
+    return cache_.emplace(key, std::move(lane)).first->second;
+  }
+
+  const scenario::RelationEvaluator& eval_;
+  const scenario::World& world_;
+  const Requirement& r_;
+  std::size_t need_;  // consecutive samples: (vmax * dt + 1 m) / kStep + 1
+  std::map<std::tuple<long long, long long, long long, long long, long long, long long, long long>,
+           Lane>
+      cache_;
+};
 
 // A positive relation to a car or pedestrian: the sampler places the related entity.
 bool placesRelated(const Requirement& r) {
@@ -465,6 +583,25 @@ void applySetting(const std::string& key, double v, ScenarioClass cls, scenario:
   }
 }
 
+// A koz statement with the values drawn for its settings (absent: the defaults).
+scenario::ScenarioPlan::Koz drawnKoz(const KozSpec& k, const std::map<std::string, double>& v) {
+  scenario::ScenarioPlan::Koz z;
+  z.purpose = k.purpose;
+  z.over = k.over;
+  auto get = [&](const char* name) -> std::optional<double> {
+    auto it = v.find(k.key + "." + name);
+    return it == v.end() ? std::nullopt : std::optional<double>(it->second);
+  };
+  if (auto c = get("count")) z.count = static_cast<int>(std::lround(*c));
+  if (auto x = get("size")) z.size = *x;
+  if (auto x = get("margin")) z.margin = *x;
+  z.alt_min = get("alt_min");
+  z.alt_max = get("alt_max");
+  z.net = get("net");
+  z.nlt = get("nlt");
+  return z;
+}
+
 }  // namespace
 
 bool worldRelationHolds(const scenario::RelationEvaluator& eval, const scenario::World& world,
@@ -492,6 +629,9 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   models_.resize(models.size());
   std::iota(models_.begin(), models_.end(), 0);
   colors_ = colors;
+  const bool route = spec_.cls == ScenarioClass::kRouteSearch;
+  // Where the lead car of a route search with requirements starts: every lane start.
+  if (route && !spec_.requirements.empty()) route_starts_ = scenario::routeStarts(world);
   std::vector<int> slots;
   if (placed_) {
     for (int i = 0; i < static_cast<int>(world.slots().size()); ++i) {
@@ -501,8 +641,12 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   auto count = [&](std::size_t pairs) {
     return static_cast<long long>(pairs) * static_cast<long long>(colors_.size());
   };
-  const std::size_t places = placed_ ? slots.size() : 1;
-  steps_.push_back({placed_ ? "parking places x looks" : "looks", count(places * models_.size())});
+  const std::size_t places =
+      placed_ ? slots.size() : std::max<std::size_t>(1, route_starts_.size());
+  steps_.push_back({placed_                 ? "parking places x looks"
+                    : route_starts_.empty() ? "looks"
+                                            : "route starts x looks",
+                    count(places * models_.size())});
   auto refuse = [&](const SourcePos& pos, const std::string& what, long long before) {
     throw SpecError(where(pos) + "unsatisfiable in this world: " + what + ": 0 of " +
                     std::to_string(before) + " candidates " + history(steps_));
@@ -547,7 +691,7 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   if (spec_.confusers.told_apart >= 0) {
     told_eval_ = std::make_shared<const scenario::RelationEvaluator>(world, base.relations);
   }
-  if (!placed_) return;
+  if (!placed_ && route_starts_.empty()) return;
   // Where: a block or a street.
   if (!spec_.target.block.empty() || !spec_.target.street.empty()) {
     const long long before = steps_.back().count;
@@ -589,6 +733,15 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   for (int s : slots) {
     for (int m : models_) pairs.emplace_back(s, m);
   }
+  for (int s = 0; s < static_cast<int>(route_starts_.size()); ++s) {
+    for (int m : models_) pairs.emplace_back(s, m);
+  }
+  // The target's box at t = 0 for a candidate pair.
+  auto boxAt = [&](const std::pair<int, int>& p) {
+    const auto& cm = models[static_cast<std::size_t>(p.second)];
+    return route ? routeStartBox(world, route_starts_[static_cast<std::size_t>(p.first)], cm)
+                 : parkedBox(world.slots()[static_cast<std::size_t>(p.first)], cm);
+  };
   // The longest footprint diagonal of the models left: one neighbourhood query per place
   // serves them all.
   double max_diagonal = 0;
@@ -598,20 +751,30 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
   }
   // Requirements, hard ones first narrowing the set, soft ones split it.
   const scenario::RelationEvaluator eval(world, base.relations);
-  std::vector<std::vector<char>> soft_masks;
+  // Per soft requirement, the pairs where it can be drawn to hold and where it can be drawn to
+  // fail (complements, except for a soft placing requirement: where the world does not meet it,
+  // a placed entity can make it hold or nothing placed leaves it failing).
+  std::vector<std::vector<char>> soft_masks, soft_fail_masks;
   // The requirement that places a car or pedestrian goes last: it is tested on the places
   // that every other requirement left.
+  // EVENTUALLY_* ones (measured along a lane) go after the others, on fewer candidates.
   std::vector<std::size_t> order;
   for (std::size_t ri = 0; ri < spec_.requirements.size(); ++ri) {
-    if (!placesRelated(spec_.requirements[ri])) order.push_back(ri);
+    if (!placesRelated(spec_.requirements[ri]) && !spec_.requirements[ri].eventually)
+      order.push_back(ri);
+  }
+  for (std::size_t ri = 0; ri < spec_.requirements.size(); ++ri) {
+    if (!placesRelated(spec_.requirements[ri]) && spec_.requirements[ri].eventually)
+      order.push_back(ri);
   }
   for (std::size_t ri = 0; ri < spec_.requirements.size(); ++ri) {
     if (placesRelated(spec_.requirements[ri])) order.push_back(ri);
   }
   for (const std::size_t ri : order) {
     const Requirement& r = spec_.requirements[ri];
-    if (r.eventually) continue;  // constructed by the pursuit's vignette
-    std::vector<char> mask(pairs.size());
+    // The pursuit's running pedestrians: constructed by its vignette.
+    if (r.eventually && r.related == EntityClass::kPedestrian) continue;
+    std::vector<char> mask(pairs.size()), fail_mask(pairs.size());
     std::vector<int> candidates;  // per parking place: the pairs run place by place
     std::shared_ptr<const RelatedPlacer> placer;
     if (placesRelated(r)) {
@@ -626,34 +789,53 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
       in_world = in_world ||
                  (scenario::operatorApplies(r.op, e.cls) && r.matchesRelated(e.cls, e.attributes));
     }
+    std::optional<EventualOnLane> eventual;
+    if (r.eventually) eventual.emplace(eval, world, r, base.car_speed.max);
     for (std::size_t k = 0; k < pairs.size(); ++k) {
-      const auto& sl = world.slots()[static_cast<std::size_t>(pairs[k].first)];
+      if (eventual) {
+        // After t = 0, along the first street the car drives.
+        const scenario::LaneDrive drive =
+            route ? scenario::routeStartDrive(
+                        world, route_starts_[static_cast<std::size_t>(pairs[k].first)])
+                  : scenario::pursuitDrive(world, pairs[k].first);
+        mask[k] = in_world && eventual->holds(boxAt(pairs[k]), drive);
+        fail_mask[k] = !mask[k];  // EVENTUALLY_* is hard only
+        continue;
+      }
       if (in_world && (k == 0 || pairs[k].first != pairs[k - 1].first)) {
-        candidates = relatedNear(world, r, parkedBox(sl, models[0]).center2(),
+        candidates = relatedNear(world, r, boxAt({pairs[k].first, 0}).center2(),
                                  base.relations.radius + 0.5 * max_diagonal);
       }
-      const OrientedBox box = parkedBox(sl, models[static_cast<std::size_t>(pairs[k].second)]);
-      bool holds = in_world && holdsAmong(eval, world, r, box, candidates);
+      const OrientedBox box = boxAt(pairs[k]);
+      const bool in_scene = in_world && holdsAmong(eval, world, r, box, candidates);
+      bool holds = in_scene;
       // Constructed: a car or pedestrian that the generator places beside the target.
       if (!holds && placer) holds = !placer->options(box, true).empty();
       mask[k] = holds != r.negated;
+      fail_mask[k] = placer ? !in_scene : !mask[k];
     }
     if (r.probability < 1.0) {
+      if (placer) placer_soft_ = static_cast<int>(soft_.size());
       soft_.push_back(static_cast<int>(ri));
       soft_masks.push_back(std::move(mask));
+      soft_fail_masks.push_back(std::move(fail_mask));
       continue;
     }
     const long long before = count(pairs.size());
     std::vector<std::pair<int, int>> kept;
-    std::vector<std::vector<char>> kept_soft(soft_masks.size());
+    std::vector<std::vector<char>> kept_soft(soft_masks.size()), kept_fail(soft_masks.size());
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       if (!mask[k]) continue;
       kept.push_back(pairs[k]);
-      for (std::size_t j = 0; j < soft_masks.size(); ++j) kept_soft[j].push_back(soft_masks[j][k]);
+      for (std::size_t j = 0; j < soft_masks.size(); ++j) {
+        kept_soft[j].push_back(soft_masks[j][k]);
+        kept_fail[j].push_back(soft_fail_masks[j][k]);
+      }
     }
     if (kept.empty()) refuse(r.pos, r.text, before);
     pairs = std::move(kept);
     soft_masks = std::move(kept_soft);
+    soft_fail_masks = std::move(kept_fail);
     steps_.push_back({r.text, count(pairs.size())});
   }
   hard_ = pairs;
@@ -668,7 +850,7 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       bool ok = true;
       for (std::size_t j = 0; j < soft_.size() && ok; ++j) {
-        ok = (soft_masks[j][k] != 0) == (((bits >> j) & 1U) != 0);
+        ok = ((bits >> j) & 1U) != 0 ? soft_masks[j][k] != 0 : soft_fail_masks[j][k] != 0;
       }
       if (ok) combos_[bits].push_back(pairs[k]);
     }
@@ -712,12 +894,15 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
   prov.file = spec_.file;
   prov.hash = spec_.hash;
   prov.sampler = sampler == SamplerKind::kHalton ? "halton" : "random";
+  std::map<std::string, double> drawn;
   for (const auto& [key, dist] : spec_.settings) {
     double v = dist.draw(unit());
     if (!dist.integer) v = scenario::roundMilli(v);
     applySetting(key, v, spec_.cls, &d.config, &d.plan);
     prov.values.emplace_back(key, v);
+    drawn[key] = v;
   }
+  for (const auto& k : spec_.kozs) d.plan.kozs.push_back(drawnKoz(k, drawn));
   std::size_t bits = 0;
   for (std::size_t j = 0; j < soft_.size(); ++j) {
     const auto& r = spec_.requirements[static_cast<std::size_t>(soft_[j])];
@@ -725,7 +910,14 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
     if (holds) bits |= std::size_t{1} << j;
     prov.values.emplace_back("prefer " + r.text, holds);
   }
-  if (placed_) d.plan.placements = &combos_[bits];
+  if (placed_ || !route_starts_.empty()) d.plan.placements = &combos_[bits];
+  if (!route_starts_.empty()) d.plan.route_starts = &route_starts_;
+  for (const auto& r : spec_.requirements) {
+    if (!r.eventually || r.related == EntityClass::kPedestrian) continue;
+    d.plan.eventually.push_back({r.op, [r](EntityClass c, const scenario::Attributes& a) {
+                                   return r.matchesRelated(c, a);
+                                 }});
+  }
   if (spec_.confusers.have_share) d.plan.confuser_share = spec_.confusers.share;
   if (spec_.confusers.told_apart >= 0) {
     const Requirement r = spec_.requirements[static_cast<std::size_t>(spec_.confusers.told_apart)];
@@ -733,7 +925,8 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
       return worldRelationHoldsPruned(*ev, ev->world(), r, box) == r.negated;
     };
   }
-  if (placer_) {
+  // A soft placing requirement drawn to fail places nothing (its pairs have no such entity).
+  if (placer_ && (placer_soft_ < 0 || ((bits >> placer_soft_) & 1U) != 0)) {
     d.plan.related = [p = placer_](const OrientedBox& box) {
       if (worldRelationHoldsPruned(p->eval, p->world, p->req, box)) {
         return std::vector<scenario::RelatedOption>{};
@@ -833,7 +1026,34 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
   const double dt = base.relations.eventually_dt;
   for (const auto& r : spec.requirements) {
     bool exists = false;
-    if (r.eventually) {
+    const bool mover = r.related == EntityClass::kCar || r.related == EntityClass::kPedestrian;
+    if (r.eventually && !mover) {
+      // Some world entity of the class and look that is not so related at t = 0 is at a later
+      // sample of the target's trajectory, within the mission's time.
+      scenario::Subject ts;
+      ts.id = t.entity.id;
+      ts.cls = t.entity.cls;
+      ts.attributes = &t.entity.attributes;
+      ts.box = box;
+      const scenario::Subject s0 = ts;
+      std::map<int, bool> at0;
+      for (int k = 1; k * dt <= mission.time_limit && !exists && !t.trajectory.empty(); ++k) {
+        ts.box = scenario::poseBox(t.entity.box, scenario::sampleTrajectory(t.trajectory, k * dt));
+        for (const auto& [i, d] : eval.nearbyWorldDistances(ts.box)) {
+          const scenario::Entity& e = world.entities()[static_cast<std::size_t>(i)];
+          if (!r.matchesRelated(e.cls, e.attributes)) continue;
+          const scenario::Subject rel = scenario::worldSubject(world, i);
+          if (!eval.holds(r.op, eval.measure(ts, rel), e.cls)) continue;
+          auto it = at0.find(i);
+          if (it == at0.end())
+            it = at0.emplace(i, eval.holds(r.op, eval.measure(s0, rel), e.cls)).first;
+          if (!it->second) {
+            exists = true;
+            break;
+          }
+        }
+      }
+    } else if (r.eventually) {
       for (int k = 1; k * dt <= mission.time_limit && !exists; ++k) {
         scenario::Subject ts;
         ts.id = t.entity.id;
@@ -904,6 +1124,15 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
       }
       if (!listed) fail("requirement '" + r.text + "' holds but the mission does not list it");
     }
+    if (require_listed && r.eventually && !mover) {
+      bool listed = false;
+      for (const auto& rel : mission.relations) {
+        listed = listed || (rel.target_id == t.entity.id && rel.op == r.op && rel.eventually &&
+                            r.matchesRelated(r.related, rel.related_attributes) &&
+                            rel.related_class == scenario::toString(r.related));
+      }
+      if (!listed) fail("requirement '" + r.text + "' holds but the mission does not list it");
+    }
   }
   // Look-alikes: what they share with the target, how far they park, and the requirement that
   // tells them apart (measured against the world, as the sampler places them).
@@ -951,6 +1180,62 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
       }
     }
   }
+  // Keep-out zones: each koz statement's zones, recomputed from the scene (the target's
+  // position at t = 0, the world's entities) with the values the sampler recorded, must be in
+  // the mission with their purpose, altitude band and window.
+  // (Not for a rejection sampler's judgement, require_listed false: zones are added, not found.)
+  std::size_t spec_zones = 0;  // of mission.kozs: the koz statements' (not the class's own)
+  if (!spec.kozs.empty() && require_listed) {
+    std::map<std::string, double> recorded;
+    if (sim.spec) {
+      for (const auto& [name, v] : sim.spec->values) {
+        if (std::holds_alternative<double>(v)) recorded[name] = std::get<double>(v);
+      }
+    }
+    auto same = [](const std::optional<double>& a, const std::optional<double>& b) {
+      return a.has_value() == b.has_value() && (!a || std::abs(*a - *b) <= 1e-3);
+    };
+    for (const auto& k : spec.kozs) {
+      const scenario::ScenarioPlan::Koz z = drawnKoz(k, recorded);
+      const std::string what = "koz " + k.purpose + " over " + k.over;
+      const auto want = scenario::specKozPolygons(world, z, box);
+      if (want.empty()) fail(what + ": no " + k.over + " in this world");
+      spec_zones += want.size();
+      for (const auto& poly : want) {
+        bool found = false;
+        for (const auto& m : mission.kozs) {
+          if (found || m.purpose != k.purpose || !same(m.alt_min, z.alt_min) ||
+              !same(m.alt_max, z.alt_max) || !same(m.window.net, z.net) ||
+              !same(m.window.nlt, z.nlt) || m.polygon.size() != poly.size())
+            continue;
+          bool match = true;
+          for (std::size_t i = 0; i < poly.size() && match; ++i) {
+            match = (m.polygon.vertices()[i] - poly.vertices()[i]).norm() <= 0.01;
+          }
+          found = match;
+        }
+        if (!found) {
+          const Vec2 c = poly.bounds().min * 0.5 + poly.bounds().max * 0.5;
+          char buf[96];
+          std::snprintf(buf, sizeof(buf), " (zone centred at %.2f, %.2f)", c.x(), c.y());
+          fail(what + ": no such keep-out zone in the mission" + buf);
+        }
+      }
+      for (const char* name : {"count", "size", "margin", "alt_min", "alt_max", "net", "nlt"}) {
+        const std::string key = k.key + "." + name;
+        const Distribution* d = spec.setting(key);
+        if (!d) continue;
+        auto it = recorded.find(key);
+        if (it == recorded.end()) {
+          fail(what + ": " + name + " not recorded in the spec block");
+        } else if (!d->contains(it->second)) {
+          char buf[64];
+          std::snprintf(buf, sizeof(buf), "%.6g", it->second);
+          fail(what + ": " + name + " " + buf + " is outside " + d->text());
+        }
+      }
+    }
+  }
   // Drawn values inside their distributions' supports.
   auto inSupport = [&](const std::string& key, double v, double tol) {
     const Distribution* d = spec.setting(key);
@@ -980,7 +1265,7 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
   inSupport("mission.time_limit", mission.time_limit, 0.5);
   if (spec.cls == ScenarioClass::kAreaSearch) {
     atMost("aois.count", mission.aois.size());
-    atMost("kozs.count", mission.kozs.size());
+    atMost("kozs.count", mission.kozs.size() - std::min(spec_zones, mission.kozs.size()));
     for (const auto& a : mission.aois) {
       const auto& v = a.polygon.vertices();
       if (v.size() != 4) continue;

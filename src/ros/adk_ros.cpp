@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "hameritt/AvoidStatus.h"
 #include "hameritt/ConstraintEvent.h"
 #include "hameritt/ConstraintStatus.h"
 #include "hameritt/DetectionScore.h"
@@ -146,6 +147,12 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   scorer_ = std::make_unique<adk::DetectionScorer>(mission_, sim_config_.entities, scoring);
   metrics_ = std::make_unique<adk::MetricsAccumulator>(mission_, objective);
   lifecycle_ = std::make_unique<adk::MissionLifecycle>(time_limit);
+  for (const auto& phase : mission_.phases) {
+    if (phase.type == scenario::PhaseType::kAvoid) {
+      avoid_ = std::make_unique<adk::AvoidScorer>(phase.avoid, time_limit);
+      avoid_phase_ = phase.id;
+    }
+  }
 
   mission_pub_ = gate_->advertise<hameritt::Mission>(nh, "mission", 1, true);
   markers_pub_ = gate_->advertise<visualization_msgs::MarkerArray>(nh, "mission/markers", 1, true);
@@ -156,6 +163,7 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   scores_pub_ = gate_->advertise<hameritt::DetectionScore>(nh, "adk/detection_scores", 100);
   state_pub_ = gate_->advertise<hameritt::MissionState>(nh, "adk/state", 10, true);
   metrics_pub_ = gate_->advertise<hameritt::MissionMetrics>(nh, "adk/metrics", 1, true);
+  if (avoid_) avoid_pub_ = gate_->advertise<hameritt::AvoidStatus>(nh, "adk/avoid", 10, true);
 
   if (gate_->enabled()) {
     // Lock-step: the turn carries the sim time (README "Lock-step missions").
@@ -272,6 +280,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   try {
     for (const auto& e : monitor_->add(t, p)) gate_->publish(events_pub_, toMsg(e));
     metrics_->addState(t, p, v);
+    if (avoid_) avoid_->add(avoidSample(t, p, v));
   } catch (const adk::InputError& e) {
     HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", odom_sub_.getTopic().c_str(), e.what());
     return;
@@ -288,6 +297,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   if (t >= next_status_t_) {
     publishConstraints(t);
+    publishAvoid(t);
     next_status_t_ = t + status_period_;
   }
   judgeTrackAtLimit(t);
@@ -297,6 +307,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   // A target found before the mission started running ends it as soon as it runs.
   checkObjective(t);
+  checkAvoid(t);
   endAtSimulationEnd(false);
 }
 
@@ -382,6 +393,62 @@ void AdkRos::checkObjective(double t) {
   const std::string how = metrics_->targets().size() == 1 ? "target" : "every target";
   if (lifecycle_->succeed(
           t, how + (found_by_sighting_ ? " sighted" : " correctly claimed by the client"))) {
+    publishState();
+    finish();
+  }
+}
+
+adk::TrafficSample AdkRos::avoidSample(double t, const Eigen::Vector3d& p,
+                                       const Eigen::Vector3d& v) const {
+  adk::TrafficSample s;
+  s.t = t;
+  s.position = p;
+  s.velocity = v;
+  // The aircraft fly scripted trajectories (sim_config.json): their ground truth at t, the
+  // velocity from the trajectory over +-0.05 s.
+  for (const auto& a : sim_config_.aircraft) {
+    const auto at = [&](double u) {
+      const scenario::TrajectoryPoint q = scenario::sampleTrajectory(a.trajectory, u);
+      return Eigen::Vector3d(q.x, q.y, q.z);
+    };
+    adk::AircraftState st;
+    st.id = a.id;
+    st.position = at(t);
+    st.velocity = (at(t + 0.05) - at(t - 0.05)) / 0.1;
+    s.aircraft.push_back(st);
+  }
+  return s;
+}
+
+void AdkRos::publishAvoid(double t) {
+  if (!avoid_) return;
+  const adk::AvoidScore a = avoid_->score(monitor_->violationDuration());
+  hameritt::AvoidStatus m;
+  m.header.stamp = stampOf(t);
+  m.header.frame_id = "map";
+  m.phase = avoid_phase_;
+  m.reached = a.reach_time.has_value();
+  m.reach_time = a.reach_time ? *a.reach_time : std::nan("");
+  m.goal_distance = a.goal_distance_m;
+  m.path_length = a.path_length_m;
+  m.separation_lost = avoid_->separationLost();
+  m.min_separation = a.separation.min_distance_m;
+  m.closest_aircraft = a.separation.closest_aircraft;
+  m.seconds_below_minimum = a.separation.seconds_below_minimum;
+  m.separation_losses = static_cast<std::uint32_t>(a.separation.losses);
+  m.min_time_to_collision = a.separation.min_time_to_collision_s;
+  m.contact = a.separation.contact;
+  m.koz_seconds = a.koz_seconds;
+  gate_->publish(avoid_pub_, m);
+}
+
+void AdkRos::checkAvoid(double t) {
+  if (!avoid_ || !avoid_->reached() || lifecycle_->state() != adk::MissionState::kRunning) return;
+  const adk::AvoidScore s = avoid_->score(monitor_->violationDuration());
+  char at[64];
+  std::snprintf(at, sizeof(at), "reached the goal at t = %.3f s", *s.reach_time);
+  if (s.success ? lifecycle_->succeed(t, at)
+                : lifecycle_->fail(t, std::string(at) + ", but " + s.failure)) {
     publishState();
     finish();
   }
@@ -482,9 +549,13 @@ void AdkRos::finish() {
                   watchdog_->lateStart());
     reason += late;
   }
-  const adk::MissionMetrics m = metrics_->finish(
-      adk::outcomeOf(lifecycle_->state()), reason, lifecycle_->startTime(), lifecycle_->endTime(),
-      lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+  adk::MissionMetrics m = metrics_->finish(adk::outcomeOf(lifecycle_->state()), reason,
+                                           lifecycle_->startTime(), lifecycle_->endTime(),
+                                           lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
+  if (avoid_) {
+    m.avoid = avoid_->score(monitor_->violationDuration());
+    publishAvoid(lifecycle_->endTime());
+  }
   std::string file;
   if (!output_dir_.empty()) {
     try {

@@ -6,6 +6,8 @@
 //   hameritt_generate --class CLASS --scenario-seed S --out DIR   (regenerates one scenario)
 //   hameritt_generate --spec FILE [--param NAME=VALUE ...] [--sampler random|halton] --count N
 //                     --seed S --out DIR [--jobs J]       (scenarios from a scenario-language spec)
+//   hameritt_generate --spec FILE ... --verify   (each scenario also re-checked against the
+//                     spec before it is written, as hameritt_validate --spec checks files)
 //   hameritt_generate ... --seed S --into DIR   (one scenario: DIR/mission.json,
 //   DIR/sim_config.json)
 // Exit codes: 0 success, 2 bad input (a malformed or unsatisfiable spec, an unknown or repeated
@@ -18,6 +20,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -42,7 +45,7 @@ const char* kUsage =
     "                         [--generator-config FILE] [--quiet]\n"
     "       hameritt_generate --class CLASS --scenario-seed S --out DIR   (one scenario, seed S)\n"
     "       hameritt_generate --spec FILE [--param NAME=VALUE ...] [--sampler random|halton]\n"
-    "                         --count N --seed S --out DIR [--jobs J]\n"
+    "                         --count N --seed S --out DIR [--jobs J] [--verify]\n"
     "       hameritt_generate (--class CLASS | --spec FILE ...) --seed S --into DIR\n"
     "  --into DIR: scenario 0 of the batch, its mission.json and sim_config.json written into\n"
     "  DIR itself (replacing those files; no manifest), e.g. for mission.launch spec:=FILE.\n"
@@ -50,7 +53,11 @@ const char* kUsage =
     "  comma-separated list\n"
     "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n"
     "  --first K: write only indices K..K+N-1 of the batch (a shard), byte-identical to them.\n"
-    "  --world: the world type, overriding the world config's \"type\" (default suburb).\n";
+    "  --world: the world type, overriding the world config's \"type\" (default suburb).\n"
+    "  --verify: re-check each scenario against the spec before it is written (the check of\n"
+    "  hameritt_validate --spec, on the scene in memory); one that fails fails the batch\n"
+    "  (exit 1). Prints the soft requirements' counts and \"N scenarios verified against the\n"
+    "  spec\".\n";
 
 std::uint64_t parseUnsigned(const std::string& flag, const std::string& v) {
   if (v.empty() || v[0] == '-' || v.find_first_not_of("0123456789") != std::string::npos) {
@@ -79,7 +86,7 @@ int main(int argc, char** argv) {
   std::string gen_cfg = defaultConfigDir() + "/generator.json";
   long count = -1, first = 0;
   std::uint64_t seed = 0;
-  bool have_seed = false, quiet = false, exact = false;
+  bool have_seed = false, quiet = false, exact = false, verify = false;
   std::string spec_file, sampler_name = "random";
   std::vector<std::string> params;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -118,6 +125,8 @@ int main(int argc, char** argv) {
         gen_cfg = next();
       else if (a == "--quiet")
         quiet = true;
+      else if (a == "--verify")
+        verify = true;
       else if (a == "--spec")
         spec_file = next();
       else if (a == "--param")
@@ -136,6 +145,7 @@ int main(int argc, char** argv) {
       throw UsageError("--class: a spec names its class; give --class or --spec, not both");
     }
     if (spec_file.empty() && !params.empty()) throw UsageError("--param: needs --spec");
+    if (spec_file.empty() && verify) throw UsageError("--verify: needs --spec");
     hameritt::generation::SamplerKind sampler;
     if (!hameritt::generation::parseSampler(sampler_name, &sampler)) {
       throw UsageError("--sampler: expected random or halton, got '" + sampler_name + "'");
@@ -189,6 +199,30 @@ int main(int argc, char** argv) {
       req.spec = compiled.get();
       req.sampler = sampler;
     }
+    // --verify: the independent checker on every scenario, the soft requirements counted in
+    // the order of the spec (the same counts whatever the thread count).
+    std::mutex verify_mu;
+    std::vector<std::string> soft_names;
+    std::vector<long> soft_held;
+    if (verify) {
+      req.check = [&](const Scenario& s) {
+        std::vector<hameritt::generation::RequirementCheck> soft;
+        const auto fails = hameritt::generation::checkScenarioAgainstSpec(
+            compiled->spec(), world, gc, s.mission, s.sim, &soft);
+        if (!fails.empty()) {
+          throw GenerationError(s.mission.scenario_id +
+                                " does not meet the spec: " + fails.front());
+        }
+        std::lock_guard<std::mutex> lock(verify_mu);
+        for (std::size_t i = 0; i < soft.size(); ++i) {
+          if (soft_names.size() <= i) {
+            soft_names.push_back(soft[i].requirement);
+            soft_held.push_back(0);
+          }
+          soft_held[i] += soft[i].holds ? 1 : 0;
+        }
+      };
+    }
     if (!into.empty()) req.write_world = false;
     std::vector<hameritt::scenario::ManifestEntry> entries;
     try {
@@ -220,6 +254,13 @@ int main(int argc, char** argv) {
     }
     const double secs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (verify) {
+      for (std::size_t i = 0; i < soft_names.size(); ++i) {
+        std::printf("soft '%s': held in %ld of %zu scenarios\n", soft_names[i].c_str(),
+                    soft_held[i], entries.size());
+      }
+      std::printf("%zu scenarios verified against the spec\n", entries.size());
+    }
     if (!quiet) {
       for (const auto& e : entries) std::printf("%s\n", e.id.c_str());
       std::fprintf(stderr, "hameritt_generate: %zu scenarios in %s (%.3f s, %d jobs)\n",

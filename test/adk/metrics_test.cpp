@@ -191,6 +191,64 @@ TEST(MissionLifecycle, Transitions) {
   EXPECT_FALSE(e.update(10.0, true));  // ended stays ended: no timeout after it
   EXPECT_EQ(e.state(), MissionState::kEnded);
   EXPECT_THROW(MissionLifecycle(0.0), InputError);
+  MissionLifecycle f(10.0);
+  f.update(1.0, true);
+  EXPECT_TRUE(f.fail(6.0, "reached the goal, but lost separation"));
+  EXPECT_STREQ(toString(f.state()), "failed");
+  EXPECT_STREQ(toString(outcomeOf(f.state())), "failed");
+  EXPECT_FALSE(f.succeed(7.0, "late"));  // failed stays failed
+  EXPECT_FALSE(f.update(10.0, true));
+}
+
+// An avoid mission's metrics.json carries the phase's score after the coverage, times that
+// never happened as null; other missions have no "avoid" block (the test above lists keys).
+TEST(MetricsJson, AvoidBlock) {
+  scenario::AvoidPhaseSpec spec;
+  spec.goal = Vec3(100, 0, 0);
+  spec.goal_radius = 5.0;
+  spec.shortest_path_m = 100.0;
+  AvoidScorer scorer(spec, 60.0);
+  for (int i = 0; i <= 20; ++i) {
+    TrafficSample s;
+    s.t = i;
+    s.position = Vec3(5.0 * i, 0, 0);
+    AircraftState a;
+    a.id = "aircraft_1";
+    a.position = Vec3(50, 4, 1);  // 4 m aside, 1 m up: a loss of separation at x = 50
+    s.aircraft.push_back(a);
+    scorer.add(s);
+  }
+  ASSERT_TRUE(scorer.reached());
+  MetricsAccumulator acc(shippedMission());
+  ConstraintMonitor mon(shippedMission());
+  CoverageGrid cov(shippedMission());
+  MissionMetrics m =
+      acc.finish(Outcome::kFailed, "lost separation", 0.0, 19.0, 60.0, "maneuver_only", mon, cov);
+  m.avoid = scorer.score(2.5);
+  const auto j = nlohmann::ordered_json::parse(metricsJson(m));
+  EXPECT_EQ(j["outcome"], "failed");
+  std::vector<std::string> keys;
+  for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
+  ASSERT_EQ(keys.back(), "avoid");
+  const auto& a = j["avoid"];
+  EXPECT_FALSE(a["success"].get<bool>());
+  EXPECT_NE(a["failure"].get<std::string>().find("lost separation 1 time"), std::string::npos);
+  EXPECT_EQ(a["reach_time"], 19.0);  // x = 95: within 5 m of the goal
+  EXPECT_EQ(a["path_length"], 95.0);
+  EXPECT_EQ(a["spl"], 0.0);
+  EXPECT_NEAR(a["min_separation"].get<double>(), std::sqrt(17.0), 1e-9);
+  EXPECT_EQ(a["closest_aircraft"], "aircraft_1");
+  EXPECT_EQ(a["separation_losses"], 1);
+  EXPECT_EQ(a["koz_seconds"], 2.5);
+  EXPECT_FALSE(a["contact"].get<bool>());
+  // Without aircraft the separation figures are null, not infinite (JSON has no infinity).
+  AvoidScorer empty(spec, 60.0);
+  empty.add(TrafficSample{});
+  m.avoid = empty.score();
+  const auto k = nlohmann::ordered_json::parse(metricsJson(m));
+  EXPECT_TRUE(k["avoid"]["min_separation"].is_null());
+  EXPECT_TRUE(k["avoid"]["min_time_to_collision"].is_null());
+  EXPECT_TRUE(k["avoid"]["reach_time"].is_null());
 }
 
 }  // namespace

@@ -125,6 +125,46 @@ TEST(Separation, RejectsMalformedInput) {
   EXPECT_EQ(scoreSeparation({}).losses, 0u);
 }
 
+// The tracker that the ADK updates live gives, after every sample, what a batch score of the
+// samples so far gives; a rejected sample leaves it as it was.
+TEST(Separation, TrackerMatchesTheBatchScoreAfterEverySample) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-20.0, 20.0);
+  std::vector<TrafficSample> samples;
+  SeparationTracker tracker;
+  for (int i = 0; i < 200; ++i) {
+    TrafficSample x;
+    x.t = 0.1 * (i + 1);
+    x.position = Vec3(u(rng), u(rng), 10 + 0.2 * u(rng));
+    x.velocity = Vec3(u(rng), u(rng), 0);
+    for (int k = 0; k < 3; ++k) {
+      AircraftState a;
+      a.id = "aircraft_" + std::to_string(k);
+      a.position = Vec3(u(rng), u(rng), 10 + 0.3 * u(rng));
+      a.velocity = Vec3(u(rng), u(rng), 0);
+      x.aircraft.push_back(a);
+    }
+    samples.push_back(x);
+    tracker.add(x);
+    const SeparationScore b = scoreSeparation(samples);
+    const SeparationScore& t = tracker.score();
+    ASSERT_EQ(t.min_distance_m, b.min_distance_m) << i;
+    ASSERT_EQ(t.closest_aircraft, b.closest_aircraft) << i;
+    ASSERT_EQ(t.seconds_below_minimum, b.seconds_below_minimum) << i;
+    ASSERT_EQ(t.losses, b.losses) << i;
+    ASSERT_EQ(t.min_time_to_collision_s, b.min_time_to_collision_s) << i;
+    ASSERT_EQ(t.contact, b.contact) << i;
+  }
+  EXPECT_GT(tracker.score().losses, 0u);  // the random traffic does lose separation
+  TrafficSample late = samples.back();    // same stamp: rejected, nothing changes
+  late.position = late.aircraft[0].position;
+  const SeparationScore before = tracker.score();
+  EXPECT_THROW(tracker.add(late), InputError);
+  EXPECT_EQ(tracker.samples(), 200u);
+  EXPECT_EQ(tracker.score().min_distance_m, before.min_distance_m);
+  EXPECT_EQ(tracker.score().contact, before.contact);
+}
+
 // A target driving north (yaw pi/2) at 10 m/s from the origin; the vehicle 15 m behind and
 // 20 m above, except where `off` says how far it lags further behind.
 std::vector<FollowSample> follow(const std::vector<double>& off) {

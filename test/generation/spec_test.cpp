@@ -5,14 +5,17 @@
 #include "hameritt/generation/spec.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 
 #include "../scenario/test_util.h"
+#include "hameritt/generation/batch.h"
 #include "hameritt/generation/spec_sampler.h"
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/relations.h"
@@ -114,7 +117,9 @@ TEST(SpecParse, TypeErrors) {
   EXPECT_EQ(moving.substr(0, moving.find('\n')),
             "t.hspec:2:1: error: an area_search target is parked; expected 'parked'");
   const std::string ev = errorOf(std::string(kHead) + "require tree EVENTUALLY_NEXT_TO target\n");
-  EXPECT_NE(ev.find("t.hspec:2:1: error: EVENTUALLY_* requirements"), std::string::npos) << ev;
+  EXPECT_EQ(ev.substr(0, ev.find('\n')),
+            "t.hspec:2:1: error: EVENTUALLY_* applies to a moving target (route_search, "
+            "pursuit); an area_search target is parked: drop EVENTUALLY_");
 }
 
 TEST(SpecParse, DistributionsDrawInsideTheirSupport) {
@@ -485,12 +490,106 @@ TEST(SpecRelated, NegationsKeepCarsAwayAndAreChecked) {
   }
 }
 
+// Whether `held` of `n` is within 3 sigma of n * p.
+bool withinThreeSigma(int held, int n, double p) {
+  return std::abs(held - n * p) <= 3 * std::sqrt(n * p * (1 - p));
+}
+
+TEST(SpecRelated, APreferredPlacedEntityHoldsWithItsProbability) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car parked\nprefer 0.4 car NEXT_TO target {vehicle_class: van}\n"
+                       "require not pedestrian NEXT_TO target\n");
+  constexpr int kN = 200;
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  int held = 0, placed = 0, removed = 0;
+  for (const auto& sc : generateChecked(s, kN)) {
+    std::vector<RequirementCheck> soft;
+    EXPECT_TRUE(
+        checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sc.sim, &soft).empty());
+    ASSERT_EQ(soft.size(), 1u);
+    EXPECT_EQ(soft[0].requirement, "car NEXT_TO target {vehicle_class: van}");
+    held += soft[0].holds;
+    // The van placed for it (a parked traffic car): without it the scene no longer agrees with
+    // the outcome drawn (negative control).
+    for (const auto& se : sc.sim.entities) {
+      if (se.role != "traffic" || !se.trajectory.empty() ||
+          se.entity.attributes.str("vehicle_class") != "van")
+        continue;
+      ++placed;
+      EXPECT_TRUE(soft[0].holds);
+      if (removed >= 5) break;
+      scenario::SimConfig without = sc.sim;
+      const std::string id = se.entity.id;
+      without.entities.erase(std::remove_if(without.entities.begin(), without.entities.end(),
+                                            [&](const auto& e) { return e.entity.id == id; }),
+                             without.entities.end());
+      const auto f = checkOf(s, sc, without);
+      ASSERT_EQ(f.size(), 1u);
+      EXPECT_EQ(f[0],
+                "soft requirement 'car NEXT_TO target {vehicle_class: van}' was drawn to hold but "
+                "does not hold in the scene");
+      ++removed;
+      break;
+    }
+  }
+  EXPECT_TRUE(withinThreeSigma(held, kN, 0.4)) << held << " of " << kN;
+  // Negative controls: the same count is far outside 3 sigma of 0.8 and of 0.1.
+  EXPECT_FALSE(withinThreeSigma(held, kN, 0.8)) << held;
+  EXPECT_FALSE(withinThreeSigma(held, kN, 0.1)) << held;
+  // Most scenes drawn to hold get their van constructed (the world's own cars rarely meet it).
+  EXPECT_GE(placed, held * 3 / 4);
+  EXPECT_LE(placed, held);
+  EXPECT_EQ(removed, 5);
+}
+
+// The batch's per-scenario check (hameritt_generate --verify): every scenario passes the
+// checker of its own spec; checked against another spec (a blue target), the batch fails and
+// leaves no scenario behind (negative control).
+TEST(SpecVerify, EveryScenarioIsCheckedBeforeItIsWritten) {
+  const Spec red = parse(std::string(kHead) +
+                         "target car {color: red} parked\nrequire garage RIGHT_OF target\n");
+  const Spec blue = parse(std::string(kHead) + "target car {color: blue} parked\n");
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  const CompiledSpec c(red, shippedWorld(), cfg);
+  const std::string out = ::testing::TempDir() + "/spec_verify_" + std::to_string(::getpid());
+  scenario::BatchRequest req;
+  req.spec = &c;
+  req.count = 6;
+  req.seed = 4;
+  req.jobs = 2;
+  req.out_dir = out;
+  std::atomic<int> checked{0};
+  const Spec* against = &red;
+  req.check = [&](const scenario::Scenario& s) {
+    const auto f =
+        checkScenarioAgainstSpec(*against, shippedWorld(), cfg, s.mission, s.sim, nullptr);
+    if (!f.empty()) throw scenario::GenerationError(f.front());
+    ++checked;
+  };
+  EXPECT_EQ(scenario::generateBatch(shippedWorld(), cfg, req).size(), 6u);
+  EXPECT_EQ(checked.load(), 6);
+  std::filesystem::remove_all(out);
+  against = &blue;
+  checked = 0;
+  std::string what = "(no error)";
+  try {
+    scenario::generateBatch(shippedWorld(), cfg, req);
+  } catch (const scenario::GenerationError& e) {
+    what = e.what();
+  }
+  EXPECT_NE(what.find("color 'red' is not one of blue"), std::string::npos) << what;
+  EXPECT_EQ(checked.load(), 0);
+  int left = 0;
+  for (const auto& e : std::filesystem::directory_iterator(out)) left += e.is_directory();
+  EXPECT_EQ(left, 0);
+  std::filesystem::remove_all(out);
+}
+
 TEST(SpecRelated, TypeCheckerRules) {
-  const std::string soft =
-      errorOf(std::string(kHead) + "target car parked\nprefer 0.5 car NEXT_TO target\n");
-  EXPECT_EQ(soft.substr(0, soft.find('\n')),
-            "t.hspec:3:1: error: a relation to a car or pedestrian is constructed (a parked car or "
-            "a standing pedestrian is placed for it): use 'require', not 'prefer'");
+  // 'prefer' on a placed entity is accepted (constructed in the scenarios drawn to meet it).
+  EXPECT_NO_THROW(parse(std::string(kHead) + "target car parked\nprefer 0.5 car NEXT_TO target\n"));
   const std::string two = errorOf(std::string(kHead) +
                                   "target car parked\nrequire car NEXT_TO target\n"
                                   "require pedestrian LEFT_OF target\n");
@@ -508,6 +607,238 @@ TEST(SpecRelated, TypeCheckerRules) {
                         "target car parked\nrequire car NEXT_TO target\n"
                         "require not car IN_FRONT_OF target\nrequire not pedestrian NEXT_TO "
                         "target\n"));
+}
+
+// The shipped generator configuration without perception paths (not checked by a spec).
+scenario::GeneratorConfig specConfig() {
+  scenario::GeneratorConfig c = shippedConfig();
+  c.perception_paths = false;
+  return c;
+}
+
+// Scenario `seed` of a compiled spec, as hameritt_generate --spec makes it, and the checker's
+// verdict on it (empty: every requirement holds).
+struct SpecScene {
+  scenario::Scenario sc;
+  std::vector<std::string> fails;
+};
+SpecScene specScene(const Spec& s, const CompiledSpec& c, const scenario::GeneratorConfig& cfg,
+                    std::uint64_t seed) {
+  const ScenarioDraw d = c.draw(seed, seed, 1, SamplerKind::kRandom);
+  SpecScene out{scenario::generateScenario(shippedWorld(), d.config, s.cls, seed, &d.plan), {}};
+  out.fails = checkScenarioAgainstSpec(s, shippedWorld(), cfg, out.sc.mission, out.sc.sim, nullptr);
+  return out;
+}
+
+// Relations of a moving target: at t = 0 (where a route-search car starts), and EVENTUALLY_* at
+// a later sample of its trajectory with an entity not so related at t = 0.
+const char* kRoute =
+    "scenario route_search\ntarget car {vehicle_class: sedan} moving\n"
+    "require house LEFT_OF target\nrequire garage EVENTUALLY_RIGHT_OF target\n";
+
+TEST(SpecMoving, TypeCheckerRules) {
+  auto first = [](const std::string& e) { return e.substr(0, e.find('\n')); };
+  const char* kRouteHead = "scenario route_search\ntarget car moving\n";
+  EXPECT_EQ(first(errorOf(std::string(kRouteHead) + "require car LEFT_OF target\n")),
+            "t.hspec:3:1: error: a route_search target relates to the neighborhood (street, "
+            "house, building, ...): relations to cars and pedestrians apply to parked targets");
+  EXPECT_EQ(first(errorOf("scenario pursuit\ntarget car\nrequire car EVENTUALLY_NEXT_TO target\n")),
+            "t.hspec:3:1: error: EVENTUALLY_* relates a moving target to the neighborhood "
+            "(street, house, building, ...), or a pursuit target to its running pedestrians "
+            "('pedestrian EVENTUALLY_NEXT_TO target')");
+  const std::string expect_require =
+      "EVENTUALLY_* is constructed where the target drives: expected 'require' without 'not' (a "
+      "negation or a 'prefer' would have to hold over the whole drive)";
+  EXPECT_EQ(
+      first(errorOf(std::string(kRouteHead) + "require not house EVENTUALLY_LEFT_OF target\n")),
+      "t.hspec:3:1: error: " + expect_require);
+  EXPECT_EQ(
+      first(errorOf(std::string(kRouteHead) + "prefer 0.4 house EVENTUALLY_LEFT_OF target\n")),
+      "t.hspec:3:1: error: " + expect_require);
+  // Accepted: every operator in its EVENTUALLY_ form on the neighborhood, static ones too.
+  EXPECT_NO_THROW(parse(std::string(kRouteHead) +
+                        "require street ON_TOP_OF target\nrequire not tree NEXT_TO target\n"
+                        "require house EVENTUALLY_IN_FRONT_OF target\n"
+                        "require garage EVENTUALLY_ORTHOGONAL_TO target\n"
+                        "require driveway EVENTUALLY_NOT_ON_TOP_OF target\n"));
+}
+
+TEST(SpecMoving, RouteSearchRelationsAreMetAndChecked) {
+  const Spec s = parse(kRoute);
+  const scenario::GeneratorConfig cfg = specConfig();
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  ASSERT_EQ(c.steps().size(), 4u);
+  EXPECT_EQ(c.steps()[0].label, "route starts x looks");
+  EXPECT_EQ(c.steps()[1].label, "vehicle_class sedan");
+  EXPECT_EQ(c.steps()[2].label, "house LEFT_OF target");
+  EXPECT_EQ(c.steps()[3].label, "garage EVENTUALLY_RIGHT_OF target");
+  // Each requirement narrows the set, and the last count is the feasible set (x colours).
+  EXPECT_LT(c.steps()[3].count, c.steps()[2].count);
+  EXPECT_LT(c.steps()[2].count, c.steps()[1].count);
+  EXPECT_GT(c.feasibleCount(), 0u);
+  int listed = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const SpecScene g = specScene(s, c, cfg, seed);
+    const scenario::Scenario& sc = g.sc;
+    EXPECT_TRUE(g.fails.empty()) << seed << ": " << g.fails.front();
+    const scenario::ScenarioEntity* lead = nullptr;
+    for (const auto& se : sc.sim.entities) {
+      if (!lead && se.role == "target") lead = &se;
+    }
+    ASSERT_TRUE(lead);
+    for (const auto& r : sc.mission.relations) {
+      if (r.target_id == lead->entity.id && r.eventually && r.related_class == "garage" &&
+          r.op == scenario::RelationOp::kRightOf) {
+        ++listed;
+        EXPECT_GT(r.time, 0.0);
+      }
+    }
+    // Negative controls: the lead car frozen at its start (nothing comes to its right later),
+    // moved 2 km off (nothing beside it at all), and the eventual relation left out of the
+    // mission.
+    scenario::SimConfig frozen = sc.sim;
+    for (auto& se : frozen.entities) {
+      if (se.entity.id != lead->entity.id) continue;
+      const scenario::TrajectoryPoint p0 = se.trajectory.front();
+      se.trajectory = {p0, p0};
+      se.trajectory.back().t = 1.0;
+    }
+    const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, frozen, nullptr);
+    ASSERT_EQ(f1.size(), 1u) << seed;
+    EXPECT_EQ(f1[0], "requirement 'garage EVENTUALLY_RIGHT_OF target' does not hold for target " +
+                         lead->entity.id + " (recomputed from the scene)");
+    scenario::SimConfig away = sc.sim;
+    for (auto& se : away.entities) {
+      if (se.entity.id != lead->entity.id) continue;
+      for (auto& p : se.trajectory) p.x += 2000.0;
+    }
+    const auto f2 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, away, nullptr);
+    ASSERT_EQ(f2.size(), 2u) << seed;
+    EXPECT_NE(f2[0].find("requirement 'house LEFT_OF target' does not hold"), std::string::npos);
+    scenario::Mission unlisted = sc.mission;
+    unlisted.relations.erase(
+        std::remove_if(unlisted.relations.begin(), unlisted.relations.end(),
+                       [](const scenario::SceneRelation& r) { return r.eventually; }),
+        unlisted.relations.end());
+    const auto f3 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, unlisted, sc.sim, nullptr);
+    ASSERT_EQ(f3.size(), 1u) << seed;
+    EXPECT_EQ(f3[0],
+              "requirement 'garage EVENTUALLY_RIGHT_OF target' holds but the mission does "
+              "not list it");
+  }
+  EXPECT_EQ(listed, 8);
+  // The same spec and seed give the same scenario.
+  const ScenarioDraw d = c.draw(3, 3, 1, SamplerKind::kRandom);
+  const scenario::Scenario a =
+      scenario::generateScenario(shippedWorld(), d.config, s.cls, 3, &d.plan);
+  const scenario::Scenario b =
+      scenario::generateScenario(shippedWorld(), d.config, s.cls, 3, &d.plan);
+  EXPECT_EQ(scenario::missionJson(a.mission), scenario::missionJson(b.mission));
+  EXPECT_EQ(scenario::simConfigJson(a.sim), scenario::simConfigJson(b.sim));
+}
+
+TEST(SpecMoving, PursuitEventuallyIsMetAfterItDrivesOff) {
+  const Spec s = parse(
+      "scenario pursuit\ntarget car\nrequire pedestrian EVENTUALLY_NEXT_TO target\n"
+      "require house EVENTUALLY_LEFT_OF target\n");
+  const scenario::GeneratorConfig cfg = specConfig();
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const SpecScene g = specScene(s, c, cfg, seed);
+    const scenario::Scenario& sc = g.sc;
+    EXPECT_TRUE(g.fails.empty()) << seed << ": " << g.fails.front();
+    // Negative control: the target never leaves its kerb.
+    scenario::SimConfig parked = sc.sim;
+    for (auto& se : parked.entities) {
+      if (se.role != "target") continue;
+      const scenario::TrajectoryPoint p0 = se.trajectory.front();
+      se.trajectory = {p0, p0};
+      se.trajectory.back().t = 1.0;
+    }
+    const auto f = checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, parked, nullptr);
+    bool reported = false;
+    for (const auto& m : f) {
+      reported = reported ||
+                 m.find("'house EVENTUALLY_LEFT_OF target' does not hold") != std::string::npos;
+    }
+    EXPECT_TRUE(reported) << seed;
+  }
+}
+
+TEST(SpecKoz, TypeCheckerRules) {
+  auto first = [](const std::string& e) { return e.substr(0, e.find('\n')); };
+  const std::string head = std::string(kHead) + "target car parked\n";
+  EXPECT_EQ(first(errorOf(head + "koz restricetd over garage\n")),
+            "t.hspec:3:5: error: unknown purpose 'restricetd'; did you mean 'restricted'?; "
+            "purposes: vantage_denial, access_denial, restricted");
+  EXPECT_EQ(first(errorOf(head + "koz restricted garage\n")),
+            "t.hspec:3:16: error: expected 'over' after the purpose, got 'garage'");
+  const std::string cover = first(errorOf(head + "koz restricted over garag\n"));
+  EXPECT_EQ(cover.rfind("t.hspec:3:21: error: unknown zone cover 'garag'; did you mean 'garage'?; "
+                        "a zone covers: target, ",
+                        0),
+            0u)
+      << cover;
+  EXPECT_EQ(first(errorOf(head + "koz restricted over target { count: 2 }\n")),
+            "t.hspec:3:30: error: unknown setting 'count' of a zone over target; settings: alt, "
+            "net, nlt, size");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { alt: [range(0, 50), 40] }\n")),
+            "t.hspec:3:50: error: alt: expected the top of the band above its bottom, whatever "
+            "is drawn (40 vs range(0, 50))");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { net: 100, nlt: 60..120 }\n")),
+            "t.hspec:3:45: error: nlt: expected NLT after NET, whatever is drawn (60..120 vs "
+            "100)");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { alt: 0 }\n")),
+            "t.hspec:3:35: error: expected '[' to open the altitude band: alt: [bottom, top] (m), "
+            "got '0'");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { count: 9 }\n")),
+            "t.hspec:3:37: error: koz1.count: expected values within [1, 5], got 9");
+  EXPECT_EQ(first(errorOf(head + "koz restricted over garage { net: 1, net: 2 }\n")),
+            "t.hspec:3:43: error: 'net' given twice in this koz");
+}
+
+TEST(SpecKoz, ZonesAreAddedAndChecked) {
+  const Spec s = parse(
+      "scenario route_search\ntarget car moving\n"
+      "koz restricted over garage { count: 2, margin: range(3, 6), alt: [0, range(40, 60)], "
+      "net: 30..60, nlt: range(300, 400) }\n"
+      "koz vantage_denial over target { size: 50 }\n");
+  const scenario::GeneratorConfig cfg = specConfig();
+  const CompiledSpec c(s, shippedWorld(), cfg);
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const SpecScene g = specScene(s, c, cfg, seed);
+    const scenario::Scenario& sc = g.sc;
+    EXPECT_TRUE(g.fails.empty()) << seed << ": " << g.fails.front();
+    // Three zones after the class's own: two over garages, one over the target.
+    const auto& k = sc.mission.kozs;
+    ASSERT_GE(k.size(), 3u);
+    EXPECT_EQ(k[k.size() - 3].purpose, "restricted");
+    EXPECT_EQ(k[k.size() - 2].purpose, "restricted");
+    EXPECT_EQ(k.back().purpose, "vantage_denial");
+    ASSERT_TRUE(k[k.size() - 3].alt_max && k[k.size() - 3].window.net);
+    EXPECT_GE(*k[k.size() - 3].alt_max, 40.0);
+    EXPECT_LE(*k[k.size() - 3].alt_max, 60.0);
+    EXPECT_FALSE(k.back().alt_max.has_value());
+    // Negative controls: a band raised, a zone moved 3 m, a zone dropped.
+    scenario::Mission raised = sc.mission;
+    *raised.kozs[k.size() - 3].alt_max += 5.0;
+    const auto f1 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, raised, sc.sim, nullptr);
+    ASSERT_EQ(f1.size(), 1u) << seed;
+    EXPECT_EQ(f1[0].rfind("koz restricted over garage: no such keep-out zone in the mission", 0),
+              0u)
+        << f1[0];
+    scenario::Mission moved = sc.mission;
+    std::vector<geometry::Vec2> v = moved.kozs.back().polygon.vertices();
+    for (auto& p : v) p.x() += 3.0;
+    moved.kozs.back().polygon = geometry::Polygon(v);
+    const auto f2 = checkScenarioAgainstSpec(s, shippedWorld(), cfg, moved, sc.sim, nullptr);
+    ASSERT_EQ(f2.size(), 1u) << seed;
+    EXPECT_EQ(f2[0].rfind("koz vantage_denial over target: no such keep-out zone", 0), 0u) << f2[0];
+    scenario::Mission dropped = sc.mission;
+    dropped.kozs.erase(dropped.kozs.end() - 2);
+    EXPECT_EQ(checkScenarioAgainstSpec(s, shippedWorld(), cfg, dropped, sc.sim, nullptr).size(),
+              1u);
+  }
 }
 
 TEST(SpecWithin, TheTargetParksNearALandmarkAndIsChecked) {

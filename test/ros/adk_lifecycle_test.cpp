@@ -60,10 +60,7 @@ Vector3d flight(double t, Vector3d* v) {
 }
 
 nlohmann::json readMetrics(const std::string& ns) {
-  std::ifstream f(kRoot + "/" + ns + "/metrics.json");
-  EXPECT_TRUE(f.good()) << ns << ": no metrics.json";
-  if (!f.good()) return nlohmann::json::object();
-  return nlohmann::json::parse(f);
+  return hameritt::testing::readJsonFile(kRoot + "/" + ns + "/metrics.json");
 }
 
 }  // namespace

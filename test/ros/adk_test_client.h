@@ -9,11 +9,21 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 namespace hameritt::testing {
+
+// A JSON file the ADK wrote; an empty object (and a test failure) when it cannot be read.
+inline nlohmann::json readJsonFile(const std::string& path) {
+  std::ifstream f(path);
+  EXPECT_TRUE(f.good()) << path << ": cannot read";
+  if (!f.good()) return nlohmann::json::object();
+  return nlohmann::json::parse(f);
+}
 
 // Serves callbacks until `done` holds or `seconds` of wall time have passed; returns done().
 inline bool spinUntil(const std::function<bool()>& done, double seconds) {
@@ -78,6 +88,14 @@ class FakeSimulator {
 
   // Publishes odometry at (t, p, v) on every namespace, then the clock.
   void publish(double t, const Eigen::Vector3d& p, const Eigen::Vector3d& v) {
+    for (std::size_t i = 0; i < odom_pubs_.size(); ++i) publishOdometry(i, t, p, v);
+    clock(t);
+  }
+
+  // Odometry at (t, p, v) on the i-th namespace only, without the clock: for flights that
+  // differ per node (publish the clock after every namespace's odometry of the step).
+  void publishOdometry(std::size_t i, double t, const Eigen::Vector3d& p,
+                       const Eigen::Vector3d& v) {
     nav_msgs::Odometry o;
     o.header.stamp.fromSec(t);
     o.header.frame_id = "map";
@@ -89,8 +107,7 @@ class FakeSimulator {
     o.twist.twist.linear.x = v.x();
     o.twist.twist.linear.y = v.y();
     o.twist.twist.linear.z = v.z();
-    for (auto& pub : odom_pubs_) pub.publish(o);
-    clock(t);
+    odom_pubs_.at(i).publish(o);
   }
 
   void clock(double t) {

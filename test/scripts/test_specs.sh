@@ -38,8 +38,31 @@ EOF
 specs=("$S"/*.hspec)
 [[ ${#specs[@]} -ge 8 ]] && ok || bad "expected at least 8 example specs, got ${#specs[@]}"
 soft_total=0
+city_verified=0
 for spec in "${specs[@]}"; do
   name="$(basename "$spec" .hspec)"
+  if grep -q '^world city' "$spec"; then
+    # A city scene carries the city's traffic (about 4.5 MB of JSON): every scenario is
+    # re-checked in memory by --verify (the checker of hameritt_validate --spec, on the finished
+    # scene) and the files of every tenth by hameritt_validate itself; made in 4 shards (--first)
+    # so that /dev/shm holds one at a time.
+    for ((k = 0; k < 4; k++)); do
+      rm -rf "$OUT/$name"
+      "$G" --spec "$spec" --count $((N / 4)) --first $((k * N / 4)) --seed 2026 --out "$OUT/$name" \
+        --jobs 2 --quiet --verify >"$T/$name.gen" 2>&1 && ok || bad "$name: generation failed: $(tail -2 "$T/$name.gen")"
+      grep -qx "$((N / 4)) scenarios verified against the spec" "$T/$name.gen" &&
+        city_verified=$((city_verified + N / 4))
+      mapfile -t tenth < <(ls -d "$OUT/$name"/*/ | awk 'NR % 10 == 1')
+      [[ ${#tenth[@]} -eq $((N / 40)) ]] && ok || bad "$name: expected $((N / 40)) scenarios to validate, got ${#tenth[@]}"
+      "$V" --spec "$spec" "${tenth[@]}" >"$T/$name.out" 2>"$T/$name.err" && ok ||
+        bad "$name: validation failed: $(head -3 "$T/$name.err")"
+      grep -qx "${#tenth[@]} scenarios, ${#tenth[@]} meet the spec, 0 fail" "$T/$name.out" && ok ||
+        bad "$name: $(tail -1 "$T/$name.out")"
+    done
+    k=$(soft_check "$T/$name.gen" "$spec") && ok || bad "$name: $k"
+    soft_total=$((soft_total + ${k:-0}))
+    continue
+  fi
   "$G" --spec "$spec" --count $N --seed 2026 --out "$OUT/$name" --jobs 2 --quiet &&
     ok || bad "$name: generation failed"
   n=$(find "$OUT/$name" -mindepth 1 -maxdepth 1 -type d | wc -l)
@@ -51,6 +74,7 @@ for spec in "${specs[@]}"; do
   k=$(soft_check "$T/$name.out" "$spec") && ok || bad "$name: $k"
   soft_total=$((soft_total + ${k:-0}))
 done
+[[ $city_verified -eq $N ]] && ok || bad "expected $N city scenarios verified, got $city_verified"
 # Three examples carry a soft requirement: all were checked.
 [[ $soft_total -eq 3 ]] && ok || bad "expected 3 soft requirements checked, got $soft_total"
 
@@ -188,6 +212,34 @@ printf 'scenario area_search\ntarget car parked within 10 of intersection\n' >"$
 "$V" --spec "$T/w40.hspec" "$T/w40" >/dev/null 2>&1 && ok || bad "within 40: scenes fail their spec"
 out=$("$V" --spec "$T/w10.hspec" "$T/w40" 2>/dev/null | tail -1)
 [[ "$out" =~ ^30\ scenarios,\ ([0-9]+)\ meet\ the\ spec,\ ([0-9]+)\ fail$ && ${BASH_REMATCH[2]} -gt 0 ]] && ok || bad "within 10 on within-40 scenes: $out"
+
+# A moving target and keep-out zones: malformed statements exit 2 naming the place, nothing
+# written; a route_landmarks scene whose mission drops the garage's EVENTUALLY_RIGHT_OF, and one
+# whose restricted zone is raised 10 m, fail (exit 2).
+printf 'scenario area_search\ntarget car parked\nrequire garage EVENTUALLY_RIGHT_OF target\n' >"$T/ev.hspec"
+expect 2 "ev.hspec:3:1: error: EVENTUALLY_\* applies to a moving target" "$G" --spec "$T/ev.hspec" --count 3 --seed 1 --out "$T/x10"
+printf 'scenario route_search\ntarget car moving\nkoz restricted over hosue\n' >"$T/koz.hspec"
+expect 2 "koz.hspec:3:21: error: unknown zone cover 'hosue'; did you mean 'house'" "$G" --spec "$T/koz.hspec" --count 3 --seed 1 --out "$T/x11"
+for x in x10 x11; do
+  [[ ! -e "$T/$x" ]] && ok || bad "a refused run wrote $T/$x"
+done
+r1="$(ls -d "$OUT/route_landmarks"/*/ | head -1)"
+cp -r "$r1" "$T/r2"
+/usr/bin/python3 - "$r1/mission.json" "$T/r2/mission.json" <<'EOF2'
+import json, sys
+d = json.load(open(sys.argv[1]))
+n = len(d["scene_relations"])
+d["scene_relations"] = [r for r in d["scene_relations"] if r["operator"] != "EVENTUALLY_RIGHT_OF"
+                        or r["related"]["class"] != "garage"]
+assert len(d["scene_relations"]) < n, "no garage EVENTUALLY_RIGHT_OF listed"
+json.dump(d, open(sys.argv[1], "w"), indent=2)
+d = json.load(open(sys.argv[2]))
+z = [k for k in d["keep_out_zones"] if k["purpose"] == "restricted"]
+z[-1]["altitude"]["max"] += 10.0
+json.dump(d, open(sys.argv[2], "w"), indent=2)
+EOF2
+expect 2 "requirement 'garage EVENTUALLY_RIGHT_OF target' holds but the mission does not list it" "$V" --spec "$S/route_landmarks.hspec" "$r1"
+expect 2 "koz restricted over house: no such keep-out zone in the mission" "$V" --spec "$S/route_landmarks.hspec" "$T/r2"
 
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

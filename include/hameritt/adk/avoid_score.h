@@ -38,16 +38,19 @@ class AvoidScorer {
   // do not increase, non-finite values, an aircraft twice), before anything is kept.
   void add(const TrafficSample& sample);
   bool reached() const { return reach_time_.has_value(); }
+  // Whether the last sample added had lost separation.
+  bool separationLost() const { return separation_.lost(); }
 
-  // The score so far; `koz_seconds` from the constraint monitor.
+  // The score so far (constant work: the ADK publishes it live); `koz_seconds` from the
+  // constraint monitor.
   AvoidScore score(double koz_seconds = 0.0) const;
 
  private:
   scenario::AvoidPhaseSpec spec_;
   double time_limit_;
-  SeparationMinimum minimum_;
-  std::vector<TrafficSample> samples_;
-  std::vector<geometry::Vec3> path_;
+  SeparationTracker separation_;
+  double path_length_ = 0.0;
+  std::optional<geometry::Vec3> last_position_;
   std::optional<double> reach_time_;
 };
 

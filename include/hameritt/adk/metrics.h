@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hameritt/adk/avoid_score.h"
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/adk/coverage.h"
 #include "hameritt/adk/detection_scoring.h"
@@ -48,9 +49,10 @@ struct EnergyModel {
   bool airborne(const geometry::Vec3& p, const geometry::Vec3& v) const;
 };
 
-enum class Outcome { kSuccess, kTimeout, kCrashed, kAborted, kEnded };
+enum class Outcome { kSuccess, kTimeout, kCrashed, kAborted, kEnded, kFailed };
 // "success", "timeout", "crashed", "aborted", "ended" (the simulator stopped at its duration
-// before the time limit).
+// before the time limit), "failed" (the objective was reached but a criterion of its phase was
+// broken on the way: an avoid mission that lost separation).
 const char* toString(Outcome o);
 
 // How the objective is judged.
@@ -110,6 +112,7 @@ struct MissionMetrics {
   std::vector<AoiCoverage> coverage;
   std::vector<AoiStatus> aoi_time;
   double prior_weighted_coverage = 0.0;
+  std::optional<AvoidScore> avoid;  // missions with an avoid phase
 };
 
 // Collects the figures of one run.
@@ -162,8 +165,17 @@ std::string metricsJson(const MissionMetrics& m);
 void writeMetricsJson(const MissionMetrics& m, const std::string& path);
 
 // The states of a mission run, and the transitions the ADK node drives.
-enum class MissionState { kWaiting, kRunning, kSucceeded, kTimeout, kCrashed, kAborted, kEnded };
-// "waiting", "running", "succeeded", "timeout", "crashed", "aborted", "ended".
+enum class MissionState {
+  kWaiting,
+  kRunning,
+  kSucceeded,
+  kTimeout,
+  kCrashed,
+  kAborted,
+  kEnded,
+  kFailed
+};
+// "waiting", "running", "succeeded", "timeout", "crashed", "aborted", "ended", "failed".
 const char* toString(MissionState s);
 Outcome outcomeOf(MissionState s);
 
@@ -179,6 +191,8 @@ class MissionLifecycle {
   bool update(double t, bool have_odometry);
   bool succeed(double t, const std::string& reason);
   bool crash(double t, const std::string& reason);
+  // The objective reached with a phase criterion broken (Outcome::kFailed).
+  bool fail(double t, const std::string& reason);
   bool abort(double t, const std::string& reason);
   // The simulator stopped at its duration at sim time t (before the time limit).
   bool simulationEnded(double t, const std::string& reason);

@@ -79,6 +79,27 @@ struct SeparationScore {
   bool contact = false;  // closer than collision_radius at a sample
 };
 
+// The separation score kept up to date sample by sample (constant work per sample): what
+// scoreSeparation() gives for the samples added so far.
+class SeparationTracker {
+ public:
+  explicit SeparationTracker(const SeparationMinimum& minimum = {});
+  // Throws InputError for a stamp that does not increase, a non-finite value, or an aircraft
+  // id twice in the sample, before anything is kept.
+  void add(const TrafficSample& sample);
+  const SeparationScore& score() const { return score_; }
+  // Whether the last sample added had lost separation.
+  bool lost() const { return last_lost_; }
+  std::size_t samples() const { return count_; }
+
+ private:
+  SeparationMinimum minimum_;
+  SeparationScore score_;
+  std::size_t count_ = 0;
+  double last_t_ = 0.0;
+  bool last_lost_ = false;
+};
+
 // Throws InputError for stamps that do not increase, a non-finite value, or an aircraft id
 // twice in one sample.
 SeparationScore scoreSeparation(const std::vector<TrafficSample>& samples,

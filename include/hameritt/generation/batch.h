@@ -3,6 +3,7 @@
 // count, each written atomically, with a manifest.json written last.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct BatchRequest {
   // Generate from this compiled spec (its class replaces `classes`), with this sampler.
   const generation::CompiledSpec* spec = nullptr;
   generation::SamplerKind sampler = generation::SamplerKind::kRandom;
+  // Called on each scenario before it is written, from the worker threads (unset: none); an
+  // exception it throws fails the batch like a generation error.
+  std::function<void(const Scenario&)> check;
 };
 
 struct ManifestEntry {

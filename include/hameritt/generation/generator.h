@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hameritt/generation/target_slots.h"
 #include "hameritt/scenario/generator_config.h"
 
 namespace hameritt::scenario {
@@ -54,7 +55,37 @@ struct ScenarioPlan {
   std::optional<double> confuser_within;
   // True when a look-alike parked with this box fails the requirement that tells it apart.
   std::function<bool(const geometry::OrientedBox&)> confuser_told_apart;
+  // route_search: the lead target's feasible starts; `placements` then holds (index here,
+  // catalog model) pairs, tried in a seeded order until one has a route.
+  const std::vector<RouteStart>* route_starts = nullptr;
+  // An EVENTUALLY_* requirement on a moving target against the world's entities: the mission
+  // lists the first trajectory sample at which a matching entity, not so related at t = 0,
+  // stands in the relation.
+  struct Eventual {
+    RelationOp op = RelationOp::kNextTo;
+    std::function<bool(EntityClass, const Attributes&)> matches;
+  };
+  std::vector<Eventual> eventually;
+  // A spec's keep-out zones (koz statements) with their drawn numbers: over the first target's
+  // position at t = 0 (a square of `size` m along its heading), or over the `count` world
+  // entities of class `over` nearest it (footprints grown by `margin` m). Added after the
+  // class's own zones.
+  struct Koz {
+    std::string purpose;
+    std::string over;  // "target" or an entity class
+    int count = 1;
+    double size = 40.0;
+    double margin = 5.0;
+    std::optional<double> alt_min, alt_max, net, nlt;
+  };
+  std::vector<Koz> kozs;
 };
+
+// The polygon of a spec keep-out zone over a target with this box at t = 0 (`over` "target"),
+// or over each of the `count` world entities of class `over` nearest it (centre distance, ties
+// by index): what the generator writes and hameritt_validate --spec expects.
+std::vector<geometry::Polygon> specKozPolygons(const World& world, const ScenarioPlan::Koz& koz,
+                                               const geometry::OrientedBox& target);
 
 // Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give
 // the same scenario. Throws GenerationError when no placement satisfies the constraints.

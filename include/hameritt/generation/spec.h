@@ -99,6 +99,18 @@ struct ConfuserSpec {
   SourcePos share_pos, told_pos;
 };
 
+// koz PURPOSE over (target | CLASS) {count, size, margin, alt: [lo, hi], net, nlt}: keep-out
+// zones that every scenario gets, over the target's position at t = 0 (a square of `size` m
+// along its heading) or over the `count` world entities of CLASS nearest it (their footprints
+// grown by `margin` m). Its numbers are settings "<key>.<name>" (key "koz1", "koz2", ...),
+// drawn like the others.
+struct KozSpec {
+  std::string purpose;  // vantage_denial | access_denial | restricted
+  std::string over;     // "target" or an entity class of the world
+  std::string key;      // "koz1", ...
+  SourcePos pos;
+};
+
 // A type-checked spec: everything the compiler needs, with its sources' hash.
 struct Spec {
   std::string file;
@@ -108,6 +120,7 @@ struct Spec {
   TargetSpec target;
   std::vector<Requirement> requirements;
   ConfuserSpec confusers;
+  std::vector<KozSpec> kozs;
   // "section.key" -> distribution (mission.time_limit, aois.count, environment.snow, ...), in
   // the order first written.
   std::vector<std::pair<std::string, Distribution>> settings;

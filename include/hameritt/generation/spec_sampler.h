@@ -63,8 +63,11 @@ class CompiledSpec {
   std::vector<std::vector<std::pair<int, int>>> combos_;
   std::vector<NarrowingStep> steps_;
   bool placed_ = false;  // the target is parked (area_search, pursuit)
+  // route_search with requirements: the lead car's starts (the pairs' first members index it).
+  std::vector<scenario::RouteStart> route_starts_;
   // The requirement that places a car or pedestrian beside the target, if any.
   std::shared_ptr<const RelatedPlacer> placer_;
+  int placer_soft_ = -1;  // its index in soft_ when it is soft ('prefer'); -1: hard
   // The world's relations, for the requirement that tells look-alikes apart.
   std::shared_ptr<const scenario::RelationEvaluator> told_eval_;
 };
@@ -88,8 +91,8 @@ struct RequirementCheck {
 // and look, relations recomputed with the relation code, and every drawn value inside its
 // distribution's support. Returns one message per violated hard requirement (empty: all hold);
 // `soft` receives whether each soft requirement held. `require_listed`: a hard requirement must
-// also be listed in the mission's relations (false: the scene alone counts, as a rejection
-// sampler would judge an unconstrained scene).
+// also be listed in the mission's relations and the koz statements' zones be in the mission
+// (false: the scene alone counts, as a rejection sampler would judge an unconstrained scene).
 std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenario::World& world,
                                                   const scenario::GeneratorConfig& base,
                                                   const scenario::Mission& mission,

@@ -76,6 +76,12 @@ class AdkRos {
   void publishState();
   void publishConstraints(double t);
   void checkObjective(double t);
+  // Avoid missions: ends the mission once the goal is reached, succeeded when the avoid phase's
+  // criteria hold (adk/avoid_score.h), failed otherwise.
+  void checkAvoid(double t);
+  void publishAvoid(double t);
+  adk::TrafficSample avoidSample(double t, const Eigen::Vector3d& p,
+                                 const Eigen::Vector3d& v) const;
   // Track objectives are judged at the time limit: at t >= the limit, success when every
   // target was in view for the track fraction of it (before the time limit's timeout).
   void judgeTrackAtLimit(double t);
@@ -108,6 +114,9 @@ class AdkRos {
   std::unique_ptr<adk::DetectionScorer> scorer_;
   std::unique_ptr<adk::MetricsAccumulator> metrics_;
   std::unique_ptr<adk::MissionLifecycle> lifecycle_;
+  // The avoid phase of an avoid mission: scored from the odometry and the scripted aircraft.
+  std::unique_ptr<adk::AvoidScorer> avoid_;
+  std::string avoid_phase_;
   std::unique_ptr<adk::ClockWatchdog> watchdog_;
   adk::GroundTruthHistory truth_{10.0};
 
@@ -127,9 +136,8 @@ class AdkRos {
   ros::WallTime finished_at_;
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
-      perception_pub_, scores_pub_, state_pub_, metrics_pub_;
-  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_,
-      sim_end_sub_;
+      perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_;
+  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };
 
