@@ -18,6 +18,8 @@ enum class MaterialKind : int {
   kLawn = 3,      // ground: green with a low-frequency world-space variation
   kStreet = 4,    // asphalt with a dashed centre line (street-local coordinates)
   kSidewalk = 5,  // light concrete
+  kFacade = 6,    // the instance colour with window bands and storefronts (city buildings)
+  kSignal = 7,    // Kd, with red, yellow and green lamps at the top (traffic-light masts)
 };
 
 // One material's triangles: indices [first_index, first_index + index_count).

@@ -161,6 +161,26 @@ SceneTriangles Renderer::sceneTriangles(const RenderRequest& request) const {
   return impl_->scene.triangles(request.time, &lod);
 }
 
+bool hasBoundingBox(scenario::EntityClass c) {
+  using scenario::EntityClass;
+  switch (c) {
+    case EntityClass::kCar:
+    case EntityClass::kPedestrian:
+    case EntityClass::kBuilding:
+    case EntityClass::kParkingGarage:
+    case EntityClass::kParkingLot:
+    case EntityClass::kAlley:
+    case EntityClass::kLampPost:
+    case EntityClass::kTrafficLight:
+    case EntityClass::kBusStop:
+    case EntityClass::kBench:
+    case EntityClass::kStreetTree:
+      return true;
+    default:
+      return false;
+  }
+}
+
 std::string defaultModelsDir() { return scenario::shareDir() + "/models"; }
 
 }  // namespace hameritt::render

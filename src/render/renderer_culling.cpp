@@ -129,6 +129,13 @@ void Renderer::Impl::cullAndUpload(const RenderRequest& r, Frame& f) {
     mover_sphere[i] = {c, radius};
   }
   if (r.draw_uav) records[uav_record] = scene.uavRecord(r.world_T_uav);
+  // Traffic-light masts: their lamps at the frame time.
+  for (const auto& [rec, k] : signal_masts) {
+    const auto& plan = *config.signals;
+    const auto& is = plan.intersections[static_cast<std::size_t>(k)];
+    records[rec].color =
+        signalLamps(plan.state(is, 0, r.time), plan.state(is, 1, r.time), is.heading[0]);
+  }
   // Cells: inside, cut or outside; visited near to far.
   cell_order.clear();
   const int cells = grid_nx * grid_ny;

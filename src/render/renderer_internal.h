@@ -244,9 +244,13 @@ struct Renderer::Impl {
   RenderStats stats;
   std::unordered_multimap<std::string, int> by_id;
 
-  GeometryProgram geometry[2];  // objects, ground layers
+  GeometryProgram geometry[3];  // objects, ground layers, building facades
   GLuint bound_program = 0;
   GLuint sky_program = 0, particle_program = 0;
+  GLuint coverage_program = 0;  // boxes: the objects' positions, no shading
+  struct {
+    GLint view_proj, camera;
+  } coverage_loc{};
   struct {
     GLint world_R_optical, intrinsics, zenith, horizon, sun_dir, glow, far_clip, haze_color, haze_k;
   } sky_loc{};
@@ -271,6 +275,8 @@ struct Renderer::Impl {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> cell_range;  // [cell * models + model]
   std::vector<std::uint32_t> cell_items;
   std::vector<std::uint32_t> movers, always;
+  // Traffic-light masts (record) and the signalised intersection they stand at.
+  std::vector<std::pair<std::uint32_t, int>> signal_masts;
   std::vector<std::pair<Eigen::Vector3f, float>> mover_sphere;  // per record
   std::array<Plane, 6> planes{};
   Eigen::Vector3d camera{0, 0, 0};
@@ -291,6 +297,8 @@ struct Renderer::Impl {
   CameraEffectsWorker effects_worker;
   std::vector<std::array<int, 4>> box_rect;
   std::vector<int> box_group, box_total;
+  std::vector<std::uint8_t> box_query;  // per touched instance: counted by an occlusion query
+  std::vector<GLuint> query_pool;       // GL_SAMPLES_PASSED queries, grown on demand
   std::vector<GpuInstance> box_upload;
   std::vector<GLuint> group_base;
   std::vector<GLsizei> group_count;

@@ -38,6 +38,7 @@ void Renderer::Impl::setFrameUniforms(const Frame& f) {
 
 const GeometryProgram& Renderer::Impl::programFor(int m) const {
   const auto& p = scene.procedural();
+  if (m == p.building || m == p.signal) return geometry[2];
   const bool ground = m == p.ground || m == p.sidewalks || m == p.street;
   return geometry[ground ? 1 : 0];
 }

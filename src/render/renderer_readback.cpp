@@ -112,15 +112,22 @@ void Renderer::Impl::boxes(Frame& f) {
   out->boxes.clear();
   if (f.touched.empty()) return;
   const Targets& t = *f.targets;
-  // Greedy grouping by rectangle overlap.
+  // Greedy grouping by rectangle overlap (convex instances are counted by queries instead).
   const std::size_t n = f.touched.size();
   box_rect.resize(n);
   box_group.assign(n, -1);
   box_total.assign(n, 0);
+  box_query.assign(n, 0);
   int groups = 0;
+  std::size_t queries = 0;
   for (std::size_t a = 0; a < n; ++a) {
     const auto rec =
         static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+    if (scene.instances()[rec].convex) {
+      box_query[a] = 1;
+      ++queries;
+      continue;
+    }
     box_rect[a] = projectedRect(f, f.model[rec], f.slot[rec]);
     for (int g = 0; g <= groups && box_group[a] < 0; ++g) {
       bool free = true;
@@ -143,6 +150,48 @@ void Renderer::Impl::boxes(Frame& f) {
   glBindVertexArray(vao);
   glVertexArrayVertexBuffer(vao, 1, f.instance_buffer, 0, sizeof(GpuInstance));
   glDisable(GL_SCISSOR_TEST);
+  if (queries > 0) {
+    // A convex instance drawn alone, back faces culled, no depth test: every fragment is one
+    // pixel it covers unoccluded; the query counts them without a read-back. Same program,
+    // instance data and rasterization as the geometry pass. Nothing is written.
+    if (query_pool.size() < queries) {
+      const std::size_t have = query_pool.size();
+      query_pool.resize(queries);
+      glCreateQueries(GL_SAMPLES_PASSED, static_cast<GLsizei>(queries - have),
+                      query_pool.data() + have);
+    }
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glUseProgram(coverage_program);
+    bound_program = coverage_program;
+    glProgramUniformMatrix4fv(coverage_program, coverage_loc.view_proj, 1, GL_FALSE, f.view_proj);
+    const Eigen::Vector3f cam = f.camera.cast<float>();
+    glProgramUniform3fv(coverage_program, coverage_loc.camera, 1, cam.data());
+    std::size_t q = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      if (!box_query[a]) continue;
+      const auto rec =
+          static_cast<std::size_t>(instance_record[static_cast<std::size_t>(f.touched[a].first)]);
+      const auto m = static_cast<std::size_t>(f.model[rec]);
+      glBeginQuery(GL_SAMPLES_PASSED, query_pool[q++]);
+      glDrawElementsInstancedBaseVertexBaseInstance(
+          GL_TRIANGLES, static_cast<GLsizei>(scene.drawnIndexCount(f.model[rec])), GL_UNSIGNED_INT,
+          reinterpret_cast<const void*>(model_first_element[m] * sizeof(std::uint32_t)), 1,
+          model_base_vertex[m], static_cast<GLuint>(f.slot[rec]));
+      glEndQuery(GL_SAMPLES_PASSED);
+      ++f.stats.draw_calls;
+    }
+    q = 0;
+    for (std::size_t a = 0; a < n; ++a) {
+      if (!box_query[a]) continue;
+      GLuint samples = 0;
+      glGetQueryObjectuiv(query_pool[q++], GL_QUERY_RESULT, &samples);
+      box_total[a] = static_cast<int>(samples);
+    }
+    glColorMaski(1, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  }
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_GREATER);
@@ -218,9 +267,7 @@ void Renderer::Impl::boxes(Frame& f) {
     BoundingBox b;
     b.instance = id;
     b.entity_id = scene.entityIds()[static_cast<std::size_t>(id)];
-    b.cls = si.semantic == scenario::semanticId(scenario::EntityClass::kPedestrian)
-                ? scenario::EntityClass::kPedestrian
-                : scenario::EntityClass::kCar;
+    b.cls = si.cls;
     b.role = si.scenario_entity >= 0
                  ? config.entities[static_cast<std::size_t>(si.scenario_entity)].role
                  : "world";

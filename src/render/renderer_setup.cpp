@@ -83,6 +83,10 @@ Renderer::Impl::~Impl() {
     glDeleteBuffers(1, &f->instance_buffer);
   }
   for (const auto& g : geometry) glDeleteProgram(g.id);
+  glDeleteProgram(coverage_program);
+  if (!query_pool.empty()) {
+    glDeleteQueries(static_cast<GLsizei>(query_pool.size()), query_pool.data());
+  }
   glDeleteProgram(sky_program);
   glDeleteProgram(particle_program);
   GLuint buffers[] = {vertex_buffer, element_buffer};
@@ -102,12 +106,16 @@ void Renderer::Impl::initGl() {
                       ")");
   }
   const std::string version = "#version 450 core\n";
-  // Two variants of the geometry program: objects, and the ground layers with their patterns.
-  for (int g = 0; g < 2; ++g) {
-    const std::string define = g == 1 ? "#define GROUND_LAYERS 1\n" : "";
-    geometry[g].id = linkProgram(version + define + shaders::kGeometryVertex,
-                                 version + define + shaders::kCommon + shaders::kGeometryFragment,
-                                 g == 1 ? "geometry (ground layers)" : "geometry (objects)");
+  // Three variants of the geometry program: objects, the ground layers with their patterns,
+  // and the buildings with their facades.
+  static const char* const kDefines[] = {"", "#define GROUND_LAYERS 1\n", "#define FACADE 1\n"};
+  static const char* const kNames[] = {"geometry (objects)", "geometry (ground layers)",
+                                       "geometry (facades)"};
+  for (int g = 0; g < 3; ++g) {
+    const std::string define = kDefines[g];
+    geometry[g].id =
+        linkProgram(version + define + shaders::kGeometryVertex,
+                    version + define + shaders::kCommon + shaders::kGeometryFragment, kNames[g]);
     auto loc = [this, g](const char* n) { return glGetUniformLocation(geometry[g].id, n); };
     geometry[g].u = {loc("u_view_proj"),
                      loc("u_camera"),
@@ -125,6 +133,12 @@ void Renderer::Impl::initGl() {
                      loc("u_extinction_color"),
                      loc("u_extinction_k")};
   }
+  // Coverage counting (boxes): the objects' vertex stage (same positions, gl_Position is
+  // invariant) and a fragment stage that does nothing.
+  coverage_program =
+      linkProgram(version + shaders::kGeometryVertex, version + "void main() {}\n", "coverage");
+  coverage_loc.view_proj = glGetUniformLocation(coverage_program, "u_view_proj");
+  coverage_loc.camera = glGetUniformLocation(coverage_program, "u_camera");
   sky_program = linkProgram(shaders::kFullscreenVertex,
                             version + shaders::kCommon + shaders::kSkyFragment, "sky");
   particle_program = linkProgram(version + shaders::kHash + shaders::kParticleVertex,
@@ -239,6 +253,20 @@ void Renderer::Impl::buildCulling() {
   cell_hi.assign(static_cast<std::size_t>(cells), Eigen::Vector3f::Constant(-1e30f));
   for (std::size_t i = 0; i < inst.size(); ++i) {
     const auto& si = inst[i];
+    if (si.model == p.signal && config.signals && !si.mover) {
+      // The nearest signalised intersection within 30 m (a mast stands at one of its corners).
+      int best = -1;
+      double best_d = 30.0;
+      const auto& list = config.signals->intersections;
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const double d = (list[k].position - si.box.center2()).norm();
+        if (d < best_d) {
+          best_d = d;
+          best = static_cast<int>(k);
+        }
+      }
+      if (best >= 0) signal_masts.emplace_back(static_cast<std::uint32_t>(i), best);
+    }
     if (si.mover) {
       movers.push_back(static_cast<std::uint32_t>(i));
       continue;

@@ -153,6 +153,24 @@ bool paintColor(const std::string& name, std::uint32_t* srgb8) {
   return false;
 }
 
+std::uint32_t signalLamps(scenario::SignalState axis0, scenario::SignalState axis1,
+                          double heading0) {
+  auto lamp = [](scenario::SignalState s) -> std::uint32_t {
+    switch (s) {
+      case scenario::SignalState::kGreen:
+        return 2;
+      case scenario::SignalState::kYellow:
+        return 1;
+      default:
+        return 0;  // red, and the other axis' protected left arrow
+    }
+  };
+  const double turns = heading0 / (2.0 * M_PI);
+  const auto h = static_cast<std::uint32_t>(
+      static_cast<long>(std::lround((turns - std::floor(turns)) * 256.0)) & 255);
+  return lamp(axis0) | (lamp(axis1) << 2) | (h << 8);
+}
+
 void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]) {
   const double c = std::cos(box.yaw), s = std::sin(box.yaw);
   const double l = box.size.x(), w = box.size.y(), h = box.size.z();
@@ -306,7 +324,8 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     si.semantic = scenario::semanticId(e.cls);
     si.scenario_entity = scenario_entity;
     si.mover = mover;
-    si.interest = e.cls == EntityClass::kCar || e.cls == EntityClass::kPedestrian;
+    si.cls = e.cls;
+    si.interest = hasBoundingBox(e.cls);
     si.box = e.box;
     double lift = 0.0;
     std::string color_key;
@@ -314,35 +333,51 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       case EntityClass::kStreet:
       case EntityClass::kAlley:
         si.model = procedural_.street;
+        si.convex = true;
         lift = streetTopZ(street_index++) - e.box.minZ();  // the slab's top face only
         break;
       case EntityClass::kBuilding:
-        si.model = cityBox("building", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        si.model = cityBox("building", MaterialKind::kFacade, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        procedural_.building = si.model;
         color_key = "color";
+        {
+          const std::int64_t storeys = e.attributes.integer("storeys", 0);
+          si.record.canopy =
+              static_cast<float>(storeys > 0 ? e.box.size.z() / static_cast<double>(storeys) : 3.5);
+        }
+        si.convex = true;
         break;
       case EntityClass::kParkingGarage:
         si.model =
             cityBox("parking_garage", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
         color_key = "color";
+        si.convex = true;
         break;
       case EntityClass::kParkingLot:
         si.model = procedural_.driveway;
         if (!paintColor("asphalt", &si.record.color)) {
           throw RenderError(attributeError(e, "material", "asphalt"));
         }
+        si.convex = true;
         break;
       case EntityClass::kLampPost:
         si.model = cityBox("lamp_post", MaterialKind::kPlain, srgbToLinear(70, 72, 76));
+        si.convex = true;
         break;
       case EntityClass::kTrafficLight:
-        si.model = cityBox("traffic_light", MaterialKind::kPlain, srgbToLinear(30, 32, 30));
+        si.model = cityBox("traffic_light", MaterialKind::kSignal, srgbToLinear(30, 32, 30));
+        procedural_.signal = si.model;
+        si.record.color = kSignalDark;
+        si.convex = true;
         break;
       case EntityClass::kBusStop:
         si.model = cityBox("bus_stop", MaterialKind::kPlain, srgbToLinear(120, 150, 170));
+        si.convex = true;
         break;
       case EntityClass::kBench:
         si.model = cityBox("bench", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
         color_key = "color";
+        si.convex = true;
         break;
       case EntityClass::kDriveway: {
         si.model = procedural_.driveway;

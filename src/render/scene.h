@@ -21,7 +21,7 @@ struct InstanceRecord {
   float row[3][4];          // rows of the 3x4 model matrix (mesh -> world)
   std::uint32_t color = 0;  // kPaint: display colour (RGB8, gamma 2); kFoliage: linear tint / 2
   std::uint32_t label = 0;  // semantic << 16 | instance
-  float canopy = 1.0f;      // canopy scale about the mesh's canopy centre
+  float canopy = 1.0f;      // canopy scale about the mesh's canopy centre; buildings: storey (m)
 };
 
 
@@ -32,7 +32,12 @@ struct SceneInstance {
   int semantic = 0;
   int scenario_entity = -1;   // index into SimConfig::entities when it comes from the scenario
   bool mover = false;         // posed from its trajectory at the frame time
-  bool interest = false;      // car or pedestrian: gets a bounding box
+  bool interest = false;      // car, pedestrian or a city class: gets a bounding box
+  // A closed convex mesh (the city classes' procedural boxes, an alley's quad): drawn alone
+  // without a depth test it covers each of its pixels once, so an occlusion query counts its
+  // unoccluded pixels.
+  bool convex = false;
+  scenario::EntityClass cls = scenario::EntityClass::kCar;
   geometry::OrientedBox box;  // pose and size (scale of a normalized mesh)
   InstanceRecord record;      // at t = 0 for movers
   Eigen::Vector3f center{0, 0, 0};  // bounding sphere
@@ -66,6 +71,8 @@ struct LodView {
 // Model indices of the procedural parts.
 struct SceneModels {
   int ground = -1, sidewalks = -1, street = -1, driveway = -1, uav = -1;
+  int building = -1;  // city buildings (facade program); -1 in a scene without buildings
+  int signal = -1;    // traffic-light masts (facade program, lamps); -1 without any
 };
 
 class Scene {
@@ -133,6 +140,13 @@ class Scene {
 // red, blue, white, black, silver, grey, green, yellow, beige, brick, brown, orange, and the
 // driveway materials concrete and asphalt; false for an unknown name.
 bool paintColor(const std::string& name, std::uint32_t* srgb8);
+
+// InstanceRecord::color of a traffic-light mast: bits 0-1 the lamp lit towards axis 0's
+// traffic, 2-3 towards axis 1's (0 red, 1 yellow, 2 green, 3 none), 8-15 axis 0's heading in
+// 256ths of a turn.
+constexpr std::uint32_t kSignalDark = 3u | (3u << 2);
+std::uint32_t signalLamps(scenario::SignalState axis0, scenario::SignalState axis1,
+                          double heading0);
 
 // Model matrix rows of a normalized mesh placed at an entity box (bottom centre, yaw, size).
 void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]);

@@ -36,7 +36,18 @@ uniform float u_wet;   // rain darkens surfaces
 // colour of the form base * pattern + snow (or alt where the pattern switches colour: dry grass
 // on the lawn, the centre line on a street), the pattern computed per pixel at the world point
 // that the fragment shader rebuilds from the pixel and the depth.
-#ifdef GROUND_LAYERS
+#if defined(FACADE)
+// Building facades: wall, window glass and storefront glass, lit; the pattern is laid out per
+// pixel from the world point (storeys from the instance's storey height, window columns along
+// the face from its per-building spacing).
+flat out vec3 v_color;   // lit wall
+flat out vec3 v_glass;   // lit upper-floor glass (the roof: its membrane)
+flat out vec3 v_shop;    // lit storefront glass (the roof: its rooftop units)
+flat out uint v_label;
+flat out vec4 v_frame;   // instance origin x, y, base z, storey height (-1: roof, 0: other)
+flat out vec4 v_layout;  // wall: face tangent x, y, window spacing, window width fraction;
+                         // roof: length axis x, y, length, width
+#elif defined(GROUND_LAYERS)
 flat out vec3 v_base;   // (1 - snow cover) * light * albedo
 flat out vec3 v_alt;    // (1 - snow cover) * light * the pattern's second colour
 flat out vec3 v_snow;   // snow cover * light * snow
@@ -67,7 +78,7 @@ void main() {
                  float((a_material >> 8) & 255u)) / 255.0;
   vec3 albedo = kd * kd;  // colours are stored gamma-2 encoded
   vec3 alt = kind == 4u ? vec3(0.62, 0.45, 0.06) : vec3(0.26, 0.25, 0.13);  // dash, dry grass
-  if (kind == 1u) {
+  if (kind == 1u || kind == 6u) {
     albedo = unpack8(i_ids.x);
     albedo *= albedo;
   } else if (kind == 2u) {
@@ -80,7 +91,32 @@ void main() {
   vec3 light = u_sun_color * max(dot(n, u_sun_dir), 0.0) +
                mix(u_ground_ambient, u_sky_ambient, 0.5 + 0.5 * n.z);
   vec3 snow = cover * light * vec3(0.82, 0.84, 0.88);
-#ifdef GROUND_LAYERS
+#if defined(FACADE)
+  v_color = (1.0 - cover) * keep * light * albedo + snow;
+  v_label = i_ids.y;
+  // Glass: a dark body that mirrors part of the sky; shop windows show a lit interior.
+  v_glass = keep * (light * vec3(0.030, 0.038, 0.050) + 0.28 * u_sky_ambient);
+  v_shop = keep * (light * vec3(0.10, 0.085, 0.06) + 0.18 * u_sky_ambient + vec3(0.05, 0.04, 0.025));
+  // Per-building layout from the instance label (the world's seed decides the ids).
+  uint h = (i_ids.y & 65535u) * 2654435761u;
+  float r0 = float((h >> 8) & 255u) / 255.0, r1 = float((h >> 16) & 255u) / 255.0;
+  bool wall = abs(n.z) < 0.3, roof = n.z > 0.7;
+  v_frame = vec4(i_row0.w, i_row1.w, i_row2.w, wall ? i_normal0.w : (roof ? -1.0 : 0.0));
+  v_layout = vec4(-n.y, n.x, 1.4 + 1.4 * r0, 0.5 + 0.3 * r1);
+  if (kind == 7u) {
+    // A traffic-light mast: the lamps of the axis its face looks along (i_ids.x: signalLamps).
+    float h0 = float((i_ids.x >> 8) & 255u) * (6.2831853 / 256.0);
+    bool along0 = abs(dot(n.xy, vec2(cos(h0), sin(h0)))) > 0.7;
+    uint lit = along0 ? (i_ids.x & 3u) : ((i_ids.x >> 2) & 3u);
+    v_frame = vec4(i_row0.w, i_row1.w, i_row2.w, wall ? -2.0 : 0.0);
+    v_layout = vec4(float(lit), i_row2.z, 0.0, 0.0);
+  } else if (roof) {
+    // The roof: membrane, a parapet cap in the wall colour, a rooftop unit and a water tank.
+    v_layout = vec4(vec2(i_row0.x, i_row1.x) / max(i_normal1.w, 1e-6), i_normal1.w, i_normal2.w);
+    v_glass = (1.0 - cover) * keep * light * vec3(0.16, 0.16, 0.17) + snow;
+    v_shop = (1.0 - cover) * keep * light * vec3(0.45, 0.46, 0.48) + snow;
+  }
+#elif defined(GROUND_LAYERS)
   v_base = (1.0 - cover) * keep * light * albedo;
   v_alt = (1.0 - cover) * keep * light * alt;
   v_snow = snow;
@@ -111,7 +147,14 @@ vec3 haze(vec3 c, float distance) {
 )GLSL";
 
 inline constexpr const char* kGeometryFragment = R"GLSL(
-#ifdef GROUND_LAYERS
+#if defined(FACADE)
+flat in vec3 v_color;
+flat in vec3 v_glass;
+flat in vec3 v_shop;
+flat in uint v_label;
+flat in vec4 v_frame;
+flat in vec4 v_layout;
+#elif defined(GROUND_LAYERS)
 flat in vec3 v_base;
 flat in vec3 v_alt;
 flat in vec3 v_snow;
@@ -182,6 +225,49 @@ void main() {
   }
   c += v_snow;
   uint label = v_ids.x;
+#elif defined(FACADE)
+  vec3 c = v_color;
+  uint label = v_label;
+  vec3 w = depth * (u_world_R_optical * ray) + u_camera;
+  if (v_frame.w > 0.0) {
+    // Window bands on every storey above the ground floor; storefronts (tall glass between
+    // piers every 3 m, a sign band above) on the ground floor.
+    float z = (w.z - v_frame.z) / v_frame.w;
+    float fz = fract(z);
+    float u = dot(w.xy - v_frame.xy, v_layout.xy);
+    if (z < 1.0) {
+      if (fz > 0.06 && fz < 0.72 && fract(u / 3.0 + 0.5) > 0.08) c = v_shop;
+      else if (fz > 0.78) c = 0.55 * v_color;
+    } else if (fz > 0.3 && fz < 0.82 && abs(fract(u / v_layout.z) - 0.5) < 0.5 * v_layout.w) {
+      c = v_glass;
+    }
+  } else if (v_frame.w < -1.5) {
+    // Signal lamps in the top 1.2 m of a mast's face: red, yellow, green from the top.
+    float below = v_frame.z + v_layout.y - w.z;
+    if (below < 1.2) {
+      float band = min(floor(below / 0.4), 2.0);
+      vec3 lamp = band < 0.5 ? vec3(1.6, 0.1, 0.05)
+                             : (band < 1.5 ? vec3(1.6, 0.9, 0.05) : vec3(0.1, 1.5, 0.4));
+      c = abs(band - v_layout.x) < 0.5 ? lamp : 0.04 * lamp;
+    }
+  } else if (v_frame.w < 0.0) {
+    vec2 d = w.xy - v_frame.xy;
+    vec2 q = vec2(dot(d, v_layout.xy), dot(d, vec2(-v_layout.y, v_layout.x)));
+    vec2 room = 0.5 * v_layout.zw;
+    vec2 e = room - abs(q);
+    c = v_glass;
+    if (min(e.x, e.y) < 0.35) {
+      c = v_color;
+    } else {
+      // One rooftop unit and, on some roofs, a water tank, at spots drawn from the label.
+      uint h = (v_label & 65535u) * 2246822519u;
+      vec2 span = max(room - vec2(2.5), vec2(0.0));
+      vec4 r = vec4(uvec4(h, h >> 8, h >> 16, h >> 24) & 255u) / 127.5 - 1.0;
+      vec2 o = abs(q - r.xy * span);
+      if (o.x < 1.3 && o.y < 0.9) c = (o.x > 1.1 || o.y > 0.7) ? 0.6 * v_shop : v_shop;
+      if ((h & 3u) != 0u && length(q - r.zw * span) < 1.4) c = v_shop * vec3(0.75, 0.55, 0.38);
+    }
+  }
 #else
   vec3 c = v_color;
   uint label = v_label;

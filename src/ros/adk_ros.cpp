@@ -490,6 +490,9 @@ void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::Const
       pe.entity_class = "car";
       pe.role = "world";
       pe.attributes = toKeyValues(we.attributes);
+    } else if (box.role == "world" && box.entity_class != "car" &&
+               box.entity_class != "pedestrian") {
+      continue;  // the city's buildings and street furniture: scenery, not a perceived entity
     } else {
       HAMERITT_ERROR_THROTTLE(5.0,
                               "adk: camera %s: boxes[].entity_id '%s' is neither a scenario "

@@ -82,11 +82,18 @@ struct RenderRequest {
   std::vector<std::string> hidden_entities;
 };
 
-// A 2D box of one entity of interest (every car and pedestrian: parked world cars and the
-// scenario's entities) with at least one visible pixel, computed from the instance mask.
+// Whether the instances of a class get a BoundingBox: cars and pedestrians, and the city's
+// classes (building, parking_garage, parking_lot, alley, lamp_post, traffic_light, bus_stop,
+// bench, street_tree). The suburb's scenery (street, driveway, house, garage, fence, tree) gets
+// none.
+bool hasBoundingBox(scenario::EntityClass c);
+
+// A 2D box of one entity of interest (hasBoundingBox(): parked world cars, the scenario's
+// entities, the city's buildings and street furniture) with at least one visible pixel,
+// computed from the instance mask.
 struct BoundingBox {
   int instance = 0;                   // value in FrameSet::instance
-  std::string entity_id;              // "car_706"
+  std::string entity_id;              // "car_706", "building_12"
   scenario::EntityClass cls = scenario::EntityClass::kCar;
   std::string role;                   // scenario role (target, confuser, ...) or "world"
   int x_min = 0, y_min = 0, x_max = 0, y_max = 0;  // inclusive pixel bounds of the visible pixels
