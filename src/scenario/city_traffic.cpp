@@ -608,12 +608,18 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
     p.yaw = roundMilli(p.yaw);
     return p;
   };
+  const auto by_t = [](const TrajectoryPoint& p, double t) { return p.t < t; };
+  const auto first = std::lower_bound(tr.begin(), tr.end(), t0 + 1e-6, by_t);
+  const auto end = std::lower_bound(first, tr.end(), t0 + length - 1e-6, by_t);
+  out.reserve(static_cast<std::size_t>(end - first) + 2);
   out.push_back(shifted(sampleTrajectory(tr, t0)));
   out.front().t = 0.0;
-  const auto by_t = [](const TrajectoryPoint& p, double t) { return p.t < t; };
-  for (auto it = std::lower_bound(tr.begin(), tr.end(), t0 + 1e-6, by_t);
-       it != tr.end() && it->t < t0 + length - 1e-6; ++it) {
-    if (it->t > t0 + 1e-6) out.push_back(shifted(*it));
+  for (auto it = first; it != end; ++it) {
+    if (it->t <= t0 + 1e-6) continue;
+    // Decoded points are rounded already: only the time moves.
+    TrajectoryPoint p = *it;
+    p.t = roundMilli(p.t - t0);
+    out.push_back(p);
   }
   TrajectoryPoint last = shifted(sampleTrajectory(tr, t0 + length));
   last.t = roundMilli(length);

@@ -58,8 +58,8 @@ struct TrafficEpisode {
   struct Car {
     std::string vehicle_class, make, model, color;
     geometry::Vec3 size{4.5, 1.8, 1.5};  // length, width, height (m)
-    int lane = 0;                         // index into `lanes`
-    std::vector<double> knots;            // t0, s0, t1, s1, ... (t strictly increasing from 0)
+    int lane = 0;                        // index into `lanes`
+    std::vector<double> knots;           // t0, s0, t1, s1, ... (t strictly increasing from 0)
   };
   int index = 0;
   double length = 0.0;  // seconds
@@ -99,7 +99,7 @@ SignalPlan shiftedSignalPlan(const SignalPlan& plan, double offset);
 // Episode `index` of `world`, simulated once per process (thread-safe, deterministic: a function
 // of the world and the index), with its file's bytes and their SHA-256.
 struct SharedTrafficEpisode {
-  TrafficEpisode episode;  // as read back from `text`
+  TrafficEpisode episode;                   // as read back from `text`
   std::shared_ptr<const std::string> text;  // null for a scenario's own cars (not shared)
   std::string sha256;
   std::vector<Trajectory> trajectories;  // each car's, over the whole episode

@@ -333,8 +333,8 @@ struct TrafficEpisodeRef {
   std::string file;  // relative to the directory of sim_config.json
   int episode = 0;
   double offset = 0.0;
-  std::string sha256;                // of the file's bytes, lowercase hex
-  std::vector<std::string> car_ids;  // the entity id of each of the episode's cars, in order
+  std::string sha256;                       // of the file's bytes, lowercase hex
+  std::vector<std::string> car_ids;         // the entity id of each of the episode's cars, in order
   std::shared_ptr<const std::string> text;  // the file's bytes (set by the generator)
 };
 
