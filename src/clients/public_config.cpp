@@ -15,6 +15,7 @@ nlohmann::ordered_json publicSimConfigJson(const nlohmann::ordered_json& sim_con
   if (j.is_object()) {
     if (j.contains("entities")) j["entities"] = nlohmann::ordered_json::array();
     if (j.contains("groups")) j["groups"] = nlohmann::ordered_json::array();
+    j.erase("traffic");  // the ambient cars of a shared traffic episode are entities too
     if (j.contains("uav") && j["uav"].is_object()) j["uav"].erase("perception_path");
   }
   return j;

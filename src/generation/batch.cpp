@@ -10,8 +10,10 @@
 #include <exception>
 #include <filesystem>
 #include <mutex>
+#include <set>
 #include <thread>
 
+#include "hameritt/scenario/city_traffic.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/json_writer.h"
 #include "hameritt/scenario/scenario_io.h"
@@ -108,6 +110,17 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
   std::exception_ptr error;
   int error_index = -1;
   std::mutex mu;
+  // Traffic episode files: each written once, by the first scenario that uses it.
+  std::mutex episode_mu;
+  std::set<int> episodes_done;
+  std::vector<std::string> episodes_created;  // removed again on failure
+  auto writeEpisode = [&](const TrafficEpisodeRef& ref) {
+    std::lock_guard<std::mutex> lock(episode_mu);
+    if (!episodes_done.insert(ref.episode).second) return;
+    const std::string path = req.out_dir + "/" + trafficEpisodeFileName(ref.episode);
+    if (!fs::exists(path)) episodes_created.push_back(path);
+    writeFileAtomic(path, *ref.text);
+  };
   auto work = [&]() {
     for (;;) {
       const int i = next.fetch_add(1);
@@ -129,7 +142,9 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
         }
         e.id = s.mission.scenario_id;
         if (req.check) req.check(s);
-        writeScenarioDir(req.out_dir, s);
+        const bool by_reference = req.share_traffic && s.sim.traffic && s.sim.traffic->text;
+        if (by_reference) writeEpisode(*s.sim.traffic);
+        writeScenarioDir(req.out_dir, s, by_reference);
         written[static_cast<std::size_t>(i)] = 1;
       } catch (...) {
         std::lock_guard<std::mutex> lock(mu);
@@ -168,6 +183,7 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
     for (std::size_t i = 0; i < entries.size(); ++i) {
       if (written[i]) fs::remove_all(req.out_dir + "/" + entries[i].id, ec);
     }
+    for (const auto& path : episodes_created) fs::remove(path, ec);
     std::rethrow_exception(error);
   }
   return entries;

@@ -1780,16 +1780,12 @@ class ScenarioBuilder {
   }
 
   // The city's signalised ambient traffic and crowd (scenario/city_traffic.h), drawn from a
-  // stream of its own and simulated over the mission's time limit.
+  // stream of its own over the mission's time limit. The cars come last: when they are a window
+  // of a shared traffic episode, a batch writes them as a reference (SimConfig::traffic) and a
+  // reader appends them again.
   void addCityTraffic() {
     CityTraffic traffic = simulateCityTraffic(world_, deriveSeed(seed_, 0x4349545954524146ULL),
                                               sc_.mission.time_limit);
-    for (auto& car : traffic.cars) {
-      const TrajectoryPoint& p0 = car.trajectory.front();
-      Entity e = makeCar(*car.model, car.color, Vec3(p0.x, p0.y, p0.z), p0.yaw);
-      e.attributes.set("lane", car.lane);
-      add(std::move(e), "traffic", std::move(car.trajectory));
-    }
     for (auto& ped : traffic.pedestrians) {
       Entity p;
       p.id = nextPedId();
@@ -1800,6 +1796,23 @@ class ScenarioBuilder {
           boxFromPose(Vec3(ped.pose.x, ped.pose.y, 0.0), ped.pose.yaw, Vec3(0.5, 0.6, ped.height));
       p.block = world_.blockAt(p.box.center2());
       add(std::move(p), "pedestrian", std::move(ped.trajectory));
+    }
+    const TrafficEpisode& ep = traffic.episode->episode;
+    TrafficEpisodeRef ref;
+    for (std::size_t i = 0; i < traffic.cars.size(); ++i) {
+      ScenarioEntity se =
+          episodeCarEntity(ep, i, std::move(traffic.cars[i].trajectory), nextCarId());
+      se.entity.block = world_.blockAt(se.entity.box.center2());
+      ref.car_ids.push_back(se.entity.id);
+      sc_.sim.entities.push_back(std::move(se));
+    }
+    if (traffic.episode->text) {
+      ref.file = "../" + trafficEpisodeFileName(ep.index);
+      ref.episode = ep.index;
+      ref.offset = traffic.offset;
+      ref.sha256 = traffic.episode->sha256;
+      ref.text = traffic.episode->text;
+      sc_.sim.traffic = std::move(ref);
     }
     sc_.sim.signals = std::move(traffic.plan);
   }

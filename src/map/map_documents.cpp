@@ -1,5 +1,6 @@
 // Reads mission.json and sim_config.json into the map's data, naming the file and field of a bad
 // value.
+#include "hameritt/scenario/sim_config_io.h"
 #include "map_internal.h"
 
 namespace hameritt::map::map_internal {
@@ -193,6 +194,28 @@ MapData parseDocuments(const json& mission, const json& sim, const std::string& 
   const DocReader mr(mission_file), sr(sim_file);
   parseMission(mission, mr, &d);
   parseSimConfig(sim, sr, &d);
+  if (sim.is_object() && sim.contains("traffic")) {
+    // A batch's city scenario: its traffic cars are a window of a shared traffic episode file,
+    // resolved (and checked) by the simulator's reader.
+    const scenario::SimConfig full = scenario::loadSimConfig(sim_file);
+    const std::size_t n = full.traffic ? full.traffic->car_ids.size() : 0;
+    for (std::size_t i = full.entities.size() - n; i < full.entities.size(); ++i) {
+      const scenario::ScenarioEntity& se = full.entities[i];
+      MoverData mv;
+      mv.id = se.entity.id;
+      mv.cls = "car";
+      mv.role = se.role;
+      mv.position = Vec2(se.entity.box.center.x(), se.entity.box.center.y());
+      mv.yaw = se.entity.box.yaw;
+      mv.length = se.entity.box.size.x();
+      mv.width = se.entity.box.size.y();
+      for (const auto& q : se.trajectory) {
+        mv.times.push_back(q.t);
+        mv.path.emplace_back(q.x, q.y);
+      }
+      d.entities.push_back(std::move(mv));
+    }
+  }
   const std::string sim_id = sr.stringAt(sim, "", "scenario_id");
   if (sim_id != d.scenario_id) {
     sr.fail("scenario_id",

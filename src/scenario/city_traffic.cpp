@@ -22,6 +22,7 @@
 namespace hameritt::scenario {
 
 using geometry::Vec2;
+using geometry::Vec3;
 
 const char* toString(SignalState s) {
   switch (s) {
@@ -346,9 +347,12 @@ int cityPedestrianBound(const World& world) {
 namespace {
 
 // Every ring's cars simulated over [0, horizon] with the plan of `seed`.
-CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, const IdmParams& idm) {
+TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
+                       const IdmParams& idm) {
   const CityParams& cp = world.params().city;
-  CityTraffic out;
+  TrafficEpisode out;
+  out.length = horizon;
+  out.world_fingerprint = world.fingerprint();
   out.plan = citySignalPlan(world, seed);
   const SignalPlan& plan = out.plan;
   const double duration = horizon;
@@ -393,6 +397,8 @@ CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, cons
       appendLoop(back.back(), (back.back() - back[back.size() - 2]).normalized(), r, lane,
                  &ring.pts);
       ring.pts.push_back(ring.pts.front());
+      // Rounded as written, so that the cars are simulated on the polyline a reader decodes.
+      for (auto& p : ring.pts) p = Vec2(roundMilli(p.x()), roundMilli(p.y()));
       ring.finish();
       ring.inside_length = 2.0 * inside;
       const int other = 1 - c.axis;
@@ -410,7 +416,10 @@ CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, cons
     }
   }
   double inside_total = 0.0;
-  for (const auto& r : rings) inside_total += r.inside_length;
+  for (const auto& r : rings) {
+    inside_total += r.inside_length;
+    out.lanes.push_back({r.name, r.pts});
+  }
 
   // ---------------------------------------------------------------- cars
   const int car_bound = cityCarBound(world);
@@ -491,7 +500,9 @@ CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, cons
           dist = it->stop + lap - fw;
         }
         bool blocked = false;
-        int commit = c.committed;
+        // A commitment holds for the stop line it was made at, until the car has passed it
+        // (a stale one would let the car run the same signal's yellow a lap later).
+        int commit = c.committed == stop_idx ? c.committed : -1;
         if (stop_idx >= 0 && dist < 200.0) {
           const StopLine& st = ring.stops[stop_idx];
           const SignalState state = plan.state(plan.intersections[st.intersection], st.axis, t);
@@ -564,19 +575,18 @@ CityTraffic runCars(const World& world, std::uint64_t seed, double horizon, cons
       cars.swap(next);
     }
     for (std::size_t i = 0; i < nc; ++i) {
-      CityCar car;
-      car.model = models[i];
+      TrafficEpisode::Car car;
+      car.vehicle_class = models[i]->vehicle_class;
+      car.make = models[i]->make;
+      car.model = models[i]->model;
       car.color = colors[i];
-      car.lane = ring.name;
+      car.size = Vec3(models[i]->length, models[i]->width, models[i]->height);
+      car.lane = static_cast<int>(ri);
       for (const Sample& q : simplify(track[i], idm.step, ring, 0.1)) {
-        const Vec2 p = ring.at(q.s);
-        TrajectoryPoint tp;
-        tp.t = roundMilli(q.t);
-        if (!car.trajectory.empty() && tp.t <= car.trajectory.back().t) continue;
-        tp.x = roundMilli(p.x());
-        tp.y = roundMilli(p.y());
-        tp.yaw = roundMilli(geometry::wrapPi(ring.yawAt(q.s)));
-        car.trajectory.push_back(tp);
+        const double t = roundMilli(q.t);
+        if (!car.knots.empty() && t <= car.knots[car.knots.size() - 2]) continue;
+        car.knots.push_back(t);
+        car.knots.push_back(roundMilli(q.s));
       }
       out.cars.push_back(std::move(car));
     }
@@ -598,12 +608,18 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
     p.yaw = roundMilli(p.yaw);
     return p;
   };
+  const auto by_t = [](const TrajectoryPoint& p, double t) { return p.t < t; };
+  const auto first = std::lower_bound(tr.begin(), tr.end(), t0 + 1e-6, by_t);
+  const auto end = std::lower_bound(first, tr.end(), t0 + length - 1e-6, by_t);
+  out.reserve(static_cast<std::size_t>(end - first) + 2);
   out.push_back(shifted(sampleTrajectory(tr, t0)));
   out.front().t = 0.0;
-  const auto by_t = [](const TrajectoryPoint& p, double t) { return p.t < t; };
-  for (auto it = std::lower_bound(tr.begin(), tr.end(), t0 + 1e-6, by_t);
-       it != tr.end() && it->t < t0 + length - 1e-6; ++it) {
-    if (it->t > t0 + 1e-6) out.push_back(shifted(*it));
+  for (auto it = first; it != end; ++it) {
+    if (it->t <= t0 + 1e-6) continue;
+    // Decoded points are rounded already: only the time moves.
+    TrajectoryPoint p = *it;
+    p.t = roundMilli(p.t - t0);
+    out.push_back(p);
   }
   TrajectoryPoint last = shifted(sampleTrajectory(tr, t0 + length));
   last.t = roundMilli(length);
@@ -611,33 +627,147 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
   return out;
 }
 
-constexpr double kCachedHorizon = 1800.0;  // one run per world serves scenarios up to this long
-
-struct RunCache {
-  std::mutex mutex;
-  std::vector<std::pair<std::string, std::shared_ptr<const CityTraffic>>> runs;  // newest last
-};
-
-// The car run of `world` over kCachedHorizon, computed once per world parameters in a process.
-std::shared_ptr<const CityTraffic> cachedRun(const World& world, const IdmParams& idm) {
-  static RunCache cache;
-  char idm_key[256];
-  std::snprintf(idm_key, sizeof(idm_key), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g", idm.time_gap,
-                idm.min_gap, idm.max_accel, idm.comfort_decel, idm.yellow_stop_decel, idm.step,
-                idm.warm_up);
-  const std::string key = worldParamsJson(world.params()) + idm_key;
-  std::lock_guard<std::mutex> lock(cache.mutex);
-  for (const auto& [k, run] : cache.runs) {
-    if (k == key) return run;
-  }
-  auto run = std::make_shared<const CityTraffic>(
-      runCars(world, deriveSeed(world.params().seed, 0x43415252554EULL), kCachedHorizon, idm));
-  if (cache.runs.size() >= 4) cache.runs.erase(cache.runs.begin());
-  cache.runs.emplace_back(key, run);
-  return run;
+LaneRing ringOf(const TrafficEpisode::Lane& lane) {
+  LaneRing r;
+  r.name = lane.name;
+  r.pts = lane.points;
+  r.finish();
+  return r;
 }
 
+// Knots [from, to) of `car` decoded along its ring.
+Trajectory decodeKnots(const TrafficEpisode& e, const TrafficEpisode::Car& car, std::size_t from,
+                       std::size_t to) {
+  const LaneRing ring = ringOf(e.lanes.at(static_cast<std::size_t>(car.lane)));
+  Trajectory out;
+  out.reserve(to - from);
+  for (std::size_t k = from; k < to; ++k) {
+    const double s = car.knots[2 * k + 1];
+    const Vec2 p = ring.at(s);
+    TrajectoryPoint tp;
+    tp.t = car.knots[2 * k];
+    tp.x = roundMilli(p.x());
+    tp.y = roundMilli(p.y());
+    tp.yaw = roundMilli(geometry::wrapPi(ring.yawAt(s)));
+    out.push_back(tp);
+  }
+  return out;
+}
+
+std::shared_ptr<SharedTrafficEpisode> decodedEpisode(TrafficEpisode e) {
+  auto shared = std::make_shared<SharedTrafficEpisode>();
+  shared->episode = std::move(e);
+  for (const auto& car : shared->episode.cars) {
+    shared->trajectories.push_back(decodeKnots(shared->episode, car, 0, car.knots.size() / 2));
+  }
+  return shared;
+}
+
+struct EpisodeSlot {
+  std::once_flag once;
+  std::shared_ptr<const SharedTrafficEpisode> value;
+};
+
+struct EpisodeCache {
+  std::mutex mutex;
+  std::vector<std::pair<std::string, std::shared_ptr<EpisodeSlot>>> slots;  // newest last
+};
+
 }  // namespace
+
+std::string trafficEpisodeFileName(int index) {
+  char name[48];
+  std::snprintf(name, sizeof(name), "traffic_episode_%02d.json", index);
+  return name;
+}
+
+Trajectory episodeCarWindow(const TrafficEpisode& e, std::size_t car, double offset,
+                            double duration) {
+  const TrafficEpisode::Car& c = e.cars.at(car);
+  const std::size_t n = c.knots.size() / 2;
+  // The knots from the last at or before `offset` to the first at or after the window's end.
+  auto firstAfter = [&](double t, bool strict) {
+    std::size_t lo = 0, hi = n;
+    while (lo < hi) {
+      const std::size_t mid = (lo + hi) / 2;
+      const double tm = c.knots[2 * mid];
+      if (strict ? tm <= t : tm < t) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return lo;
+  };
+  const std::size_t a = firstAfter(offset, true), b = firstAfter(offset + duration, false);
+  return window(decodeKnots(e, c, a > 0 ? a - 1 : 0, std::min(n, b + 1)), offset, duration);
+}
+
+ScenarioEntity episodeCarEntity(const TrafficEpisode& e, std::size_t car, Trajectory window,
+                                const std::string& id) {
+  const TrafficEpisode::Car& c = e.cars.at(car);
+  ScenarioEntity se;
+  Entity& en = se.entity;
+  en.id = id;
+  en.cls = EntityClass::kCar;
+  en.attributes.set("vehicle_class", c.vehicle_class);
+  en.attributes.set("make", c.make);
+  en.attributes.set("model", c.model);
+  en.attributes.set("color", c.color);
+  en.attributes.set("lane", e.lanes.at(static_cast<std::size_t>(c.lane)).name);
+  const TrajectoryPoint p0 = window.empty() ? TrajectoryPoint{} : window.front();
+  en.box = boxFromPose(Vec3(roundMilli(p0.x), roundMilli(p0.y), roundMilli(p0.z)),
+                       roundMilli(geometry::wrapPi(p0.yaw)), c.size);
+  se.role = "traffic";
+  se.trajectory = std::move(window);
+  return se;
+}
+
+SignalPlan shiftedSignalPlan(const SignalPlan& plan, double offset) {
+  SignalPlan out = plan;
+  const double cyc = out.cycle();
+  for (auto& i : out.intersections) {
+    i.offset = roundMilli(std::fmod(std::fmod(i.offset - offset, cyc) + cyc, cyc));
+    if (i.offset >= cyc) i.offset = 0.0;
+  }
+  return out;
+}
+
+std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
+                                                               const IdmParams& idm) {
+  static EpisodeCache cache;
+  char idm_key[300];
+  std::snprintf(idm_key, sizeof(idm_key), "%.17g %.17g %.17g %.17g %.17g %.17g %.17g #%d",
+                idm.time_gap, idm.min_gap, idm.max_accel, idm.comfort_decel, idm.yellow_stop_decel,
+                idm.step, idm.warm_up, index);
+  const std::string key = worldParamsJson(world.params()) + idm_key;
+  std::shared_ptr<EpisodeSlot> slot;
+  {
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    for (const auto& [k, sl] : cache.slots) {
+      if (k == key) slot = sl;
+    }
+    if (!slot) {
+      slot = std::make_shared<EpisodeSlot>();
+      if (cache.slots.size() >= 128) cache.slots.erase(cache.slots.begin());
+      cache.slots.emplace_back(key, slot);
+    }
+  }
+  // Each episode is simulated once, outside the cache's lock (others are simulated meanwhile).
+  std::call_once(slot->once, [&] {
+    const std::uint64_t seed =
+        deriveSeed(world.params().seed, 0x43415252554EULL + static_cast<std::uint64_t>(index));
+    TrafficEpisode e = runCars(world, seed, kTrafficEpisodeLength, idm);
+    e.index = index;
+    auto text = std::make_shared<const std::string>(trafficEpisodeJson(e));
+    // Read back from its bytes: a reader of the file decodes exactly these trajectories.
+    auto shared = decodedEpisode(parseTrafficEpisode(*text, trafficEpisodeFileName(index)));
+    shared->sha256 = sha256Hex(*text);
+    shared->text = std::move(text);
+    slot->value = std::move(shared);
+  });
+  return slot->value;
+}
 
 CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
                                 const IdmParams& idm) {
@@ -650,25 +780,22 @@ CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double d
   const double area_km2 = tileArea(world) / 1e6;
   Rng rng(deriveSeed(seed, 0x5045444553ULL));
   CityTraffic out;
-  if (duration <= 0.5 * kCachedHorizon) {
-    // A window of the world's run, starting at a time drawn for this scenario; the signal
-    // offsets move with it.
-    const std::shared_ptr<const CityTraffic> run = cachedRun(world, idm);
-    const double t0 = idm.step * std::floor(rng.uniform(0.0, kCachedHorizon - duration) / idm.step);
-    out.plan = run->plan;
-    const double cyc = out.plan.cycle();
-    for (auto& i : out.plan.intersections) {
-      i.offset = roundMilli(std::fmod(std::fmod(i.offset - t0, cyc) + cyc, cyc));
-      if (i.offset >= cyc) i.offset = 0.0;
-    }
-    for (const auto& car : run->cars) {
-      CityCar c = car;
-      c.color = catalog::pick(rng, catalog::carColors());
-      c.trajectory = window(car.trajectory, t0, duration);
-      out.cars.push_back(std::move(c));
+  if (duration <= 0.5 * kTrafficEpisodeLength) {
+    // A window of one of the world's episodes, starting at a time drawn for this scenario; the
+    // signal offsets move with it.
+    const int k = static_cast<int>(rng.uniformInt(0, static_cast<long>(cp.traffic_episodes) - 1));
+    out.episode = cityTrafficEpisode(world, k, idm);
+    out.offset = roundMilli(
+        idm.step * std::floor(rng.uniform(0.0, kTrafficEpisodeLength - duration) / idm.step));
+    out.plan = shiftedSignalPlan(out.episode->episode.plan, out.offset);
+    for (const auto& tr : out.episode->trajectories) {
+      out.cars.push_back({window(tr, out.offset, duration)});
     }
   } else {
-    out = runCars(world, seed, duration, idm);
+    // Longer than an episode's offset range: the scenario's own cars.
+    out.episode = decodedEpisode(runCars(world, seed, duration, idm));
+    out.plan = out.episode->episode.plan;
+    for (const auto& tr : out.episode->trajectories) out.cars.push_back({tr});
   }
   const SignalPlan& plan = out.plan;
 

@@ -60,6 +60,7 @@ const std::vector<CityField>& cityFieldTable() {
       {"crossing_share", &CityParams::crossing_share, 0.0, 1.0},
       {"jaywalk_probability", &CityParams::jaywalk_probability, 0.0, 1.0},
       {"bus_queue_share", &CityParams::bus_queue_share, 0.0, 0.5},
+      {"traffic_episodes", &CityParams::traffic_episodes, 1.0, 64.0},
   };
   return k;
 }
@@ -72,6 +73,11 @@ void CityParams::validate() const {
       os << "world.city." << f.key << ": expected " << f.min << " to " << f.max << ", got " << v;
       throw ConfigError(os.str());
     }
+  }
+  if (traffic_episodes != std::floor(traffic_episodes)) {
+    std::ostringstream os;
+    os << "world.city.traffic_episodes: expected an integer from 1 to 64, got " << traffic_episodes;
+    throw ConfigError(os.str());
   }
   auto ordered = [](const char* lo_key, double lo, const char* hi_key, double hi) {
     if (lo > hi) {

@@ -12,6 +12,7 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/json_writer.h"
 #include "hameritt/scenario/params_table.h"
+#include "signal_plan_io.h"
 
 namespace hameritt::scenario {
 
@@ -266,14 +267,33 @@ std::string missionJson(const Mission& m) {
   return w.take();
 }
 
+void writeSignalPlan(JsonWriter& w, const SignalPlan& sp) {
+  w.beginObject();
+  w.key("left").value(sp.left).key("green").value(sp.green).key("yellow").value(sp.yellow);
+  w.key("all_red").value(sp.all_red).key("sidewalk").value(sp.sidewalk);
+  w.key("cycle").value(sp.cycle());
+  w.key("intersections").beginArray();
+  for (const auto& i : sp.intersections) {
+    w.beginObject().key("id").value(i.id).key("x").value(i.position.x());
+    w.key("y").value(i.position.y()).key("offset").value(i.offset);
+    w.key("heading").numbers({i.heading[0], i.heading[1]});
+    w.key("width").numbers({i.width[0], i.width[1]});
+    w.endObject();
+  }
+  w.endArray().endObject();
+}
+
 namespace {
 
-// sim_config.json into w (emptied first).
-void writeSimConfig(JsonWriter& w, const SimConfig& s) {
+// sim_config.json into w (emptied first). traffic_by_reference: a city scenario's episode cars
+// are left out of "entities" and named by the "traffic" reference instead.
+void writeSimConfig(JsonWriter& w, const SimConfig& s, bool traffic_by_reference = false) {
   // Room for the whole document up front (a trajectory point takes about 60 characters):
   // growing a 100 KB buffer by doubling would copy it several times.
   std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;
-  for (const auto& se : s.entities) points += se.trajectory.size() + 8;
+  const std::size_t written =
+      s.entities.size() - (s.traffic && traffic_by_reference ? s.traffic->car_ids.size() : 0);
+  for (std::size_t k = 0; k < written; ++k) points += s.entities[k].trajectory.size() + 8;
   for (const auto& a : s.aircraft) points += a.trajectory.size() + 4;
   w.clear(8192 + 64 * points);
   w.beginObject();
@@ -287,7 +307,8 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
   w.endObject();
 
   w.key("entities").beginArray();
-  for (const auto& se : s.entities) {
+  for (std::size_t k = 0; k < written; ++k) {
+    const ScenarioEntity& se = s.entities[k];
     const Entity& e = se.entity;
     w.beginObject();
     w.key("id").value(e.id).key("class").value(toString(e.cls)).key("role").value(se.role);
@@ -378,19 +399,16 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
   w.key("motion_blur_px").value(s.perturbations.motion_blur_px);
   w.endObject().endObject();
   if (s.signals) {
-    const SignalPlan& sp = *s.signals;
-    w.key("signals").beginObject();
-    w.key("left").value(sp.left).key("green").value(sp.green).key("yellow").value(sp.yellow);
-    w.key("all_red").value(sp.all_red).key("sidewalk").value(sp.sidewalk);
-    w.key("cycle").value(sp.cycle());
-    w.key("intersections").beginArray();
-    for (const auto& i : sp.intersections) {
-      w.beginObject().key("id").value(i.id).key("x").value(i.position.x());
-      w.key("y").value(i.position.y()).key("offset").value(i.offset);
-      w.key("heading").numbers({i.heading[0], i.heading[1]});
-      w.key("width").numbers({i.width[0], i.width[1]});
-      w.endObject();
-    }
+    w.key("signals");
+    writeSignalPlan(w, *s.signals);
+  }
+  if (s.traffic && traffic_by_reference) {
+    const TrafficEpisodeRef& r = *s.traffic;
+    w.key("traffic").beginObject();
+    w.key("file").value(r.file).key("episode").value(r.episode).key("offset").value(r.offset);
+    w.key("sha256").value(r.sha256);
+    w.key("cars").beginArray();
+    for (const auto& id : r.car_ids) w.value(id);
     w.endArray().endObject();
   }
   if (s.spec) {
@@ -412,9 +430,9 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s) {
 
 }  // namespace
 
-std::string simConfigJson(const SimConfig& s) {
+std::string simConfigJson(const SimConfig& s, bool traffic_by_reference) {
   JsonWriter w(true, 64);  // sized by writeSimConfig()
-  writeSimConfig(w, s);
+  writeSimConfig(w, s, traffic_by_reference);
   return w.take();
 }
 
@@ -557,7 +575,7 @@ void replaceDirectory(const std::string& tmp, const std::string& final_path) {
   fs::remove_all(old, ec);
 }
 
-std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
+std::string writeScenarioDir(const std::string& dir, const Scenario& s, bool traffic_by_reference) {
   const std::string final_dir = dir + "/" + s.mission.scenario_id;
   const std::string tmp = dir + "/.tmp-" + s.mission.scenario_id + "-" + std::to_string(::getpid());
   std::error_code ec;
@@ -579,7 +597,7 @@ std::string writeScenarioDir(const std::string& dir, const Scenario& s) {
     thread_local JsonWriter t_writer;
     writeMission(t_writer, s.mission);
     put("mission.json", t_writer.finish());
-    writeSimConfig(t_writer, s.sim);
+    writeSimConfig(t_writer, s.sim, traffic_by_reference);
     put("sim_config.json", t_writer.finish());
     replaceDirectory(tmp, final_dir);
   } catch (...) {

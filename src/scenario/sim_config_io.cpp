@@ -4,16 +4,19 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <utility>
 
+#include "hameritt/scenario/city_traffic.h"
 #include "hameritt/scenario/error.h"
-#include "hameritt/scenario/scenario_io.h"
-#include "strict_json.h"
 #include "hameritt/scenario/params_table.h"
+#include "hameritt/scenario/scenario_io.h"
+#include "signal_plan_io.h"
+#include "strict_json.h"
 
 namespace hameritt::scenario {
 
@@ -150,6 +153,119 @@ CameraSpec readCamera(const json& j, const std::string& path, const std::string&
   c.modalities = strings(o.array("modalities"), o.at("modalities"), file);
   o.finish();
   return c;
+}
+
+}  // namespace
+
+SignalPlan readSignalPlan(Obj& sg, const std::string& path, const std::string& file) {
+  SignalPlan plan;
+  plan.left = sg.numberIn("left", 0, 600);
+  plan.green = sg.numberIn("green", 0.001, 600);
+  plan.yellow = sg.numberIn("yellow", 0.001, 600);
+  plan.all_red = sg.numberIn("all_red", 0, 600);
+  plan.sidewalk = sg.numberIn("sidewalk", 0.001, 100);
+  const double cycle = sg.number("cycle");
+  if (std::abs(cycle - plan.cycle()) > 1e-6) {
+    sg.error("cycle", "expected 2 * (left + green + yellow + all_red) = " + fmt(plan.cycle()) +
+                          ", got " + fmt(cycle));
+  }
+  const json& list = sg.array("intersections");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    Obj o(list[i], idx(path + ".intersections", i), file);
+    SignalizedIntersection si;
+    si.id = o.string("id");
+    si.position = geometry::Vec2(o.number("x"), o.number("y"));
+    si.offset = o.numberIn("offset", 0, plan.cycle());
+    for (const char* key : {"heading", "width"}) {
+      const json& a = o.get(key);
+      if (!a.is_array() || a.size() != 2 || !a[0].is_number() || !a[1].is_number()) {
+        o.fail(o.at(key), "expected an array of 2 numbers", a);
+      }
+      double* dst = std::string(key) == "heading" ? si.heading : si.width;
+      dst[0] = a[0].get<double>();
+      dst[1] = a[1].get<double>();
+    }
+    o.finish();
+    plan.intersections.push_back(si);
+  }
+  sg.finish();
+  return plan;
+}
+
+namespace {
+
+// sim_config.json's "traffic": the reference to a traffic episode file, resolved: the file is
+// read (relative to the directory of `file`), its SHA-256 checked, the window checked to lie
+// within the episode and the signal plan to be the episode's shifted by the offset; the cars are
+// appended to s.entities.
+TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& file,
+                                       std::set<std::string>* ids) {
+  TrafficEpisodeRef r;
+  r.file = t.string("file");
+  r.episode = static_cast<int>(t.integer("episode"));
+  if (r.episode < 0 || r.episode > 63) t.error("episode", "expected 0 to 63");
+  r.offset = t.numberIn("offset", 0, kTrafficEpisodeLength);
+  r.sha256 = t.string("sha256");
+  if (r.sha256.size() != 64 ||
+      r.sha256.find_first_not_of("0123456789abcdef") != std::string::npos) {
+    t.error("sha256", "expected 64 lower-case hex digits, got '" + r.sha256 + "'");
+  }
+  r.car_ids = strings(t.array("cars"), t.at("cars"), file);
+  t.finish();
+  if (r.file.empty() || r.file.find('\0') != std::string::npos) {
+    t.error("file", "expected a file name");
+  }
+  const std::string path =
+      (std::filesystem::path(file).parent_path() / std::filesystem::path(r.file)).string();
+  std::string bytes;
+  try {
+    bytes = readBoundedFile(path);
+  } catch (const ConfigError& e) {
+    t.error("file", std::string("expected a readable traffic episode file: ") + e.what());
+  }
+  const std::string sha = sha256Hex(bytes);
+  if (sha != r.sha256) {
+    t.error("sha256", "expected the SHA-256 of " + path + " (" + sha + "), got " + r.sha256);
+  }
+  const TrafficEpisode e = parseTrafficEpisode(bytes, path);
+  if (e.index != r.episode) {
+    t.error("episode", "expected " + std::to_string(e.index) + " (the episode of " + path +
+                           "), got " + std::to_string(r.episode));
+  }
+  if (e.world_fingerprint != s.world_fingerprint) {
+    t.error("file", path + " is an episode of world " + hex64(e.world_fingerprint) +
+                        ", not of this scenario's world " + hex64(s.world_fingerprint));
+  }
+  if (!(r.offset + s.duration <= e.length + 1e-9)) {
+    t.error("offset", "expected the window [offset, offset + duration] = [" + fmt(r.offset) + ", " +
+                          fmt(r.offset + s.duration) + "] within the episode's [0, " +
+                          fmt(e.length) + "] s");
+  }
+  if (r.car_ids.size() != e.cars.size()) {
+    t.error("cars", "expected " + std::to_string(e.cars.size()) + " ids (one per car of " + path +
+                        "), got " + std::to_string(r.car_ids.size()));
+  }
+  const SignalPlan want = shiftedSignalPlan(e.plan, r.offset);
+  bool same = s.signals && s.signals->cycle() == want.cycle() &&
+              s.signals->intersections.size() == want.intersections.size();
+  for (std::size_t i = 0; same && i < want.intersections.size(); ++i) {
+    const auto &a = s.signals->intersections[i], &b = want.intersections[i];
+    same = a.id == b.id && std::abs(a.offset - b.offset) < 1e-6 &&
+           (a.position - b.position).norm() < 1e-6;
+  }
+  if (!same) {
+    throw ConfigError(file + ": signals: expected the signal plan of " + path +
+                      " with every offset shifted by traffic.offset (" + fmt(r.offset) + " s)");
+  }
+  for (std::size_t i = 0; i < e.cars.size(); ++i) {
+    if (!ids->insert(r.car_ids[i]).second) {
+      throw ConfigError(file + ": " + idx("traffic.cars", i) + ": duplicate id \"" + r.car_ids[i] +
+                        "\"");
+    }
+    s.entities.push_back(
+        episodeCarEntity(e, i, episodeCarWindow(e, i, r.offset, s.duration), r.car_ids[i]));
+  }
+  return r;
 }
 
 }  // namespace
@@ -309,38 +425,11 @@ SimConfig simConfigFromJson(const json& j, const std::string& file) {
   }
   if (root.has("signals")) {
     Obj sg = root.object("signals");
-    SignalPlan plan;
-    plan.left = sg.numberIn("left", 0, 600);
-    plan.green = sg.numberIn("green", 0.001, 600);
-    plan.yellow = sg.numberIn("yellow", 0.001, 600);
-    plan.all_red = sg.numberIn("all_red", 0, 600);
-    plan.sidewalk = sg.numberIn("sidewalk", 0.001, 100);
-    const double cycle = sg.number("cycle");
-    if (std::abs(cycle - plan.cycle()) > 1e-6) {
-      sg.error("cycle", "expected 2 * (left + green + yellow + all_red) = " + fmt(plan.cycle()) +
-                            ", got " + fmt(cycle));
-    }
-    const json& list = sg.array("intersections");
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      Obj o(list[i], idx("signals.intersections", i), file);
-      SignalizedIntersection si;
-      si.id = o.string("id");
-      si.position = geometry::Vec2(o.number("x"), o.number("y"));
-      si.offset = o.numberIn("offset", 0, plan.cycle());
-      for (const char* key : {"heading", "width"}) {
-        const json& a = o.get(key);
-        if (!a.is_array() || a.size() != 2 || !a[0].is_number() || !a[1].is_number()) {
-          o.fail(o.at(key), "expected an array of 2 numbers", a);
-        }
-        double* dst = std::string(key) == "heading" ? si.heading : si.width;
-        dst[0] = a[0].get<double>();
-        dst[1] = a[1].get<double>();
-      }
-      o.finish();
-      plan.intersections.push_back(si);
-    }
-    sg.finish();
-    s.signals = plan;
+    s.signals = readSignalPlan(sg, "signals", file);
+  }
+  if (root.has("traffic")) {
+    Obj t = root.object("traffic");
+    s.traffic = readTrafficReference(t, s, file, &ids);
   }
   if (root.has("spec")) {
     Obj sp = root.object("spec");

@@ -137,11 +137,14 @@ class Semantics {
     bool note(const json& item, const std::string& item_path, const char* key = "id") {
       const auto id = stringAt(item, key);
       if (!id) return true;
-      const std::string p = jsonPointerAppend(item_path, key);
-      auto [it, fresh] = first_.emplace(*id, p);
+      return noteId(*id, jsonPointerAppend(item_path, key));
+    }
+    // Notes `id` found at pointer `p`; false when it repeats.
+    bool noteId(const std::string& id, const std::string& p) {
+      auto [it, fresh] = first_.emplace(id, p);
       if (!fresh) {
         s_->add(p, "unique_id",
-                "duplicate " + what_ + " '" + *id + "' (first at " + it->second + ")");
+                "duplicate " + what_ + " '" + id + "' (first at " + it->second + ")");
       }
       return fresh;
     }
@@ -183,6 +186,9 @@ class Semantics {
 
   // ---------------------------------------------------------------- sim_config.json
   void simConfig();
+  // sim_config.json's "traffic": its car ids, and the episode file it names (present, its
+  // SHA-256, the window within the episode, the signal plan shifted with the offset).
+  void trafficReference(IdSet& ids);
 
   // Samples [t, x, y, z, yaw] of a timed path at `pointer`: t >= 0 and strictly increasing
   // (malformed samples are the schema's to report).

@@ -1,4 +1,5 @@
 // Semantic checks of sim_config.json, world.json and manifest.json.
+#include "hameritt/scenario/sim_config_io.h"
 #include "validation_internal.h"
 
 namespace hameritt::scenario::validation_internal {
@@ -16,6 +17,7 @@ void Semantics::simConfig() {
     has_target = has_target || stringAt(ents[i], "role") == std::optional<std::string>("target");
     trajectoryOrder(arrayOrEmpty(ents[i], "trajectory"), p + "/trajectory");
   }
+  if (exists("/traffic")) trafficReference(ids);
   const bool avoid = stringAt(doc_, "class") == std::optional<std::string>("avoid");
   if (!ents.empty() && !has_target && !avoid) {
     add("/entities", "role_target", "no entity has role 'target'");
@@ -47,6 +49,24 @@ void Semantics::simConfig() {
   if (exists("/uav/altitude"))
     altitude(doc_.at(json::json_pointer("/uav/altitude")), "/uav/altitude");
   if (exists("/uav/perception_path")) perceptionPath(ents);
+}
+
+void Semantics::trafficReference(IdSet& ids) {
+  const json& cars = arrayOrEmpty(doc_.at("traffic"), "cars");
+  for (std::size_t i = 0; i < cars.size(); ++i) {
+    if (cars[i].is_string())
+      ids.noteId(cars[i].get<std::string>(), jsonPointerAppend("/traffic/cars", i));
+  }
+  // The reader resolves the reference; its message names the file, the field and what it
+  // expected. Issues elsewhere in the document are reported by the other checks.
+  try {
+    (void)loadSimConfig(file_);
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    if (m.find(": traffic") != std::string::npos || m.find(": signals") != std::string::npos) {
+      add("/traffic", "traffic_episode", m);
+    }
+  }
 }
 
 void Semantics::trajectoryOrder(const json& traj, const std::string& pointer) {

@@ -224,6 +224,7 @@ int main(int argc, char** argv) {
       };
     }
     if (!into.empty()) req.write_world = false;
+    req.share_traffic = into.empty();  // a single scenario stays self-contained
     std::vector<hameritt::scenario::ManifestEntry> entries;
     try {
       entries = generateBatch(world, gc, req);

@@ -11,8 +11,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 
+#include "hameritt/generation/batch.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "hameritt/scenario/trajectory.h"
@@ -390,6 +393,132 @@ TEST(CityTraffic, DeterministicAndWrittenWithItsSignalPlan) {
       generateScenario(testing::shippedWorld(), quickConfig(), ScenarioClass::kAreaSearch, 7);
   EXPECT_FALSE(suburb.sim.signals.has_value());
   EXPECT_EQ(simConfigJson(suburb.sim).find("\"signals\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hameritt::scenario
+
+namespace hameritt::scenario {
+namespace {
+
+void writeText(const std::string& path, const std::string& text) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr) << path;
+  std::fwrite(text.data(), 1, text.size(), f);
+  std::fclose(f);
+}
+
+// Every regular file under `dir` (relative name -> bytes).
+std::map<std::string, std::string> treeOf(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) {
+      out[std::filesystem::relative(e.path(), dir).string()] = testing::slurp(e.path().string());
+    }
+  }
+  return out;
+}
+
+TEST(CityTrafficEpisode, Sha256KnownAnswers) {
+  // FIPS 180-4 examples; the outside judge (test_city_traffic.py) also checks written files
+  // with Python's hashlib.
+  EXPECT_EQ(sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256Hex(std::string(1000, 'a')),
+            "41edece42d63e8d9bf515a9ba6932e1c20cbc9f5a5d134645adb5db1b9737ea3");
+  EXPECT_NE(sha256Hex("abd"), sha256Hex("abc"));
+}
+
+// A batch writes each used episode once beside world.json and a reference in every
+// sim_config.json; the reader resolves it into exactly the scenario the generator built (the
+// same bytes as the self-contained file), the same whatever the thread count. The reader
+// refuses a changed episode file, a missing one, a window beyond the episode and a wrong count
+// of car ids, naming the field.
+TEST(CityTrafficEpisode, BatchReferencesReadBackAsTheGeneratedScenario) {
+  const std::string dir = testing::freshTempDir("episode_batch");
+  BatchRequest req;
+  req.classes = parseClassList("area_search,route_search,pursuit");
+  req.count = 4;
+  req.seed = 5;
+  req.share_traffic = true;
+  req.jobs = 1;
+  req.out_dir = dir + "/j1";
+  const std::vector<ManifestEntry> entries = generateBatch(cityWorld(), quickConfig(), req);
+  req.jobs = 2;
+  req.out_dir = dir + "/j2";
+  generateBatch(cityWorld(), quickConfig(), req);
+  const auto tree1 = treeOf(dir + "/j1");
+  EXPECT_TRUE(tree1 == treeOf(dir + "/j2")) << "--jobs 1 and 2 differ";
+  int episode_files = 0;
+  for (const auto& [name, bytes] : tree1) {
+    if (name.rfind("traffic_episode_", 0) == 0) ++episode_files;
+  }
+  EXPECT_GE(episode_files, 1);
+  EXPECT_LE(episode_files, 4);
+
+  std::string first_path, first_text;
+  for (const auto& e : entries) {
+    const std::string path = dir + "/j1/" + e.id + "/sim_config.json";
+    const std::string text = testing::slurp(path);
+    ASSERT_NE(text.find("\"traffic\""), std::string::npos) << path;
+    const SimConfig back = loadSimConfig(path);
+    ASSERT_TRUE(back.traffic.has_value());
+    EXPECT_GE(back.traffic->car_ids.size(), 100u);
+    const Scenario again = generateScenario(cityWorld(), quickConfig(), e.cls, e.seed);
+    EXPECT_EQ(simConfigJson(back), simConfigJson(again.sim)) << path;
+    EXPECT_EQ(simConfigJson(again.sim, true), text);
+    if (first_path.empty()) {
+      first_path = path;
+      first_text = text;
+    }
+  }
+  auto failure = [&](const std::string& text) {
+    writeText(first_path, text);
+    return testing::messageOf([&] { loadSimConfig(first_path); });
+  };
+  nlohmann::json j = nlohmann::json::parse(first_text);
+  const std::string episode =
+      (std::filesystem::path(first_path).parent_path() / j["traffic"]["file"].get<std::string>())
+          .string();
+  const std::string episode_bytes = testing::slurp(episode);
+  ASSERT_FALSE(episode_bytes.empty()) << episode;
+  // A changed byte in the episode file.
+  std::string changed = episode_bytes;
+  changed[changed.size() / 2] = changed[changed.size() / 2] == '1' ? '2' : '1';
+  writeText(episode, changed);
+  const std::string sha_message = failure(first_text);
+  EXPECT_NE(sha_message.find("traffic.sha256: expected the SHA-256"), std::string::npos)
+      << sha_message;
+  writeText(episode, episode_bytes);
+  EXPECT_EQ(failure(first_text), "(no error)");  // restored: read again
+  // A missing file, a window past the episode's end, one car id short.
+  nlohmann::json k = j;
+  k["traffic"]["file"] = "../no_such_episode.json";
+  EXPECT_NE(failure(k.dump()).find("traffic.file"), std::string::npos);
+  k = j;
+  k["traffic"]["offset"] = kTrafficEpisodeLength - j["duration"].get<double>() + 1.0;
+  EXPECT_NE(failure(k.dump()).find("traffic.offset: expected the window"), std::string::npos);
+  k = j;
+  k["traffic"]["cars"].erase(k["traffic"]["cars"].size() - 1);
+  EXPECT_NE(failure(k.dump()).find("traffic.cars: expected"), std::string::npos);
+  // A signal plan not shifted with the offset.
+  k = j;
+  const double t0 = j["traffic"]["offset"].get<double>();
+  k["traffic"]["offset"] = t0 >= 1.0 ? t0 - 1.0 : t0 + 1.0;
+  EXPECT_NE(failure(k.dump()).find("signals: expected the signal plan"), std::string::npos);
+  writeText(first_path, first_text);
+}
+
+TEST(CityTrafficEpisode, EpisodeCountIsRangeChecked) {
+  WorldParams p = cityWorld().params();
+  for (double bad : {0.0, 65.0, 2.5}) {
+    p.city.traffic_episodes = bad;
+    EXPECT_NE(testing::messageOf([&] { p.city.validate(); }).find("world.city.traffic_episodes"),
+              std::string::npos)
+        << bad;
+  }
+  p.city.traffic_episodes = 64;
+  EXPECT_EQ(testing::messageOf([&] { p.city.validate(); }), "(no error)");
 }
 
 }  // namespace

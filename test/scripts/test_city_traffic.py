@@ -19,6 +19,7 @@ Prints one line per failure and a "N passed, N failed" summary; exits 1 on any f
 """
 
 import glob
+import hashlib
 import json
 import math
 import os
@@ -211,11 +212,61 @@ def crossings_off_red(peds, plan, times):
     return checked, bad
 
 
+def lane_at(points, s):
+    """x, y of arc lengths s (wrapped) along a closed polyline given as x0, y0, x1, y1, ..."""
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
+    w = np.mod(s, cum[-1])
+    return np.interp(w, cum, p[:, 0]), np.interp(w, cum, p[:, 1])
+
+
+def sha_ok(path, ref):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest() == ref["sha256"]
+
+
+def episode_cars(ref, sim, sim_path):
+    """The traffic cars of a scenario that references a traffic episode file, as entities with a
+    [t, x, y, z, yaw] trajectory over the scenario's window: the knots (t, s) along the lane
+    shifted by the offset, the yaw that of the chord from s - 1.5 m to s + 1.5 m."""
+    path = os.path.join(os.path.dirname(sim_path), ref["file"])
+    with open(path, "rb") as f:
+        raw = f.read()
+    check(sha_ok(path, ref), "sha256 of " + ref["file"])
+    ep = json.loads(raw)
+    check(ep["episode"] == ref["episode"], "episode index of " + ref["file"])
+    t0, dur = ref["offset"], sim["duration"]
+    check(0 <= t0 and t0 + dur <= ep["length"], "window within the episode",
+          "%.3f + %.3f > %.3f" % (t0, dur, ep["length"]))
+    check(len(ref["cars"]) == len(ep["cars"]), "one id per episode car")
+    out = []
+    for cid, car in zip(ref["cars"], ep["cars"]):
+        k = np.asarray(car["knots"], dtype=float).reshape(-1, 2)
+        # The knots of the window and one on each side of it.
+        a = max(0, int(np.searchsorted(k[:, 0], t0, side="right")) - 1)
+        b = min(len(k), int(np.searchsorted(k[:, 0], t0 + dur, side="left")) + 1)
+        k = k[a:b]
+        pts = ep["lanes"][car["lane"]]["points"]
+        x, y = lane_at(pts, k[:, 1])
+        xa, ya = lane_at(pts, k[:, 1] - 1.5)
+        xb, yb = lane_at(pts, k[:, 1] + 1.5)
+        yaw = np.arctan2(yb - ya, xb - xa)
+        traj = [[t - t0, xi, yi, 0.0, w] for t, xi, yi, w in zip(k[:, 0], x, y, yaw)]
+        out.append({"id": cid, "class": "car", "role": "traffic", "size": car["size"],
+                    "attributes": {"lane": ep["lanes"][car["lane"]]["name"]},
+                    "pose": {"x": x[0], "y": y[0], "z": 0.0, "yaw": yaw[0]},
+                    "trajectory": traj})
+    return out
+
+
 def load(d):
     out = []
     for path in sorted(glob.glob(os.path.join(d, "**", "sim_config.json"), recursive=True)):
         with open(path) as f:
-            out.append(json.load(f))
+            sim = json.load(f)
+        if "traffic" in sim:
+            sim["entities"] += episode_cars(sim["traffic"], sim, path)
+        out.append(sim)
     return out
 
 
@@ -317,6 +368,39 @@ def main():
         check(r.returncode == 0, "generate --world city", r.stderr)
         sims = load(d)
         check(len(sims) == 2, "scenarios written", str(len(sims)))
+        check(all("traffic" in s for s in sims), "a batch references its traffic episodes")
+        episodes = sorted(glob.glob(os.path.join(d, "traffic_episode_*.json")))
+        check(1 <= len(episodes) <= 2, "one episode file per episode used", str(episodes))
+        for path in episodes:
+            with open(path) as f:
+                ep = json.load(f)
+            car_min = len(ep["cars"]) * ep["length"] / 60.0
+            knots = sum(len(c["knots"]) // 2 for c in ep["cars"])
+            print("%s: %d bytes, %d cars, %d knots, %.0f bytes per car-minute"
+                  % (os.path.basename(path), os.path.getsize(path), len(ep["cars"]), knots,
+                     os.path.getsize(path) / car_min))
+        for path in sorted(glob.glob(os.path.join(d, "*", "sim_config.json"))):
+            print("%s: %d bytes" % (os.path.relpath(path, d), os.path.getsize(path)))
+
+        # A changed episode file: this judge and hameritt_validate both refuse it.
+        victim = sorted(glob.glob(os.path.join(d, "*", "sim_config.json")))[0]
+        with open(victim) as f:
+            ref = json.load(f)["traffic"]
+        ep_path = os.path.join(os.path.dirname(victim), ref["file"])
+        with open(ep_path, "rb") as f:
+            good = f.read()
+        r = run("hameritt_validate", victim)
+        check(r.returncode == 0, "hameritt_validate accepts the reference", r.stderr)
+        bad = bytearray(good)
+        bad[len(bad) // 2] = ord("1") if bad[len(bad) // 2] != ord("1") else ord("2")
+        with open(ep_path, "wb") as f:
+            f.write(bytes(bad))
+        check(not sha_ok(ep_path, ref), "control: the judge flags a changed episode file")
+        r = run("hameritt_validate", victim)
+        check(r.returncode == 2 and "traffic_episode" in r.stderr and "traffic.sha256" in r.stderr,
+              "hameritt_validate refuses a changed episode file", r.stderr)
+        with open(ep_path, "wb") as f:
+            f.write(good)
         params = world["params"]["city"] if "city" in world["params"] else {}
         pj = params.get("jaywalk_probability", 0.15)
         crossers = jay = queuing = far = 0
@@ -370,7 +454,9 @@ def main():
         for key, value, msg in (("signal_green", 90.0, "expected 5 to 60, got 90"),
                                 ("signal_yellow", 2.0, "expected 3 to 6, got 2"),
                                 ("signal_left", -1.0, "expected 0 to 20, got -1"),
-                                ("jaywalk_probability", 1.5, "expected 0 to 1, got 1.5")):
+                                ("jaywalk_probability", 1.5, "expected 0 to 1, got 1.5"),
+                                ("traffic_episodes", 65.0, "expected 1 to 64, got 65"),
+                                ("traffic_episodes", 2.5, "expected an integer from 1 to 64")):
             with open(cfg, "w") as f:
                 json.dump(dict(base, type="city", city={key: value}), f)
             out = os.path.join(tmp, "never")

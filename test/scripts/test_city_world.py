@@ -113,7 +113,7 @@ def main():
 
         # A batch of every class, judged by jsonschema and hameritt_validate; --jobs invariant.
         validators = {}
-        for kind in ("mission", "sim_config", "world", "manifest"):
+        for kind in ("mission", "sim_config", "world", "manifest", "traffic_episode"):
             with open(os.path.join(SRC, "config", "schema", kind + ".schema.json")) as f:
                 validators[kind] = Draft7Validator(json.load(f))
         dirs = []
@@ -126,6 +126,8 @@ def main():
         docs = 0
         for path in sorted(glob.glob(os.path.join(dirs[0], "**", "*.json"), recursive=True)):
             kind = os.path.basename(path)[:-5]
+            if kind.startswith("traffic_episode_"):
+                kind = "traffic_episode"
             if kind not in validators:
                 continue
             with open(path) as f:
@@ -135,9 +137,12 @@ def main():
             docs += 1
             other = path.replace(dirs[0], dirs[1])
             check(filecmp.cmp(path, other, shallow=False), "byte-identical across --jobs " + path)
-        check(docs == 2 * 6 + 2, "documents in the batch", str(docs))
-        files = sorted(glob.glob(os.path.join(dirs[0], "**", "*.json"), recursive=True))
-        check(len(files) == docs, "files for hameritt_validate", str(len(files)))
+        episodes = glob.glob(os.path.join(dirs[0], "traffic_episode_*.json"))
+        check(1 <= len(episodes) <= 6, "traffic episode files beside world.json", str(episodes))
+        check(docs == 2 * 6 + 2 + len(episodes), "documents in the batch", str(docs))
+        files = sorted(f for f in glob.glob(os.path.join(dirs[0], "**", "*.json"), recursive=True)
+                       if f not in episodes)
+        check(len(files) == docs - len(episodes), "files for hameritt_validate", str(len(files)))
         r = run("hameritt_validate", *files)
         check(r.returncode == 0, "hameritt_validate accepts the city batch", r.stdout + r.stderr)
 

@@ -22,6 +22,9 @@ struct BatchRequest {
   std::string out_dir;
   int jobs = 1;
   bool write_world = true;  // also write DIR/world.json
+  // City: write each traffic episode that a scenario uses once, as DIR/traffic_episode_NN.json,
+  // and a reference to it in each sim_config.json (off: every scenario self-contained).
+  bool share_traffic = false;
   // Use `seed` itself as the scenario seed (count must be 1): regenerates a scenario from the
   // class and seed written in its files.
   bool exact_seed = false;

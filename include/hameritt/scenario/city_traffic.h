@@ -6,6 +6,7 @@
 // the bus stops. Deterministic by seed.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,11 +28,9 @@ struct IdmParams {
   double warm_up = 60.0;           // simulated before t = 0 so that queues exist at the start (s)
 };
 
-// One ambient car: its model, colour, lane and trajectory over [0, duration].
+// One ambient car's trajectory over [0, duration] (its model, colour and lane ring are those of
+// the episode's car of the same index).
 struct CityCar {
-  const catalog::CarModel* model = nullptr;
-  std::string color;
-  std::string lane;  // "lane_<corridor>_<direction><lane>"
   Trajectory trajectory;
 };
 
@@ -46,10 +45,75 @@ struct CityPedestrian {
   Trajectory trajectory;
 };
 
+// A traffic episode: the ambient cars of a city world simulated once over `length` seconds,
+// shared by every scenario of a batch that draws it (each sees a window of it). Compact: each
+// lane ring's polyline is stored once, and each car's motion as knots (t, s) of its arc length
+// s along its ring (unwrapped: it grows by the ring's length each lap), between which the car
+// moves at constant speed; every simulated position lies within 10 cm of the interpolation.
+struct TrafficEpisode {
+  struct Lane {
+    std::string name;
+    std::vector<geometry::Vec2> points;  // closed: the last point is the first
+  };
+  struct Car {
+    std::string vehicle_class, make, model, color;
+    geometry::Vec3 size{4.5, 1.8, 1.5};  // length, width, height (m)
+    int lane = 0;                        // index into `lanes`
+    std::vector<double> knots;           // t0, s0, t1, s1, ... (t strictly increasing from 0)
+  };
+  int index = 0;
+  double length = 0.0;  // seconds
+  std::uint64_t world_fingerprint = 0;
+  SignalPlan plan;  // at episode time
+  std::vector<Lane> lanes;
+  std::vector<Car> cars;
+};
+
+// The length of every traffic episode (s): a scenario of duration d starts at an offset in
+// [0, kTrafficEpisodeLength - d]; scenarios longer than half of it simulate their own cars.
+constexpr double kTrafficEpisodeLength = 1800.0;
+
+// "traffic_episode_03.json": the file of episode `index` beside a batch's world.json.
+std::string trafficEpisodeFileName(int index);
+
+// The episode file's bytes, and its strict reader (ConfigError naming the file, the JSON path and
+// what was expected).
+std::string trafficEpisodeJson(const TrafficEpisode& e);
+TrafficEpisode parseTrafficEpisode(const std::string& text, const std::string& file);
+
+// Lowercase hex SHA-256 (FIPS 180-4) of `bytes`.
+std::string sha256Hex(const std::string& bytes);
+
+// Car `car`'s trajectory over the episode window [offset, offset + duration], shifted to start
+// at 0: positions and yaw interpolated from the knots along the lane, rounded to the millimetre.
+Trajectory episodeCarWindow(const TrafficEpisode& e, std::size_t car, double offset,
+                            double duration);
+
+// The scenario entity (role "traffic") of car `car` of the episode moving along `window`.
+ScenarioEntity episodeCarEntity(const TrafficEpisode& e, std::size_t car, Trajectory window,
+                                const std::string& id);
+
+// The signal plan a scenario sees when it starts at `offset` of a plan: every offset shifted.
+SignalPlan shiftedSignalPlan(const SignalPlan& plan, double offset);
+
+// Episode `index` of `world`, simulated once per process (thread-safe, deterministic: a function
+// of the world and the index), with its file's bytes and their SHA-256.
+struct SharedTrafficEpisode {
+  TrafficEpisode episode;                   // as read back from `text`
+  std::shared_ptr<const std::string> text;  // null for a scenario's own cars (not shared)
+  std::string sha256;
+  std::vector<Trajectory> trajectories;  // each car's, over the whole episode
+};
+std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
+                                                               const IdmParams& idm = {});
+
 struct CityTraffic {
   SignalPlan plan;
   std::vector<CityCar> cars;
   std::vector<CityPedestrian> pedestrians;
+  // Set when the cars are a window of a shared episode (car i is the episode's car i).
+  std::shared_ptr<const SharedTrafficEpisode> episode;
+  double offset = 0.0;
 };
 
 // The signal plan of a city world: one intersection per interior street node that an arterial

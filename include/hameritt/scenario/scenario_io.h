@@ -11,7 +11,8 @@
 namespace hameritt::scenario {
 
 std::string missionJson(const Mission& m);
-std::string simConfigJson(const SimConfig& s);
+// traffic_by_reference: as a batch writes it (SimConfig::traffic; see writeScenarioDir()).
+std::string simConfigJson(const SimConfig& s, bool traffic_by_reference = false);
 // The whole neighborhood: street graph, blocks, parking slots and every entity.
 std::string worldJson(const World& w);
 // World parameters as the "params" object used in config/world.json and sim_config.json.
@@ -32,6 +33,9 @@ void replaceDirectory(const std::string& tmp, const std::string& final_path);
 
 // Writes DIR/<scenario_id>/{mission.json, sim_config.json} through a temporary directory that
 // is renamed into place (replacing an older scenario of the same id). Returns the directory.
-std::string writeScenarioDir(const std::string& dir, const Scenario& s);
+// traffic_by_reference: a city scenario's episode cars are written as a reference to the shared
+// traffic episode file (SimConfig::traffic) instead of inline; the caller writes that file.
+std::string writeScenarioDir(const std::string& dir, const Scenario& s,
+                             bool traffic_by_reference = false);
 
 }  // namespace hameritt::scenario

@@ -62,6 +62,7 @@ struct CityParams {
   double crossing_share = 0.3;         // share of pedestrians who cross a street, [0, 1]
   double jaywalk_probability = 0.15;   // a crossing is mid-block, off the signals, [0, 1]
   double bus_queue_share = 0.08;       // share of pedestrians queueing at bus stops, [0, 0.5]
+  double traffic_episodes = 8.0;  // car runs per world that scenarios draw from, integer [1, 64]
 
   // Throws ConfigError "world.city.KEY: expected LO to HI, got V" for the first bad field.
   void validate() const;
