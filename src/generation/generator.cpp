@@ -64,13 +64,20 @@ Polygon roundPolygon(const Polygon& p) {
   return Polygon(v);
 }
 
-double rangeDraw(Rng& rng, const Range& r) { return r.max > r.min ? rng.uniform(r.min, r.max) : r.min; }
+double rangeDraw(Rng& rng, const Range& r) {
+  return r.max > r.min ? rng.uniform(r.min, r.max) : r.min;
+}
 
 class ScenarioBuilder {
  public:
   ScenarioBuilder(const World& world, const GeneratorConfig& cfg, ScenarioClass cls,
                   std::uint64_t seed, const ScenarioPlan* plan)
-      : world_(world), cfg_(cfg), cls_(cls), seed_(seed), rng_(seed), eval_(world, cfg.relations),
+      : world_(world),
+        cfg_(cfg),
+        cls_(cls),
+        seed_(seed),
+        rng_(seed),
+        eval_(world, cfg.relations),
         plan_(plan) {
     slot_taken_.assign(world.slots().size(), 0);
     for (std::size_t i = 0; i < world.slots().size(); ++i) {
@@ -153,9 +160,9 @@ class ScenarioBuilder {
     e.attributes.set("make", model.make);
     e.attributes.set("model", model.model);
     e.attributes.set("color", color);
-    e.box = boxFromPose(Vec3(roundMilli(bottom.x()), roundMilli(bottom.y()), roundMilli(bottom.z())),
-                        roundMilli(geometry::wrapPi(yaw)),
-                        Vec3(model.length, model.width, model.height));
+    e.box = boxFromPose(
+        Vec3(roundMilli(bottom.x()), roundMilli(bottom.y()), roundMilli(bottom.z())),
+        roundMilli(geometry::wrapPi(yaw)), Vec3(model.length, model.width, model.height));
     e.block = world_.blockAt(e.box.center2());
     return e;
   }
@@ -293,8 +300,7 @@ class ScenarioBuilder {
   static TrajectoryPoint lanePose(const Vec2& a, const Vec2& dir, double s, double lane_offset,
                                   double t) {
     const Vec2 p = a + dir * s + Vec2(dir.y(), -dir.x()) * lane_offset;
-    return {t, roundMilli(p.x()), roundMilli(p.y()), 0.0,
-            roundMilli(std::atan2(dir.y(), dir.x()))};
+    return {t, roundMilli(p.x()), roundMilli(p.y()), 0.0, roundMilli(std::atan2(dir.y(), dir.x()))};
   }
 
   // ------------------------------------------------------------------ constraints
@@ -319,7 +325,8 @@ class ScenarioBuilder {
     // Near the edge of the neighborhood: keep the off-centre placement (so the point does not
     // fall on a prior-cell corner) and let the AOI reach past the edge.
     const double ox = rng_.uniform(0.1, 0.35) * len, oy = rng_.uniform(0.1, 0.35) * wid;
-    a.polygon = roundPolygon(geometry::orientedRectangle(contains - ox * ax - oy * ay, len, wid, yaw));
+    a.polygon =
+        roundPolygon(geometry::orientedRectangle(contains - ox * ax - oy * ay, len, wid, yaw));
     return a;
   }
 
@@ -334,7 +341,8 @@ class ScenarioBuilder {
     const Vec2 o = v[0], ex = v[1] - v[0], ey = v[3] - v[0];
     std::vector<Vec2> grid;
     for (int r = 0; r <= n; ++r) {
-      for (int c = 0; c <= n; ++c) grid.push_back(round2(o + (double(c) / n) * ex + (double(r) / n) * ey));
+      for (int c = 0; c <= n; ++c)
+        grid.push_back(round2(o + (double(c) / n) * ex + (double(r) / n) * ey));
     }
     auto g = [&](int r, int c) { return grid[static_cast<std::size_t>(r * (n + 1) + c)]; };
     std::vector<double> w;
@@ -368,8 +376,10 @@ class ScenarioBuilder {
       units.push_back(std::lround(x / sum * 10000.0));
       total += units.back();
     }
-    const std::size_t fix = target_cell >= 0 ? static_cast<std::size_t>(target_cell)
-                                             : static_cast<std::size_t>(std::max_element(units.begin(), units.end()) - units.begin());
+    const std::size_t fix = target_cell >= 0
+                                ? static_cast<std::size_t>(target_cell)
+                                : static_cast<std::size_t>(
+                                      std::max_element(units.begin(), units.end()) - units.begin());
     units[fix] += 10000 - total;
     for (std::size_t i = 0; i < units.size(); ++i) p.cells[i].probability = units[i] / 10000.0;
     return p;
@@ -388,9 +398,10 @@ class ScenarioBuilder {
   // so that the description mixes surface, direction, proximity and membership facts.
   std::vector<SceneRelation> selectRelations(std::vector<SceneRelation> all) {
     rng_.shuffle(all);
-    std::map<std::string, int> caps = {{"ON_TOP_OF", 1},  {"NOT_ON_TOP_OF", 1}, {"PART_OF", 1},
-                                       {"LEFT_OF", 1},    {"RIGHT_OF", 1},      {"IN_FRONT_OF", 1},
-                                       {"ORTHOGONAL_TO", 1}, {"NEXT_TO", 2},    {"NOT_NEXT_TO", 1}};
+    std::map<std::string, int> caps = {
+        {"ON_TOP_OF", 1},     {"NOT_ON_TOP_OF", 1}, {"PART_OF", 1},
+        {"LEFT_OF", 1},       {"RIGHT_OF", 1},      {"IN_FRONT_OF", 1},
+        {"ORTHOGONAL_TO", 1}, {"NEXT_TO", 2},       {"NOT_NEXT_TO", 1}};
     std::vector<SceneRelation> out;
     std::set<std::string> used;
     // Membership and surface first (always informative), then the rest in random order.
@@ -443,8 +454,8 @@ class ScenarioBuilder {
       }
     }
     if (forced.empty()) return;
-    const std::size_t keep =
-        static_cast<std::size_t>(std::max<int>(0, cfg_.relations.max_relations - static_cast<int>(forced.size())));
+    const std::size_t keep = static_cast<std::size_t>(
+        std::max<int>(0, cfg_.relations.max_relations - static_cast<int>(forced.size())));
     // Drop from the end, sparing the relations that another requirement listed.
     auto listed = [&](const SceneRelation& r) {
       for (const auto& pred : plan_->listed) {
@@ -552,7 +563,9 @@ class ScenarioBuilder {
     const Subject c = subjectOf(candidate);
     const double dt = cfg_.relations.eventually_dt;
     for (const auto& se : sc_.sim.entities) {
-      if (se.trajectory.empty() || se.entity.cls != cls || !(se.entity.attributes == r.related_attributes)) continue;
+      if (se.trajectory.empty() || se.entity.cls != cls ||
+          !(se.entity.attributes == r.related_attributes))
+        continue;
       for (int k = 1; k * dt <= sc_.mission.time_limit; ++k) {
         Subject m = subjectOf(se.entity);
         m.box = poseBox(se.entity.box, sampleTrajectory(se.trajectory, k * dt));
@@ -579,14 +592,16 @@ class ScenarioBuilder {
     const ScenarioEntity* se = scenarioEntity(id);
     if (!se) return false;
     *out = subjectOf(se->entity);
-    if (!se->trajectory.empty()) out->box = poseBox(se->entity.box, sampleTrajectory(se->trajectory, t));
+    if (!se->trajectory.empty())
+      out->box = poseBox(se->entity.box, sampleTrajectory(se->trajectory, t));
     return true;
   }
 
   // Re-evaluates relation r at time t with the final scene; fills its evidence when it holds.
   bool holdsAt(SceneRelation* r, double t) const {
     Subject target, related;
-    if (!subjectAt(r->target_id, t, &target) || !subjectAt(r->related_id, t, &related)) return false;
+    if (!subjectAt(r->target_id, t, &target) || !subjectAt(r->related_id, t, &related))
+      return false;
     const RelationFacts f = eval_.measure(target, related);
     if (!eval_.holds(r->op, f, related.cls)) return false;
     r->distance = f.distance;
@@ -651,7 +666,8 @@ class ScenarioBuilder {
     for (const auto& se : sc_.sim.entities) {
       if (se.role != "target") continue;
       const auto& t = se.entity.attributes;
-      if (t.str("make") != c.attributes.str("make") || t.str("model") != c.attributes.str("model") ||
+      if (t.str("make") != c.attributes.str("make") ||
+          t.str("model") != c.attributes.str("model") ||
           t.str("color") != c.attributes.str("color")) {
         continue;
       }
@@ -704,7 +720,8 @@ class ScenarioBuilder {
       if (keep_out_of) return !keep_out_of->intersects(c.box.footprint());
       return disambiguated(c, rels, target_aois);
     };
-    const auto* model = catalog::findCarModel(target.attributes.str("make"), target.attributes.str("model"));
+    const auto* model =
+        catalog::findCarModel(target.attributes.str("make"), target.attributes.str("model"));
     std::string color = target.attributes.str("color");
     // A spec's share: the looks that share those attributes with the target and differ in the
     // others.
@@ -728,7 +745,8 @@ class ScenarioBuilder {
       }
       if (share_models.empty() || share_colors.empty()) return;  // no such look-alike
     }
-    const int n = static_cast<int>(rng_.uniformInt(cfg_.confuser_count_min, cfg_.confuser_count_max));
+    const int n =
+        static_cast<int>(rng_.uniformInt(cfg_.confuser_count_min, cfg_.confuser_count_max));
     for (int k = 0; k < n; ++k) {
       // Alternate: outside the AOI first, then inside it but without the described context.
       const bool want_inside = !target_aois.empty() && (k % 2 == 1);
@@ -868,7 +886,8 @@ class ScenarioBuilder {
           throw GenerationError("target AOI does not contain the target");
       } else if (i == 0) {
         a = makeAoi(id, tp, yaw0, len, wid);
-        if (!a.polygon.contains(tp)) throw GenerationError("target AOI does not contain the target");
+        if (!a.polygon.contains(tp))
+          throw GenerationError("target AOI does not contain the target");
       } else {
         bool ok = false;
         for (int attempt = 0; attempt < 30 && !ok; ++attempt) {
@@ -908,15 +927,17 @@ class ScenarioBuilder {
       double best_d = 1e18;
       for (int ei = 0; ei < static_cast<int>(world_.edges().size()); ++ei) {
         const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
-        const double d = geometry::pointSegmentDistance(tp, world_.nodes()[e.a].position, world_.nodes()[e.b].position);
+        const double d = geometry::pointSegmentDistance(tp, world_.nodes()[e.a].position,
+                                                        world_.nodes()[e.b].position);
         if (d < best_d) best_d = d, best = ei;
       }
       const auto& e = world_.edges()[static_cast<std::size_t>(best)];
       const Vec2 a = world_.nodes()[e.a].position, b = world_.nodes()[e.b].position;
       const double w = e.width + 2 * world_.sidewalkWidth();
-      KeepOutZone k = makeKoz(geometry::orientedRectangle(0.5 * (a + b), std::max(10.0, (b - a).norm() - e.width), w,
-                                                          std::atan2((b - a).y(), (b - a).x())),
-                              "vantage_denial");
+      KeepOutZone k = makeKoz(
+          geometry::orientedRectangle(0.5 * (a + b), std::max(10.0, (b - a).norm() - e.width), w,
+                                      std::atan2((b - a).y(), (b - a).x())),
+          "vantage_denial");
       k.alt_min = 0.0;
       k.alt_max = std::round(rng_.uniform(25.0, 40.0));
       m.kozs.push_back(k);
@@ -933,7 +954,8 @@ class ScenarioBuilder {
         const double kw = rng_.uniform(20, 50);
         const double kl = rng_.uniform(20, 50);
         KeepOutZone k = makeKoz(geometry::orientedRectangle(c, kl, kw, kyaw), "restricted");
-        if (rng_.bernoulli(plan_ && plan_->koz_window_probability ? *plan_->koz_window_probability : 0.5)) {
+        if (rng_.bernoulli(plan_ && plan_->koz_window_probability ? *plan_->koz_window_probability
+                                                                  : 0.5)) {
           k.window.net = std::round(rng_.uniform(0.0, 0.5) * m.time_limit);
           k.window.nlt = std::round(*k.window.net + rng_.uniform(60.0, 0.5 * m.time_limit));
         }
@@ -1033,7 +1055,8 @@ class ScenarioBuilder {
       for (int ei : world_.adjacency()[static_cast<std::size_t>(nodes[i])]) {
         const auto& e = world_.edges()[static_cast<std::size_t>(ei)];
         if ((e.a == nodes[i] && e.b == nodes[i + 1]) || (e.b == nodes[i] && e.a == nodes[i + 1])) {
-          if (route.streets.empty() || route.streets.back() != e.name) route.streets.push_back(e.name);
+          if (route.streets.empty() || route.streets.back() != e.name)
+            route.streets.push_back(e.name);
         }
       }
     }
@@ -1084,9 +1107,10 @@ class ScenarioBuilder {
       m.objective.targets.push_back(describe(e));
     }
     m.objective.type = "find";
-    m.objective.text = "Find the " + lookText(m.objective.targets[0]) +
-                       (n_targets == 2 ? " and the " + lookText(m.objective.targets[1]) : std::string()) +
-                       " travelling along route_1.";
+    m.objective.text =
+        "Find the " + lookText(m.objective.targets[0]) +
+        (n_targets == 2 ? " and the " + lookText(m.objective.targets[1]) : std::string()) +
+        " travelling along route_1.";
     if (n_targets == 2) extra_groups_.push_back(convoy);
 
     // Access denial: a street of the route, closed for exactly the time the target cars are on
@@ -1123,7 +1147,8 @@ class ScenarioBuilder {
       add(targets[static_cast<std::size_t>(i)], "target", trajs[static_cast<std::size_t>(i)]);
     }
     for (int i = 0; i < n_targets; ++i) {
-      movingTargetRelations(targets[static_cast<std::size_t>(i)], trajs[static_cast<std::size_t>(i)], {});
+      movingTargetRelations(targets[static_cast<std::size_t>(i)],
+                            trajs[static_cast<std::size_t>(i)], {});
       if (i == 0) listEventually(targets[0], trajs[0]);
       addConfusers(targets[static_cast<std::size_t>(i)], {}, {}, &route.band, 40.0);
     }
@@ -1138,7 +1163,8 @@ class ScenarioBuilder {
     const auto at_start = eval_.allRelations(subjectOf(target), others, mine);
     std::vector<SceneRelation> rels = selectRelations(at_start);
     const int n_ev = std::max(1, cfg_.relations.max_relations / 3);
-    if (static_cast<int>(rels.size()) > cfg_.relations.max_relations - n_ev) rels.resize(static_cast<std::size_t>(cfg_.relations.max_relations - n_ev));
+    if (static_cast<int>(rels.size()) > cfg_.relations.max_relations - n_ev)
+      rels.resize(static_cast<std::size_t>(cfg_.relations.max_relations - n_ev));
     ensureListed(&rels, at_start);
     for (auto& r : eventuallyRelations(target, traj, at_start, n_ev)) rels.push_back(r);
     for (auto& r : rels) sc_.mission.relations.push_back(r);
@@ -1216,7 +1242,7 @@ class ScenarioBuilder {
     const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
     const planning::RouteSettings rs = routeSettings();
     const planning::SpeedProfile speed = speedProfile(rangeDraw(rng_, cfg_.car_speed));
-    constexpr double kPullOutTime = 6.0;   // seconds, from rest to rest
+    constexpr double kPullOutTime = 6.0;  // seconds, from rest to rest
     int slot = -1;
     Trajectory traj;
     std::vector<int> tried;  // slots without a route, skipped on later attempts
@@ -1321,7 +1347,10 @@ class ScenarioBuilder {
       const double lead = rng_.uniform(25.0, 45.0);
       const double dir = (block.sidewalk.size() > 1 &&
                           (geometry::polylinePointAt(block.sidewalk, std::fmod(s_car + 1.0, ring)) -
-                           geometry::polylinePointAt(block.sidewalk, s_car)).dot(fwd) > 0) ? 1.0 : -1.0;
+                           geometry::polylinePointAt(block.sidewalk, s_car))
+                                  .dot(fwd) > 0)
+                             ? 1.0
+                             : -1.0;
       // Start behind the car (against its heading) and run past it in its direction.
       const double s0 = s_car - dir * lead;
       const double s1 = s_car + dir * rng_.uniform(8.0, 20.0);
@@ -1333,7 +1362,8 @@ class ScenarioBuilder {
       p.cls = EntityClass::kPedestrian;
       p.attributes.set("clothing_color", catalog::pick(rng_, catalog::clothingColors()));
       p.attributes.set("activity", std::string("running"));
-      p.box = boxFromPose(Vec3(pt[0].x, pt[0].y, 0.0), pt[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.6, 1.9))));
+      p.box = boxFromPose(Vec3(pt[0].x, pt[0].y, 0.0), pt[0].yaw,
+                          Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.6, 1.9))));
       p.block = -1;
       vignette.members.push_back(p.id);
       add(p, "vignette", pt);
@@ -1648,7 +1678,8 @@ class ScenarioBuilder {
   // ------------------------------------------------------------------ everything else
   void drawUav() {
     uav_.altitude_min = std::round(rangeDraw(rng_, cfg_.uav_altitude_min));
-    uav_.altitude_max = std::round(std::max(uav_.altitude_min + 15.0, rangeDraw(rng_, cfg_.uav_altitude_max)));
+    uav_.altitude_max =
+        std::round(std::max(uav_.altitude_min + 15.0, rangeDraw(rng_, cfg_.uav_altitude_max)));
     uav_.max_speed = cfg_.uav_max_speed;
     CameraSpec front;
     front.name = "front";
@@ -1705,7 +1736,8 @@ class ScenarioBuilder {
     for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
       const Vec2 p = world_.nodes()[static_cast<std::size_t>(randomNode())].position;
       if (!allowed(p, 600.0)) continue;
-      uav_.start = {0.0, p.x(), p.y(), 0.0, roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
+      uav_.start = {0.0, p.x(), p.y(), 0.0,
+                    roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
       sc_.sim.uav = uav_;
       return;
     }
@@ -1714,7 +1746,8 @@ class ScenarioBuilder {
 
   // Ambient traffic (cars driving a few blocks, then stopping) and strolling pedestrians.
   void addTraffic() {
-    const int cars = static_cast<int>(rng_.uniformInt(cfg_.traffic_count_min, cfg_.traffic_count_max));
+    const int cars =
+        static_cast<int>(rng_.uniformInt(cfg_.traffic_count_min, cfg_.traffic_count_max));
     for (int i = 0; i < cars; ++i) {
       const int hops = static_cast<int>(rng_.uniformInt(2, 5));  // "Draw order" at the top
       std::vector<int> nodes = randomWalk(randomNode(), hops);
@@ -1725,12 +1758,15 @@ class ScenarioBuilder {
       spec.depart_delay = rng_.uniform(0.0, 20.0);
       Trajectory traj = planDrive(path, spec);
       const auto& model = catalog::pickModel(rng_);
-      Entity e = makeCar(model, catalog::pick(rng_, catalog::carColors()), Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
+      Entity e = makeCar(model, catalog::pick(rng_, catalog::carColors()),
+                         Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
       add(std::move(e), "traffic", std::move(traj));
     }
-    const int peds = static_cast<int>(rng_.uniformInt(cfg_.pedestrian_count_min, cfg_.pedestrian_count_max));
+    const int peds =
+        static_cast<int>(rng_.uniformInt(cfg_.pedestrian_count_min, cfg_.pedestrian_count_max));
     for (int i = 0; i < peds; ++i) {
-      const Block& b = world_.blocks()[static_cast<std::size_t>(rng_.uniformInt(0, static_cast<long>(world_.blocks().size()) - 1))];
+      const Block& b = world_.blocks()[static_cast<std::size_t>(
+          rng_.uniformInt(0, static_cast<long>(world_.blocks().size()) - 1))];
       const double ring = geometry::polylineLength(b.sidewalk);
       const double s0 = rng_.uniform(0.0, ring);
       const double span = rng_.uniform(60.0, 300.0);  // "Draw order" at the top
@@ -1743,7 +1779,8 @@ class ScenarioBuilder {
       p.cls = EntityClass::kPedestrian;
       p.attributes.set("clothing_color", catalog::pick(rng_, catalog::clothingColors()));
       p.attributes.set("activity", std::string("walking"));
-      p.box = boxFromPose(Vec3(traj[0].x, traj[0].y, 0.0), traj[0].yaw, Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.55, 1.9))));
+      p.box = boxFromPose(Vec3(traj[0].x, traj[0].y, 0.0), traj[0].yaw,
+                          Vec3(0.5, 0.6, roundMilli(rng_.uniform(1.55, 1.9))));
       add(std::move(p), "pedestrian", std::move(traj));
     }
   }
@@ -1767,13 +1804,12 @@ class ScenarioBuilder {
       fits.push_back(&e);
     }
     if (fits.empty()) return;
-    const Entity& b = *fits[static_cast<std::size_t>(
-        r.uniformInt(0, static_cast<long>(fits.size()) - 1))];
-    KeepOutZone k = makeKoz(
-        roundPolygon(geometry::orientedRectangle(b.box.center2(),
-                                                 b.box.size.x() + 2 * kBuildingStandoff,
-                                                 b.box.size.y() + 2 * kBuildingStandoff, b.box.yaw)),
-        "restricted");
+    const Entity& b =
+        *fits[static_cast<std::size_t>(r.uniformInt(0, static_cast<long>(fits.size()) - 1))];
+    KeepOutZone k = makeKoz(roundPolygon(geometry::orientedRectangle(
+                                b.box.center2(), b.box.size.x() + 2 * kBuildingStandoff,
+                                b.box.size.y() + 2 * kBuildingStandoff, b.box.yaw)),
+                            "restricted");
     k.alt_min = 0.0;
     k.alt_max = std::ceil(b.box.maxZ() + kBuildingStandoff);
     sc_.mission.kozs.push_back(k);
@@ -1924,33 +1960,9 @@ Scenario generateScenario(const World& world, const GeneratorConfig& config, Sce
   try {
     return ScenarioBuilder(world, config, cls, seed, plan).build();
   } catch (const GenerationError& e) {
-    throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " + e.what());
+    throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " +
+                          e.what());
   }
-}
-
-std::vector<Polygon> specKozPolygons(const World& world, const ScenarioPlan::Koz& koz,
-                                     const OrientedBox& target) {
-  std::vector<Polygon> out;
-  if (koz.over == "target") {
-    out.push_back(roundPolygon(
-        geometry::orientedRectangle(target.center2(), koz.size, koz.size, target.yaw)));
-    return out;
-  }
-  EntityClass cls;
-  if (!parseEntityClass(koz.over, &cls)) return out;
-  std::vector<std::pair<double, int>> near;
-  for (int i = 0; i < static_cast<int>(world.entities().size()); ++i) {
-    const Entity& e = world.entities()[static_cast<std::size_t>(i)];
-    if (e.cls == cls) near.emplace_back((e.box.center2() - target.center2()).norm(), i);
-  }
-  std::sort(near.begin(), near.end());
-  for (std::size_t k = 0; k < near.size() && static_cast<int>(k) < koz.count; ++k) {
-    const Entity& e = world.entities()[static_cast<std::size_t>(near[k].second)];
-    out.push_back(
-        roundPolygon(geometry::orientedRectangle(e.box.center2(), e.box.size.x() + 2 * koz.margin,
-                                                 e.box.size.y() + 2 * koz.margin, e.box.yaw)));
-  }
-  return out;
 }
 
 }  // namespace hameritt::scenario
