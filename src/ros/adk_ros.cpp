@@ -297,7 +297,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   if (t >= next_status_t_) {
     publishConstraints(t);
-    publishAvoid(t);
+    if (avoid_) publishAvoid(t, avoid_->score(monitor_->violationDuration()));
     next_status_t_ = t + status_period_;
   }
   judgeTrackAtLimit(t);
@@ -420,9 +420,7 @@ adk::TrafficSample AdkRos::avoidSample(double t, const Eigen::Vector3d& p,
   return s;
 }
 
-void AdkRos::publishAvoid(double t) {
-  if (!avoid_) return;
-  const adk::AvoidScore a = avoid_->score(monitor_->violationDuration());
+void AdkRos::publishAvoid(double t, const adk::AvoidScore& a) {
   hameritt::AvoidStatus m;
   m.header.stamp = stampOf(t);
   m.header.frame_id = "map";
@@ -554,7 +552,7 @@ void AdkRos::finish() {
                                            lifecycle_->timeLimit(), mode_, *monitor_, *coverage_);
   if (avoid_) {
     m.avoid = avoid_->score(monitor_->violationDuration());
-    publishAvoid(lifecycle_->endTime());
+    publishAvoid(lifecycle_->endTime(), *m.avoid);
   }
   std::string file;
   if (!output_dir_.empty()) {

@@ -79,7 +79,8 @@ class AdkRos {
   // Avoid missions: ends the mission once the goal is reached, succeeded when the avoid phase's
   // criteria hold (adk/avoid_score.h), failed otherwise.
   void checkAvoid(double t);
-  void publishAvoid(double t);
+  // adk/avoid: the avoid phase's score `a` at sim time t.
+  void publishAvoid(double t, const adk::AvoidScore& a);
   adk::TrafficSample avoidSample(double t, const Eigen::Vector3d& p,
                                  const Eigen::Vector3d& v) const;
   // Track objectives are judged at the time limit: at t >= the limit, success when every
