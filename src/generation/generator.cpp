@@ -794,14 +794,14 @@ class ScenarioBuilder {
     }
   }
 
-  // The spec's related car or pedestrian beside a parked target (a parked traffic car or a
-  // standing pedestrian), drawn among the options that the spec compiler accepts.
+  // The spec's related cars and pedestrians beside a parked target (parked traffic cars or
+  // standing pedestrians), drawn among the options that the spec compiler accepts.
   void placeRelated(const OrientedBox& target_box) {
     if (!plan_ || !plan_->related) return;
-    const std::vector<RelatedOption> options = plan_->related(target_box);
-    if (options.empty()) return;  // the world already meets the relation
-    const RelatedOption& o = options[static_cast<std::size_t>(
-        rng_.uniformInt(0, static_cast<long>(options.size()) - 1))];
+    for (const RelatedOption& o : plan_->related(target_box, rng_)) placeRelatedOption(o);
+  }
+
+  void placeRelatedOption(const RelatedOption& o) {
     Entity e;
     e.cls = o.cls;
     e.attributes = o.attributes;

@@ -1093,7 +1093,8 @@ class Parser {
         errorAt(t.pos, target_src_, "expected one of 'in BLOCK' and 'on \"STREET\"', not both");
       }
     }
-    bool placed_seen = false;
+    constexpr int kMaxPlaced = 3;
+    int placing = 0;
     for (std::size_t i = 0; i < spec_.requirements.size(); ++i) {
       const Requirement& r = spec_.requirements[i];
       const bool mover = r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar;
@@ -1134,14 +1135,15 @@ class Parser {
       if (!r.eventually &&
           (r.related == EntityClass::kPedestrian || r.related == EntityClass::kCar) && !r.negated) {
         // A positive relation to a car or pedestrian is constructed: the sampler parks a car or
-        // stands a pedestrian beside the target, one per spec (with 'prefer', in the scenarios
-        // drawn to meet it).
-        if (placed_seen) {
+        // stands a pedestrian beside the target, one per such requirement, in the order written
+        // (with 'prefer', in the scenarios drawn to meet it); at most kMaxPlaced of them, as the
+        // compiler's search for spots that meet them together grows with their power.
+        if (++placing > kMaxPlaced) {
           errorAt(r.pos, requirement_src_[i],
-                  "one relation per spec may place a car or pedestrian beside the target; "
-                  "this is the second");
+                  "at most " + std::to_string(kMaxPlaced) +
+                      " requirements per spec place a car or pedestrian beside the target; this "
+                      "is one more");
         }
-        placed_seen = true;
         for (const auto& a : r.attributes) {
           if (a.key == "activity" && !a.values.empty() &&
               std::find(a.values.begin(), a.values.end(), "standing") == a.values.end()) {

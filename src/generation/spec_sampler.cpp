@@ -8,6 +8,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <tuple>
 #include <variant>
 
@@ -286,11 +287,19 @@ bool placesRelated(const Requirement& r) {
 
 }  // namespace
 
+// How a placer treats another requirement of the spec while it places its entity.
+enum class OtherRole : char {
+  kKeep,   // its outcome (hard: as required; soft: as the scene has it) must not change
+  kHolds,  // an earlier placing requirement, met: it must keep holding
+  kLater,  // a later placing requirement that places its own entity: not constrained here
+};
+
 // Where the related car or pedestrian of a placing requirement can go: free parking places
 // (a parked car of each look the requirement allows) and points every metre along the
 // sidewalks (a standing pedestrian). An option is kept when the relation holds, no negated
 // requirement comes to hold with it, and every other requirement keeps its outcome with it as
-// an occluder; the compiler and the generator use the same test.
+// an occluder (the entities placed for earlier requirements count as part of the scene); the
+// compiler and the generator use the same test.
 struct RelatedPlacer {
   static constexpr double kCell = 16.0;
   static constexpr double kStandStep = 1.0;
@@ -298,6 +307,7 @@ struct RelatedPlacer {
   scenario::RelationEvaluator eval;
   Requirement req;
   std::vector<Requirement> others;  // every other static requirement
+  std::vector<int> other_index;     // their indices in the spec's requirements
   ScenarioClass cls;
   std::vector<int> models;          // car looks: catalog models
   std::vector<std::string> colors;  // car colours or pedestrian clothing colours
@@ -306,11 +316,14 @@ struct RelatedPlacer {
   // Grid cells of kCell m: free parking slots (cars) or indices of `stands` (pedestrians).
   std::map<std::pair<int, int>, std::vector<int>> cells;
 
-  RelatedPlacer(const scenario::World& w, const scenario::RelationConfig& rc, Requirement r,
+  RelatedPlacer(const scenario::World& w, const scenario::RelationConfig& rc, std::size_t self,
                 const std::vector<Requirement>& all, ScenarioClass c)
-      : world(w), eval(w, rc), req(std::move(r)), cls(c) {
-    for (const auto& o : all) {
-      if (!o.eventually && o.text != req.text) others.push_back(o);
+      : world(w), eval(w, rc), req(all[self]), cls(c) {
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      if (!all[i].eventually && i != self) {
+        others.push_back(all[i]);
+        other_index.push_back(static_cast<int>(i));
+      }
     }
     auto allowed = [&](const std::string& key, const std::string& v) {
       for (const auto& a : req.attributes) {
@@ -387,43 +400,94 @@ struct RelatedPlacer {
     return a;
   }
 
-  // Whether `q` holds among the world's entities for a target with this box, as the checker
-  // sees it with `ev` (the world, and the candidate as an occluder when given).
-  static bool worldHolds(const scenario::RelationEvaluator& ev, const scenario::World& w,
-                         const Requirement& q, const OrientedBox& box) {
-    return worldRelationHoldsPruned(ev, w, q, box);
+  // The id under which the k-th entity placed for an earlier requirement is measured.
+  static std::string placedId(std::size_t k) { return "__spec_placed_" + std::to_string(k); }
+
+  // This placer's evaluator with the entities placed so far as occluders.
+  scenario::RelationEvaluator sceneEval(const std::vector<scenario::RelatedOption>& placed) const {
+    scenario::RelationEvaluator ev = eval;
+    for (std::size_t k = 0; k < placed.size(); ++k) ev.addOccluder(placedId(k), placed[k].box);
+    return ev;
   }
 
-  // The options for a target with this box (all of them, or the first only).
-  std::vector<scenario::RelatedOption> options(const OrientedBox& target, bool first) const {
-    std::vector<scenario::RelatedOption> out;
+  // Whether `q` holds (negation not applied) for a target with this box among the world's
+  // entities and the placed ones, as the checker sees it with `ev` (which holds the placed
+  // entities, and any candidate, as occluders).
+  bool sceneHolds(const scenario::RelationEvaluator& ev, const Requirement& q,
+                  const OrientedBox& box,
+                  const std::vector<scenario::RelatedOption>& placed) const {
+    if (worldRelationHoldsPruned(ev, world, q, box)) return true;
+    if (placed.empty()) return false;
+    const scenario::Subject ts = specTarget(box);
+    for (std::size_t k = 0; k < placed.size(); ++k) {
+      const scenario::RelatedOption& p = placed[k];
+      if (!q.matchesRelated(p.cls, p.attributes)) continue;
+      scenario::Subject ps;
+      const std::string id = placedId(k);
+      ps.id = id;
+      ps.cls = p.cls;
+      ps.attributes = &p.attributes;
+      ps.box = p.box;
+      if (ev.holds(q.op, ev.measure(ts, ps), p.cls)) return true;
+    }
+    return false;
+  }
+
+  // Whether this requirement already holds for the target with the entities placed so far.
+  bool met(const OrientedBox& target, const std::vector<scenario::RelatedOption>& placed) const {
+    if (placed.empty()) return worldRelationHoldsPruned(eval, world, req, target);
+    return sceneHolds(sceneEval(placed), req, target, placed);
+  }
+
+  // Calls `fn` on each option for a target with this box, with `placed` (the entities placed
+  // for earlier requirements) in the scene and `roles` (per spec requirement; empty: every
+  // other one kKeep); stops when `fn` returns true.
+  template <typename Fn>
+  void forEachOption(const OrientedBox& target, const std::vector<scenario::RelatedOption>& placed,
+                     const std::vector<OtherRole>& roles, Fn fn) const {
     const scenario::RelationConfig& cfg = eval.config();
     static const scenario::Attributes kNone;
     const scenario::Subject ts = specTarget(target);
+    std::optional<scenario::RelationEvaluator> scene;
+    if (!placed.empty()) scene.emplace(sceneEval(placed));
+    const scenario::RelationEvaluator& sev = scene ? *scene : eval;
+    auto role = [&](std::size_t k) {
+      return roles.empty() ? OtherRole::kKeep : roles[static_cast<std::size_t>(other_index[k])];
+    };
     // Centre to centre, the farthest a related entity can stand: the operator's footprint
     // distance plus half of each footprint's diagonal.
     const double op_reach =
         (req.op == scenario::RelationOp::kNextTo ? cfg.next_to_distance + 1e-3 : cfg.radius);
     const double reach = op_reach + 0.5 * target.size.head<2>().norm() + max_half_diagonal + 0.01;
     std::vector<char> before;  // outcomes of the other requirements without the candidate
+    bool stop = false;
     auto tryBox = [&](const OrientedBox& box, int slot, const std::vector<int>& looks) {
       const double d = geometry::footprintDistance(target, box);
       if (d < 0.3) return;  // touching the target
+      for (const auto& p : placed) {
+        // Not in the place of an entity placed for an earlier requirement, nor touching it.
+        if ((slot >= 0 && p.slot == slot) || geometry::footprintDistance(p.box, box) < 0.3) return;
+      }
       if (!couldHold(cfg, req.op, target, box, d)) return;
       scenario::Subject rs;
       rs.id = "__spec_related__";
       rs.cls = req.related;
       rs.attributes = &kNone;
       rs.box = box;
-      const scenario::RelationFacts f = eval.measure(ts, rs);
-      if (!eval.holds(req.op, f, req.related)) return;
+      const scenario::RelationFacts f = sev.measure(ts, rs);
+      if (!sev.holds(req.op, f, req.related)) return;
       if (before.empty()) {
         // The hard ones hold (negations: do not) wherever a placement is sought.
-        for (const auto& q : others) {
-          before.push_back(q.probability == 1.0 ? !q.negated : worldHolds(eval, world, q, target));
+        for (std::size_t k = 0; k < others.size(); ++k) {
+          const Requirement& q = others[k];
+          const OtherRole ro = role(k);
+          before.push_back(ro == OtherRole::kLater   ? 0
+                           : ro == OtherRole::kHolds ? 1
+                           : q.probability == 1.0    ? !q.negated
+                                                     : sceneHolds(sev, q, target, placed));
         }
       }
-      scenario::RelationEvaluator with = eval;
+      scenario::RelationEvaluator with = sev;
       with.addOccluder(rs.id, box);
       std::vector<char> after_world;
       for (std::size_t k = 0; k < others.size(); ++k) {
@@ -431,13 +495,16 @@ struct RelatedPlacer {
         // An occluder only takes relations away, but NOT_NEXT_TO and NOT_ON_TOP_OF.
         const bool can_appear =
             q.op == scenario::RelationOp::kNotNextTo || q.op == scenario::RelationOp::kNotOnTopOf;
-        after_world.push_back(!before[k] && !can_appear ? 0 : worldHolds(with, world, q, target));
+        after_world.push_back(role(k) == OtherRole::kLater || (!before[k] && !can_appear)
+                                  ? 0
+                                  : sceneHolds(with, q, target, placed));
       }
       for (int m : looks) {
         for (const auto& col : colors) {
           const scenario::Attributes a = look(col, m);
           bool ok = true;
           for (std::size_t k = 0; k < others.size() && ok; ++k) {
+            if (role(k) == OtherRole::kLater) continue;
             const Requirement& q = others[k];
             const bool by_it = q.related == req.related && q.matchesRelated(req.related, a) &&
                                eval.holds(q.op, f, req.related);
@@ -449,8 +516,10 @@ struct RelatedPlacer {
           o.box = box;
           o.slot = slot;
           o.attributes = a;
-          out.push_back(std::move(o));
-          if (first) return;
+          if (fn(o)) {
+            stop = true;
+            return;
+          }
         }
       }
     };
@@ -467,7 +536,7 @@ struct RelatedPlacer {
             const OrientedBox& box = stands[static_cast<std::size_t>(k)];
             if ((box.center2() - target.center2()).norm() > reach) continue;
             tryBox(box, -1, {-1});
-            if (first && !out.empty()) return out;
+            if (stop) return;
             continue;
           }
           const auto& sl = world.slots()[static_cast<std::size_t>(k)];
@@ -480,12 +549,137 @@ struct RelatedPlacer {
           }
           for (int m : models) {
             tryBox(parkedBox(sl, cm[static_cast<std::size_t>(m)]), k, {m});
-            if (first && !out.empty()) return out;
+            if (stop) return;
           }
         }
       }
     }
+  }
+
+  // The options for a target with this box (all of them, or the first only).
+  std::vector<scenario::RelatedOption> options(
+      const OrientedBox& target, bool first,
+      const std::vector<scenario::RelatedOption>& placed = {},
+      const std::vector<OtherRole>& roles = {}) const {
+    std::vector<scenario::RelatedOption> out;
+    forEachOption(target, placed, roles, [&](const scenario::RelatedOption& o) {
+      out.push_back(o);
+      return first;
+    });
     return out;
+  }
+};
+
+// The spec's placing requirements in the order written: each places its entity (unless the
+// scene already meets it) among its options with the earlier ones' entities in the scene, and
+// an earlier one only takes an option that leaves every later one a spot (decided by a search
+// over the options, not by drawing whole scenes).
+struct PlacerChain {
+  std::vector<std::shared_ptr<const RelatedPlacer>> placers;
+  std::vector<int> index;  // each placer's requirement in the spec
+  std::size_t requirements = 0;
+
+  // The roles of the spec's requirements for placer k, with `active` placers placing (an
+  // inactive hard one places after them all; an inactive soft one, drawn to fail, keeps failing).
+  std::vector<OtherRole> roles(std::size_t k, const std::vector<char>& active) const {
+    std::vector<OtherRole> r(requirements, OtherRole::kKeep);
+    for (std::size_t j = 0; j < placers.size(); ++j) {
+      if (j == k) continue;
+      if (active[j])
+        r[static_cast<std::size_t>(index[j])] = j < k ? OtherRole::kHolds : OtherRole::kLater;
+      else if (placers[j]->req.probability == 1.0)
+        r[static_cast<std::size_t>(index[j])] = OtherRole::kLater;
+    }
+    return r;
+  }
+
+  // The roles for placer k placing alone, before the others (a necessary condition: the
+  // placers' joint outcome is decided by complete()).
+  std::vector<OtherRole> alone(std::size_t k) const {
+    std::vector<OtherRole> r(requirements, OtherRole::kKeep);
+    for (std::size_t j = 0; j < placers.size(); ++j) {
+      if (j != k) r[static_cast<std::size_t>(index[j])] = OtherRole::kLater;
+    }
+    return r;
+  }
+
+  // The compiler's search at one place tries at most this many options of the earlier placers:
+  // a place where the search takes more counts as having no spot (a bound on the search, which
+  // grows with the power of the number of placers where they cannot all be met).
+  static constexpr long kBudget = 400;
+
+  // Whether the active placers from k on can each be met, given `placed` (restored on return).
+  // `budget`: options left to try (null: no bound).
+  bool complete(std::size_t k, const OrientedBox& box, std::vector<scenario::RelatedOption>* placed,
+                const std::vector<char>& active, long* budget = nullptr) const {
+    while (k < placers.size() && (!active[k] || placers[k]->met(box, *placed))) ++k;
+    if (k == placers.size()) return true;
+    bool found = false;
+    bool last = true;  // no active placer after k: its first option settles it
+    for (std::size_t j = k + 1; j < placers.size(); ++j) last = last && !active[j];
+    // Options that differ only in looks the spec's requirements do not tell apart are tried once.
+    std::set<std::tuple<long long, long long, long long, long long, long long, std::string>> tried;
+    placers[k]->forEachOption(box, *placed, roles(k, active),
+                              [&](const scenario::RelatedOption& o) {
+                                if (last) return found = true;
+                                if (budget && --*budget < 0) return true;  // over: no spot
+                                if (!tried.insert(key(o)).second) return false;
+                                placed->push_back(o);
+                                found = complete(k + 1, box, placed, active, budget);
+                                placed->pop_back();
+                                return found;
+                              });
+    return found;
+  }
+
+  // The entities placed for a target with this box: each active placer in turn draws uniformly
+  // among its options that leave the later ones a spot (the first of a seeded permutation that
+  // does).
+  std::vector<scenario::RelatedOption> draw(const OrientedBox& box, const std::vector<char>& active,
+                                            scenario::Rng& rng) const {
+    std::vector<scenario::RelatedOption> placed;
+    for (std::size_t k = 0; k < placers.size(); ++k) {
+      if (!active[k] || placers[k]->met(box, placed)) continue;
+      std::vector<scenario::RelatedOption> o =
+          placers[k]->options(box, false, placed, roles(k, active));
+      bool later = false;
+      for (std::size_t j = k + 1; j < placers.size(); ++j) later = later || active[j];
+      if (!later && !o.empty()) {
+        placed.push_back(
+            o[static_cast<std::size_t>(rng.uniformInt(0, static_cast<long>(o.size()) - 1))]);
+        continue;
+      }
+      bool done = false;
+      for (std::size_t i = 0; i < o.size() && !done; ++i) {
+        const auto j = static_cast<std::size_t>(
+            rng.uniformInt(static_cast<long>(i), static_cast<long>(o.size()) - 1));
+        std::swap(o[i], o[j]);
+        placed.push_back(o[i]);
+        done = complete(k + 1, box, &placed, active);
+        if (!done) placed.pop_back();
+      }
+      if (!done) {
+        throw scenario::GenerationError("no place beside the target for '" + placers[k]->req.text +
+                                        "'");
+      }
+    }
+    return placed;
+  }
+
+  // What an option is to the later placers: its box and which requirements its look matches.
+  std::tuple<long long, long long, long long, long long, long long, std::string> key(
+      const scenario::RelatedOption& o) const {
+    const RelatedPlacer& p = *placers.front();  // its requirement and the others: all static ones
+    std::string sig(requirements, '0');
+    for (std::size_t q = 0; q < p.others.size(); ++q) {
+      if (p.others[q].matchesRelated(o.cls, o.attributes))
+        sig[static_cast<std::size_t>(p.other_index[q])] = '1';
+    }
+    if (p.req.matchesRelated(o.cls, o.attributes))
+      sig[static_cast<std::size_t>(index.front())] = '1';
+    return {std::llround(o.box.center.x() * 1e3), std::llround(o.box.center.y() * 1e3),
+            std::llround(o.box.yaw * 1e6),        std::llround(o.box.size.x() * 1e3),
+            std::llround(o.box.size.y() * 1e3),   sig};
   }
 };
 
@@ -767,9 +961,32 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     if (!placesRelated(spec_.requirements[ri]) && spec_.requirements[ri].eventually)
       order.push_back(ri);
   }
+  auto chain = std::make_shared<PlacerChain>();
+  chain->requirements = spec_.requirements.size();
   for (std::size_t ri = 0; ri < spec_.requirements.size(); ++ri) {
-    if (placesRelated(spec_.requirements[ri])) order.push_back(ri);
+    if (!placesRelated(spec_.requirements[ri])) continue;
+    order.push_back(ri);
+    chain->placers.push_back(std::make_shared<const RelatedPlacer>(world, base.relations, ri,
+                                                                   spec_.requirements, spec_.cls));
+    chain->index.push_back(static_cast<int>(ri));
   }
+  const std::size_t n_placers = chain->placers.size();
+  if (n_placers > 0) {
+    chain_ = chain;
+    placer_soft_.assign(n_placers, -1);
+  }
+  // The hard placers written up to placer c: they place together (soft ones place nothing).
+  auto hardUpTo = [&](std::size_t c) {
+    std::vector<char> active(n_placers, 0);
+    int n = 0;
+    for (std::size_t j = 0; j <= c; ++j) {
+      const bool hard =
+          spec_.requirements[static_cast<std::size_t>(chain->index[j])].probability == 1.0;
+      active[j] = hard;
+      n += hard;
+    }
+    return std::make_pair(active, n);
+  };
   for (const std::size_t ri : order) {
     const Requirement& r = spec_.requirements[ri];
     // The pursuit's running pedestrians: constructed by its vignette.
@@ -777,10 +994,14 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
     std::vector<char> mask(pairs.size()), fail_mask(pairs.size());
     std::vector<int> candidates;  // per parking place: the pairs run place by place
     std::shared_ptr<const RelatedPlacer> placer;
+    std::size_t chain_pos = 0;
+    std::pair<std::vector<char>, int> joint;  // the hard placers that place with this one
+    std::vector<OtherRole> alone;             // roles with this placer first, the others later
     if (placesRelated(r)) {
-      placer = std::make_shared<const RelatedPlacer>(world, base.relations, r, spec_.requirements,
-                                                     spec_.cls);
-      placer_ = placer;
+      while (chain->index[chain_pos] != static_cast<int>(ri)) ++chain_pos;
+      placer = chain->placers[chain_pos];
+      joint = hardUpTo(chain_pos);
+      if (n_placers > 1) alone = chain->alone(chain_pos);
     }
     // No entity of the related class and look in the world (pedestrians, a colour no parked
     // car has): no place meets it through the world, and nothing is measured.
@@ -810,12 +1031,20 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
       const bool in_scene = in_world && holdsAmong(eval, world, r, box, candidates);
       bool holds = in_scene;
       // Constructed: a car or pedestrian that the generator places beside the target.
-      if (!holds && placer) holds = !placer->options(box, true).empty();
+      if (placer && r.probability == 1.0 && joint.second > 1) {
+        // After the earlier hard placers: met with their entities in the scene, or placed.
+        std::vector<scenario::RelatedOption> placed;
+        long budget = PlacerChain::kBudget;
+        holds = chain->complete(0, box, &placed, joint.first, &budget);
+      } else if (!holds && placer) {
+        // Alone: the other placers place later (their joint outcome: the combinations below).
+        holds = !placer->options(box, true, {}, alone).empty();
+      }
       mask[k] = holds != r.negated;
       fail_mask[k] = placer ? !in_scene : !mask[k];
     }
     if (r.probability < 1.0) {
-      if (placer) placer_soft_ = static_cast<int>(soft_.size());
+      if (placer) placer_soft_[chain_pos] = static_cast<int>(soft_.size());
       soft_.push_back(static_cast<int>(ri));
       soft_masks.push_back(std::move(mask));
       soft_fail_masks.push_back(std::move(fail_mask));
@@ -852,6 +1081,15 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
       for (std::size_t j = 0; j < soft_.size() && ok; ++j) {
         ok = ((bits >> j) & 1U) != 0 ? soft_masks[j][k] != 0 : soft_fail_masks[j][k] != 0;
       }
+      if (ok && n_placers > 1) {
+        // The placers of this combination together, each leaving the others' outcomes.
+        const std::vector<char> active = activePlacers(bits);
+        if (std::find(active.begin(), active.end(), 1) != active.end()) {
+          std::vector<scenario::RelatedOption> placed;
+          long budget = PlacerChain::kBudget;
+          ok = chain->complete(0, boxAt(pairs[k]), &placed, active, &budget);
+        }
+      }
       if (ok) combos_[bits].push_back(pairs[k]);
     }
     if (combos_[bits].empty()) {
@@ -869,6 +1107,14 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
                       history(steps_));
     }
   }
+}
+
+std::vector<char> CompiledSpec::activePlacers(std::size_t bits) const {
+  std::vector<char> active(placer_soft_.size());
+  for (std::size_t j = 0; j < placer_soft_.size(); ++j) {
+    active[j] = placer_soft_[j] < 0 || ((bits >> placer_soft_[j]) & 1U) != 0;
+  }
+  return active;
 }
 
 ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::uint64_t batch_seed,
@@ -926,16 +1172,10 @@ ScenarioDraw CompiledSpec::draw(std::uint64_t seed, std::uint64_t index, std::ui
     };
   }
   // A soft placing requirement drawn to fail places nothing (its pairs have no such entity).
-  if (placer_ && (placer_soft_ < 0 || ((bits >> placer_soft_) & 1U) != 0)) {
-    d.plan.related = [p = placer_](const OrientedBox& box) {
-      if (worldRelationHoldsPruned(p->eval, p->world, p->req, box)) {
-        return std::vector<scenario::RelatedOption>{};
-      }
-      std::vector<scenario::RelatedOption> o = p->options(box, false);
-      if (o.empty()) {
-        throw scenario::GenerationError("no place beside the target for '" + p->req.text + "'");
-      }
-      return o;
+  const std::vector<char> active = activePlacers(bits);
+  if (std::find(active.begin(), active.end(), 1) != active.end()) {
+    d.plan.related = [c = chain_, active](const OrientedBox& box, scenario::Rng& rng) {
+      return c->draw(box, active, rng);
     };
   }
   d.plan.models = models_;

@@ -418,6 +418,15 @@ std::vector<std::string> checkOf(const Spec& s, const scenario::Scenario& sc,
   return checkScenarioAgainstSpec(s, shippedWorld(), cfg, sc.mission, sim, nullptr);
 }
 
+// The scene without the entity `id` (a negative control's doctored scene).
+scenario::SimConfig withoutEntity(const scenario::SimConfig& sim, const std::string& id) {
+  scenario::SimConfig out = sim;
+  out.entities.erase(std::remove_if(out.entities.begin(), out.entities.end(),
+                                    [&](const auto& se) { return se.entity.id == id; }),
+                     out.entities.end());
+  return out;
+}
+
 TEST(SpecRelated, ACarOrPedestrianIsPlacedBesideTheTargetAndChecked) {
   struct Case {
     std::string text, related, role;
@@ -448,12 +457,7 @@ TEST(SpecRelated, ACarOrPedestrianIsPlacedBesideTheTargetAndChecked) {
       ++placed;
       if (k.role == "pedestrian") EXPECT_EQ(rel->entity.attributes.str("activity"), "standing");
       // Negative control: without the placed entity the requirement fails.
-      scenario::SimConfig without = sc.sim;
-      const std::string id = rel->entity.id;
-      without.entities.erase(std::remove_if(without.entities.begin(), without.entities.end(),
-                                            [&](const auto& se) { return se.entity.id == id; }),
-                             without.entities.end());
-      const auto f = checkOf(s, sc, without);
+      const auto f = checkOf(s, sc, withoutEntity(sc.sim, rel->entity.id));
       ASSERT_FALSE(f.empty()) << k.text;
       EXPECT_NE(f[0].find("requirement '" + k.related + "' does not hold"), std::string::npos)
           << f[0];
@@ -488,6 +492,80 @@ TEST(SpecRelated, NegationsKeepCarsAwayAndAreChecked) {
     ASSERT_EQ(f.size(), 1u);
     EXPECT_EQ(f[0].find("requirement 'not pedestrian NEXT_TO target' does not hold"), 0u) << f[0];
   }
+}
+
+// Two placing relations in one spec: each scene gets a white car next to the target and a
+// pedestrian on its left (or the scene already meets one of them), both checked from the scene;
+// without the pedestrian placed for the second relation the check fails (negative control).
+TEST(SpecRelated, TwoPlacedEntitiesEachHoldAndAreChecked) {
+  const Spec s = parse(std::string(kHead) +
+                       "target car parked\nrequire car NEXT_TO target {color: white}\n"
+                       "require pedestrian LEFT_OF target\nrequire not car IN_FRONT_OF target\n");
+  int both = 0, removed = 0;
+  for (const auto& sc : generateChecked(s, 24)) {
+    const scenario::ScenarioEntity* car = nullptr;
+    const scenario::ScenarioEntity* ped = nullptr;
+    for (const auto& r : sc.mission.relations) {
+      for (const auto& se : sc.sim.entities) {
+        if (se.entity.id != r.related_id || !se.trajectory.empty()) continue;
+        if (r.op == scenario::RelationOp::kNextTo && se.role == "traffic" &&
+            se.entity.attributes.str("color") == "white")
+          car = &se;
+        if (r.op == scenario::RelationOp::kLeftOf && se.role == "pedestrian") ped = &se;
+      }
+    }
+    if (!car || !ped) continue;  // a world entity meets one of them
+    ++both;
+    EXPECT_EQ(ped->entity.attributes.str("activity"), "standing");
+    EXPECT_GE(geometry::footprintDistance(car->entity.box, ped->entity.box), 0.3);
+    const auto f = checkOf(s, sc, withoutEntity(sc.sim, ped->entity.id));
+    ASSERT_FALSE(f.empty());
+    EXPECT_EQ(f[0], "requirement 'pedestrian LEFT_OF target' does not hold for target " +
+                        sc.mission.objective.targets.front().id + " (recomputed from the scene)");
+    ++removed;
+  }
+  EXPECT_GE(both, 18);  // of 24: world entities rarely meet either
+  EXPECT_EQ(removed, both);
+}
+
+// Placing relations that each can be met but not together are refused at compile time, naming
+// the later one; a soft second one holds with its probability.
+TEST(SpecRelated, PlacedPairsUnsatisfiableTogetherAreRefusedAndSoftOnesHoldAtRate) {
+  scenario::GeneratorConfig cfg = shippedConfig();
+  cfg.perception_paths = false;
+  // Each alone compiles; together they need two cars next to the target, and with none in
+  // front of it only the place behind it is left.
+  const std::string one = "target car parked\nrequire not car IN_FRONT_OF target\n";
+  EXPECT_NO_THROW(
+      CompiledSpec(parse(std::string(kHead) + one + "require car NEXT_TO target {color: white}\n"),
+                   shippedWorld(), cfg));
+  EXPECT_NO_THROW(
+      CompiledSpec(parse(std::string(kHead) + one + "require car NEXT_TO target {color: black}\n"),
+                   shippedWorld(), cfg));
+  const std::string pair = messageOf([&] {
+    CompiledSpec(parse(std::string(kHead) + one +
+                       "require car NEXT_TO target {color: white}\n"
+                       "require car NEXT_TO target {color: black}\n"),
+                 shippedWorld(), cfg);
+  });
+  EXPECT_EQ(pair.find("t.hspec:5:1: error: unsatisfiable in this world: car NEXT_TO target "
+                      "{color: black}: 0 of "),
+            0u)
+      << pair;
+  const Spec soft = parse(std::string(kHead) +
+                          "target car parked\nrequire car NEXT_TO target {color: white}\n"
+                          "prefer 0.3 pedestrian RIGHT_OF target\n");
+  constexpr int kN = 120;
+  int held = 0;
+  for (const auto& sc : generateChecked(soft, kN)) {
+    std::vector<RequirementCheck> checks;
+    EXPECT_TRUE(
+        checkScenarioAgainstSpec(soft, shippedWorld(), cfg, sc.mission, sc.sim, &checks).empty());
+    ASSERT_EQ(checks.size(), 1u);
+    held += checks[0].holds;
+  }
+  EXPECT_LE(std::abs(held - kN * 0.3), 3 * std::sqrt(kN * 0.3 * 0.7)) << held;
+  EXPECT_GT(std::abs(held - kN * 0.7), 3 * std::sqrt(kN * 0.3 * 0.7)) << held;  // control
 }
 
 // Whether `held` of `n` is within 3 sigma of n * p.
@@ -590,12 +668,17 @@ TEST(SpecVerify, EveryScenarioIsCheckedBeforeItIsWritten) {
 TEST(SpecRelated, TypeCheckerRules) {
   // 'prefer' on a placed entity is accepted (constructed in the scenarios drawn to meet it).
   EXPECT_NO_THROW(parse(std::string(kHead) + "target car parked\nprefer 0.5 car NEXT_TO target\n"));
-  const std::string two = errorOf(std::string(kHead) +
-                                  "target car parked\nrequire car NEXT_TO target\n"
-                                  "require pedestrian LEFT_OF target\n");
-  EXPECT_EQ(two.substr(0, two.find('\n')),
-            "t.hspec:4:1: error: one relation per spec may place a car or pedestrian beside the "
-            "target; this is the second");
+  // Several placing relations: one entity each, in the order written.
+  EXPECT_NO_THROW(parse(std::string(kHead) +
+                        "target car parked\nrequire car NEXT_TO target\n"
+                        "require pedestrian LEFT_OF target\nprefer 0.5 car RIGHT_OF target\n"));
+  const std::string four = errorOf(std::string(kHead) +
+                                   "target car parked\nrequire car NEXT_TO target\n"
+                                   "require pedestrian LEFT_OF target\nprefer 0.5 car RIGHT_OF "
+                                   "target\nrequire pedestrian IN_FRONT_OF target\n");
+  EXPECT_EQ(four.substr(0, four.find('\n')),
+            "t.hspec:6:1: error: at most 3 requirements per spec place a car or pedestrian beside "
+            "the target; this is one more");
   const std::string walk = errorOf(std::string(kHead) +
                                    "target car parked\n"
                                    "require pedestrian NEXT_TO target {activity: walking}\n");

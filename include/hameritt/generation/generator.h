@@ -9,6 +9,7 @@
 
 #include "hameritt/generation/target_slots.h"
 #include "hameritt/scenario/generator_config.h"
+#include "hameritt/scenario/rng.h"
 
 namespace hameritt::scenario {
 
@@ -44,10 +45,10 @@ struct ScenarioPlan {
   // min(120, this / 2) from it.
   std::optional<double> uav_start_within;
   std::optional<SpecProvenance> provenance;
-  // Given the parked target's box: every option for the related car or pedestrian that a spec
-  // requires beside it (the generator draws one and adds it as a parked traffic car or a
-  // standing pedestrian); empty when the world already meets the relation. Null: none.
-  std::function<std::vector<RelatedOption>(const geometry::OrientedBox&)> related;
+  // Given the parked target's box: the cars and pedestrians that a spec's relations place
+  // beside it, drawn with the generator's `rng` (the generator adds each as a parked traffic car
+  // or a standing pedestrian, in order); none for a relation the scene already meets. Null: none.
+  std::function<std::vector<RelatedOption>(const geometry::OrientedBox&, Rng&)> related;
   // Look-alikes: the attributes they share with the target (vehicle_class, make, model,
   // color; the others differ); unset: make, model and colour.
   std::optional<std::vector<std::string>> confuser_share;

@@ -33,7 +33,7 @@ struct ScenarioDraw {
   scenario::ScenarioPlan plan;
 };
 
-struct RelatedPlacer;
+struct PlacerChain;
 
 class CompiledSpec {
  public:
@@ -65,9 +65,11 @@ class CompiledSpec {
   bool placed_ = false;  // the target is parked (area_search, pursuit)
   // route_search with requirements: the lead car's starts (the pairs' first members index it).
   std::vector<scenario::RouteStart> route_starts_;
-  // The requirement that places a car or pedestrian beside the target, if any.
-  std::shared_ptr<const RelatedPlacer> placer_;
-  int placer_soft_ = -1;  // its index in soft_ when it is soft ('prefer'); -1: hard
+  // The requirements that place a car or pedestrian beside the target, in the order written.
+  std::shared_ptr<const PlacerChain> chain_;
+  std::vector<int> placer_soft_;  // per placer: its index in soft_ ('prefer'); -1: hard
+  // Per placer, whether it places in a scenario with these soft outcomes (bit i: soft_[i] holds).
+  std::vector<char> activePlacers(std::size_t bits) const;
   // The world's relations, for the requirement that tells look-alikes apart.
   std::shared_ptr<const scenario::RelationEvaluator> told_eval_;
 };
