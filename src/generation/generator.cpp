@@ -1219,7 +1219,7 @@ class ScenarioBuilder {
     OrientedBox box = target->entity.box;
     if (!target->trajectory.empty()) box = poseBox(box, sampleTrajectory(target->trajectory, 0.0));
     for (const auto& z : plan_->kozs) {
-      for (const Polygon& poly : specKozPolygons(world_, z, box)) {
+      for (const Polygon& poly : specKozPolygons(world_, z, box, sc_.mission.aois)) {
         KeepOutZone k = makeKoz(poly, z.purpose);
         k.alt_min = z.alt_min;
         k.alt_max = z.alt_max;

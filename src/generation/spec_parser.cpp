@@ -247,7 +247,7 @@ const std::map<std::string, KeyLimits>& kozLimits() {
   static const std::map<std::string, KeyLimits> k = {
       {"count", {1, 5, true}},      {"size", {10, 200, false}},   {"margin", {0, 30, false}},
       {"alt_min", {0, 400, false}}, {"alt_max", {5, 500, false}}, {"net", {0, 3600, false}},
-      {"nlt", {1, 3600, false}},
+      {"nlt", {1, 3600, false}},    {"length", {10, 400, false}},
   };
   return k;
 }
@@ -793,13 +793,28 @@ class Parser {
                     .text;
     if (!isWord("over")) error("expected 'over' after the purpose, got " + describe(peek()));
     take();
-    std::vector<std::string> overs = {"target"};
-    for (const auto& c : world_classes_) overs.push_back(c);
+    std::vector<std::string> overs = {"target", "block", "aoi"};
+    for (const auto& c : world_classes_) {
+      if (std::find(overs.begin(), overs.end(), c) == overs.end()) overs.push_back(c);
+    }
+    if (std::find(overs.begin(), overs.end(), "street") == overs.end()) overs.push_back("street");
     const Token o = expectOneOf(overs, "what the zone covers", "zone cover", "a zone covers");
     k.over = o.text;
+    if (o.text == "aoi") {
+      // over aoi N: the N-th AOI of the mission (1-based).
+      const Token n = peek();
+      if (n.kind != Tok::kNumber || !n.integer || n.number < 1 || n.number > 5)
+        error("expected the AOI's number (1 to 5) after 'aoi', got " + describe(n), &n);
+      take();
+      k.aoi = static_cast<int>(n.number);
+      k.aoi_pos = pos(n);
+    }
     const std::vector<std::string> keys =
-        o.text == "target" ? std::vector<std::string>{"alt", "net", "nlt", "size"}
-                           : std::vector<std::string>{"alt", "count", "margin", "net", "nlt"};
+        o.text == "target"   ? std::vector<std::string>{"alt", "net", "nlt", "size"}
+        : o.text == "street" ? std::vector<std::string>{"alt", "length", "margin", "net", "nlt"}
+        : o.text == "block" || o.text == "aoi"
+            ? std::vector<std::string>{"alt", "margin", "net", "nlt"}
+            : std::vector<std::string>{"alt", "count", "margin", "net", "nlt"};
     if (isPunct("{")) {
       take();
       while (!isPunct("}")) {
@@ -858,7 +873,22 @@ class Parser {
       }
       return nullptr;
     };
-    for (const auto& k : spec_.kozs) {
+    for (std::size_t i = 0; i < spec_.kozs.size(); ++i) {
+      const KozSpec& k = spec_.kozs[i];
+      if (k.over == "aoi") {
+        // The AOI must exist in every scenario: an area search with at least that many.
+        if (spec_.cls != scenario::ScenarioClass::kAreaSearch) {
+          errorAt(k.pos, koz_src_[i], "a zone over an AOI applies to area_search only");
+        }
+        const Distribution* n = spec_.setting("aois.count");
+        if (n && n->minValue() < k.aoi) {
+          char buf[160];
+          std::snprintf(buf, sizeof(buf),
+                        "aoi %d: a scenario of this spec may have %g AOI(s) (aois { count: %s })",
+                        k.aoi, n->minValue(), n->text().c_str());
+          errorAt(k.aoi_pos, koz_src_[i], buf);
+        }
+      }
       for (const auto& [lo, hi, what] :
            {std::make_tuple("alt_min", "alt_max",
                             "alt: expected the top of the band above its "

@@ -789,6 +789,8 @@ scenario::ScenarioPlan::Koz drawnKoz(const KozSpec& k, const std::map<std::strin
   if (auto c = get("count")) z.count = static_cast<int>(std::lround(*c));
   if (auto x = get("size")) z.size = *x;
   if (auto x = get("margin")) z.margin = *x;
+  if (auto x = get("length")) z.length = *x;
+  z.aoi = k.aoi;
   z.alt_min = get("alt_min");
   z.alt_max = get("alt_max");
   z.net = get("net");
@@ -880,6 +882,15 @@ CompiledSpec::CompiledSpec(Spec spec, const scenario::World& world,
                     "inside an AOI whose shortest side may be %.3g m (at most %.3g m)",
                     spec_.file.c_str(), off->maxValue(), side, 0.5 * side - 5.0);
       throw SpecError(buf);
+    }
+  }
+  for (const auto& k : spec_.kozs) {
+    // A zone over the N-th AOI: every scenario has that many (the parser checks aois.count).
+    if (k.aoi > base_.aoi_count_min && !spec_.setting("aois.count")) {
+      throw SpecError(where(k.aoi_pos) + "aoi " + std::to_string(k.aoi) + ": a scenario may have " +
+                      std::to_string(base_.aoi_count_min) +
+                      " AOI(s) (config aoi_count_min); set aois { count: ... } to at least " +
+                      std::to_string(k.aoi));
     }
   }
   if (spec_.confusers.told_apart >= 0) {
@@ -1437,9 +1448,13 @@ std::vector<std::string> checkScenarioAgainstSpec(const Spec& spec, const scenar
     };
     for (const auto& k : spec.kozs) {
       const scenario::ScenarioPlan::Koz z = drawnKoz(k, recorded);
-      const std::string what = "koz " + k.purpose + " over " + k.over;
-      const auto want = scenario::specKozPolygons(world, z, box);
-      if (want.empty()) fail(what + ": no " + k.over + " in this world");
+      const std::string what = "koz " + k.purpose + " over " + k.over +
+                               (k.aoi > 0 ? " " + std::to_string(k.aoi) : std::string());
+      const auto want = scenario::specKozPolygons(world, z, box, mission.aois);
+      if (want.empty()) {
+        fail(what +
+             (k.aoi > 0 ? ": no such AOI in the mission" : ": no " + k.over + " in this world"));
+      }
       spec_zones += want.size();
       for (const auto& poly : want) {
         bool found = false;

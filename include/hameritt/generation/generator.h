@@ -68,25 +68,31 @@ struct ScenarioPlan {
   };
   std::vector<Eventual> eventually;
   // A spec's keep-out zones (koz statements) with their drawn numbers: over the first target's
-  // position at t = 0 (a square of `size` m along its heading), or over the `count` world
-  // entities of class `over` nearest it (footprints grown by `margin` m). Added after the
-  // class's own zones.
+  // position at t = 0 (a square of `size` m along its heading), the block it is on or nearest
+  // to (its land grown by `margin` m), its street (a band of the street's width + 2 `margin`,
+  // `length` m along it, centred where the target is), the `aoi`-th AOI (grown by `margin` m),
+  // or the `count` world entities of class `over` nearest it (footprints grown by `margin` m).
+  // Added after the class's own zones.
   struct Koz {
     std::string purpose;
-    std::string over;  // "target" or an entity class
+    std::string over;  // "target", "block", "street", "aoi" or an entity class
     int count = 1;
+    int aoi = 0;  // over "aoi": 1-based
     double size = 40.0;
     double margin = 5.0;
+    double length = 60.0;
     std::optional<double> alt_min, alt_max, net, nlt;
   };
   std::vector<Koz> kozs;
 };
 
 // The polygon of a spec keep-out zone over a target with this box at t = 0 (`over` "target"),
-// or over each of the `count` world entities of class `over` nearest it (centre distance, ties
-// by index): what the generator writes and hameritt_validate --spec expects.
+// its block, its street, the mission's AOI `aoi` (from `aois`; none when it has fewer), or over
+// each of the `count` world entities of class `over` nearest it (centre distance, ties by
+// index): what the generator writes and hameritt_validate --spec expects.
 std::vector<geometry::Polygon> specKozPolygons(const World& world, const ScenarioPlan::Koz& koz,
-                                               const geometry::OrientedBox& target);
+                                               const geometry::OrientedBox& target,
+                                               const std::vector<AreaOfInterest>& aois = {});
 
 // Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give
 // the same scenario. Throws GenerationError when no placement satisfies the constraints.

@@ -99,16 +99,18 @@ struct ConfuserSpec {
   SourcePos share_pos, told_pos;
 };
 
-// koz PURPOSE over (target | CLASS) {count, size, margin, alt: [lo, hi], net, nlt}: keep-out
-// zones that every scenario gets, over the target's position at t = 0 (a square of `size` m
-// along its heading) or over the `count` world entities of CLASS nearest it (their footprints
-// grown by `margin` m). Its numbers are settings "<key>.<name>" (key "koz1", "koz2", ...),
-// drawn like the others.
+// koz PURPOSE over (target | block | street | aoi N | CLASS) {count, size, margin, length,
+// alt: [lo, hi], net, nlt}: keep-out zones that every scenario gets, over the target's position
+// at t = 0 (a square of `size` m along its heading), the block it is on (grown by `margin` m),
+// its street (a band `length` m along it), the N-th AOI (grown by `margin` m) or the `count`
+// world entities of CLASS nearest it (their footprints grown by `margin` m). Its numbers are
+// settings "<key>.<name>" (key "koz1", "koz2", ...), drawn like the others.
 struct KozSpec {
   std::string purpose;  // vantage_denial | access_denial | restricted
-  std::string over;     // "target" or an entity class of the world
+  std::string over;     // "target", "block", "street", "aoi" or an entity class of the world
   std::string key;      // "koz1", ...
-  SourcePos pos;
+  int aoi = 0;          // over aoi N: N (1-based)
+  SourcePos pos, aoi_pos;
 };
 
 // A type-checked spec: everything the compiler needs, with its sources' hash.
