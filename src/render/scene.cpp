@@ -168,7 +168,10 @@ std::uint32_t signalLamps(scenario::SignalState axis0, scenario::SignalState axi
   const double turns = heading0 / (2.0 * M_PI);
   const auto h = static_cast<std::uint32_t>(
       static_cast<long>(std::lround((turns - std::floor(turns)) * 256.0)) & 255);
-  return lamp(axis0) | (lamp(axis1) << 2) | (h << 8);
+  const auto arrow = [](scenario::SignalState st) -> std::uint32_t {
+    return st == scenario::SignalState::kLeftArrow ? 1u : 0u;
+  };
+  return lamp(axis0) | (lamp(axis1) << 2) | (arrow(axis0) << 4) | (arrow(axis1) << 5) | (h << 8);
 }
 
 void boxRecordRows(const geometry::OrientedBox& box, double lift, float rows[3][4]) {
@@ -203,8 +206,8 @@ int LodView::level(const SceneInstance& si, const Eigen::Vector3f& center, float
   if (z_min <= 0) return 0;
   const double dist = v.norm();
   const double lateral = std::sqrt(std::max(0.0, dist * dist - z * z));
-  const double angle = std::min(std::atan2(lateral, z) + std::asin(std::min(1.0, radius / dist)),
-                                max_angle);
+  const double angle =
+      std::min(std::atan2(lateral, z) + std::asin(std::min(1.0, radius / dist)), max_angle);
   // Deviations grow with the level: the last one within the budget.
   const double budget = max_error_px * z_min * std::cos(angle) / focal;
   int level = 0;

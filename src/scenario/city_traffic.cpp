@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <mutex>
 
@@ -60,6 +61,14 @@ constexpr double kLoopSpread = 20.0;  // length over which the lane widens into 
 constexpr double kLoopExtra = 8.0;    // the inner lane's loop radius exceeds its offset by this (m)
 constexpr double kStopBack = 1.0;     // stop line: this far before the crosswalk (m)
 constexpr double kGuard = 0.25;       // a car over its stop line on red stays this far short (m)
+constexpr double kLookAhead = 150.0;  // a car looks this far ahead for the car it follows (m)
+// A turn starts no later than this before the end of the protected arrow (s), so that the
+// turning car is out of the box when the axis' through traffic moves.
+constexpr double kTurnClose = 4.0;
+// At a box where two arterials cross, a car of the inner lane turns left and one of the outer
+// lane turns right with these probabilities (otherwise it goes straight on).
+constexpr double kLeftTurnProbability = 0.15;
+constexpr double kRightTurnProbability = 0.15;
 
 bool isArterial(const World& w, const StreetEdge& e) {
   return e.width >= w.params().city.arterial_width - 1e-9;
@@ -80,23 +89,13 @@ bool onBoundary(const World& w, const Vec2& p) {
 Vec2 unit(double heading) { return {std::cos(heading), std::sin(heading)}; }
 Vec2 leftOf(const Vec2& u) { return {-u.y(), u.x()}; }
 
-// A stop line on a lane ring: the car's front stays at or before `stop` while its signal does
-// not let it enter; the intersection box it guards ends at `exit`.
-struct StopLine {
-  double stop = 0.0;
-  double exit = 0.0;
-  int intersection = -1;
-  int axis = 0;
-};
-
-// A closed lane polyline with arc lengths and its stop lines (sorted by `stop`).
+// A lane polyline with arc lengths: a closed ring or a car's open path.
 struct LaneRing {
   std::string name;
+  bool closed = true;     // a ring; otherwise an open path whose arc length is clamped
   std::vector<Vec2> pts;  // closed: last == first
   std::vector<double> cum;
   double length = 0.0;
-  double inside_length = 0.0;  // length within the tile (both directions)
-  std::vector<StopLine> stops;
 
   void finish() {
     cum.assign(1, 0.0);
@@ -105,6 +104,7 @@ struct LaneRing {
     length = cum.back();
   }
   double wrap(double s) const {
+    if (!closed) return std::clamp(s, 0.0, length);
     double m = std::fmod(s, length);
     return m < 0 ? m + length : m;
   }
@@ -271,14 +271,70 @@ std::vector<Sample> simplify(const std::vector<double>& s, double dt, const Lane
   return keep;
 }
 
+// What a lane piece is: a link between boxes (or a box and the tile's end), a connector across
+// a box (straight on, or a turn) or a loop beyond the tile.
+enum class PieceKind { kLink, kThrough, kLeft, kRight, kLoop };
+
+// A piece of a directed lane; cars drive paths of pieces, each starting where the last ends.
+struct Piece {
+  std::string name;
+  PieceKind kind = PieceKind::kLink;
+  std::vector<Vec2> pts;
+  double length = 0.0;
+  int intersection = -1;  // a connector's box
+  int axis = 0;           // the axis a connector is entered from
+  int next = -1;          // the piece after this one (a link before a box: see below)
+  int through = -1, left = -1, right = -1;  // a link before a box: its connectors
+
+  void finish() { length = geometry::polylineLength(pts); }
+};
+
 struct Car {
-  double s = 0.0;  // unwrapped arc length of the centre
+  double s = 0.0;  // arc length of the centre along its path
   double v = 0.0;
   double v0 = 12.0;
   double length = 4.5;
-  int committed = -1;  // stop line the car crosses on yellow
-  std::size_t out = 0;
+  long committed = -1;         // path index of the link whose stop line the car crosses on yellow
+  std::vector<int> path;       // pieces, drawn as the car goes
+  std::vector<double> base;    // arc length at which each path piece starts
+  std::size_t at = 0;          // path index of the piece under the centre
+  std::uint64_t turn_rng = 0;  // state of the car's own stream of turn choices
 };
+
+// Whether a turn at `si` from `axis` may start at t: during the first part of the axis' arrow,
+// so that the turning car clears the box before the axis' through traffic gets green. A right
+// turn may also start on the cross street's arrow: its curve meets none of the left turns then.
+bool turnOpen(const SignalPlan& plan, const SignalizedIntersection& si, int axis, PieceKind kind,
+              double t) {
+  for (int a = 0; a < 2; ++a) {
+    if (a != axis && kind != PieceKind::kRight) continue;
+    if (plan.state(si, a, t) != SignalState::kLeftArrow) continue;
+    const double c = plan.cycle();
+    double tau = std::fmod(t - si.offset - (a == 1 ? 0.5 * c : 0.0), c);
+    if (tau < 0) tau += c;
+    if (tau <= plan.left - kTurnClose) return true;
+  }
+  return false;
+}
+
+// Whether an arrow that lets a turn of `kind` from `axis` go shows at t.
+bool turnArrow(const SignalPlan& plan, const SignalizedIntersection& si, int axis, PieceKind kind,
+               double t) {
+  return plan.state(si, axis, t) == SignalState::kLeftArrow ||
+         (kind == PieceKind::kRight && plan.state(si, 1 - axis, t) == SignalState::kLeftArrow);
+}
+
+// The open polyline of a car's path: its pieces' points joined end to start.
+LaneRing pathLine(const std::vector<TrafficEpisode::Lane>& lanes, const std::vector<int>& path) {
+  LaneRing r;
+  r.closed = false;
+  for (int id : path) {
+    const auto& pts = lanes.at(static_cast<std::size_t>(id)).points;
+    r.pts.insert(r.pts.end(), pts.begin() + (r.pts.empty() ? 0 : 1), pts.end());
+  }
+  r.finish();
+  return r;
+}
 
 }  // namespace
 
@@ -369,227 +425,449 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
     }
   }
 
-  // ---------------------------------------------------------------- lanes
-  std::vector<LaneRing> rings;
+  // ---------------------------------------------------------------- lane pieces
+  // Every directed lane of every arterial corridor is cut at each signalised box into links
+  // (between boxes) and through connectors (across a box); at a box where two corridors cross,
+  // turn connectors join the inner lane to the inner lane on the left and the outer lane to the
+  // outer lane on the right; beyond each end of the tile a loop joins a lane to the opposite
+  // lane. A car drives a path of pieces, drawn turn by turn as it goes.
+  const bool turns = plan.left >= kTurnClose + 1.0;
+  std::vector<Piece> pieces;
+  auto addPiece = [&](Piece p) {
+    for (auto& q : p.pts) q = Vec2(roundMilli(q.x()), roundMilli(q.y()));
+    p.finish();
+    pieces.push_back(std::move(p));
+    return static_cast<int>(pieces.size()) - 1;
+  };
+  // Per signalised node: the directed lanes through it (their link before the box, through
+  // connector and link after it, the box's entry and exit points and the lane's direction).
+  struct Approach {
+    int corridor = 0, dir = 0, lane = 0, axis = 0;
+    int link_in = -1, through = -1, link_out = -1;
+    Vec2 entry, exit, u;
+  };
+  std::map<int, std::vector<Approach>> at_node;
   const std::vector<Corridor> corridors = arterialCorridors(world);
+  // Circuits: the pieces of the straight ring of each corridor lane (forward, loop, back, loop),
+  // along which the cars start.
+  std::vector<std::vector<int>> circuits;
+  double inside_total = 0.0;
   for (std::size_t ci = 0; ci < corridors.size(); ++ci) {
     const Corridor& c = corridors[ci];
     std::vector<Vec2> centre;
     for (int n : c.nodes) centre.push_back(world.nodes()[n].position);
-    std::vector<Vec2> back(centre.rbegin(), centre.rend());
     const double inside = geometry::polylineLength(centre);
+    const int other = 1 - c.axis;
     for (int lane = 0; lane < 2; ++lane) {
       const double r = (0.5 + lane) * kLaneWidth;
-      LaneRing ring;
-      ring.name = "lane_" + std::to_string(ci + 1) + "_" + std::to_string(lane + 1);
-      const std::vector<Vec2> fwd = offsetRight(centre, r), rev = offsetRight(back, r);
-      std::vector<std::size_t> fwd_at, rev_at;
-      for (const auto& p : fwd) {
-        fwd_at.push_back(ring.pts.size());
-        ring.pts.push_back(p);
-      }
-      appendLoop(centre.back(), (centre.back() - centre[centre.size() - 2]).normalized(), r, lane,
-                 &ring.pts);
-      for (const auto& p : rev) {
-        rev_at.push_back(ring.pts.size());
-        ring.pts.push_back(p);
-      }
-      appendLoop(back.back(), (back.back() - back[back.size() - 2]).normalized(), r, lane,
-                 &ring.pts);
-      ring.pts.push_back(ring.pts.front());
-      // Rounded as written, so that the cars are simulated on the polyline a reader decodes.
-      for (auto& p : ring.pts) p = Vec2(roundMilli(p.x()), roundMilli(p.y()));
-      ring.finish();
-      ring.inside_length = 2.0 * inside;
-      const int other = 1 - c.axis;
-      for (std::size_t k = 0; k < c.nodes.size(); ++k) {
-        const int si = signal_of[c.nodes[k]];
-        if (si < 0) continue;
-        const double half = 0.5 * plan.intersections[si].width[other] + sw;
-        for (double s_node : {ring.cum[fwd_at[k]], ring.cum[rev_at[c.nodes.size() - 1 - k]]}) {
-          ring.stops.push_back({s_node - half - kStopBack, s_node + half, si, c.axis});
+      std::vector<int> first(2), last(2);
+      std::vector<std::vector<int>> runs(2);
+      for (int dir = 0; dir < 2; ++dir) {
+        std::vector<int> nodes = c.nodes;
+        std::vector<Vec2> line = centre;
+        if (dir == 1) {
+          std::reverse(nodes.begin(), nodes.end());
+          std::reverse(line.begin(), line.end());
         }
+        std::vector<Vec2> p = offsetRight(line, r);
+        for (auto& q : p) q = Vec2(roundMilli(q.x()), roundMilli(q.y()));
+        std::vector<double> cum{0.0};
+        for (std::size_t i = 1; i < p.size(); ++i)
+          cum.push_back(cum.back() + (p[i] - p[i - 1]).norm());
+        auto pointAt = [&](double s) {
+          std::size_t k = 0;
+          while (k + 2 < p.size() && cum[k + 1] < s) ++k;
+          const double u = (s - cum[k]) / std::max(1e-9, cum[k + 1] - cum[k]);
+          const Vec2 q = p[k] + u * (p[k + 1] - p[k]);
+          return Vec2(roundMilli(q.x()), roundMilli(q.y()));
+        };
+        // The sub-polyline from a to b (arc lengths), its ends the given points.
+        auto slice = [&](double a, const Vec2& pa, double b, const Vec2& pb) {
+          std::vector<Vec2> out{pa};
+          for (std::size_t i = 0; i < p.size(); ++i) {
+            if (cum[i] > a + 1e-6 && cum[i] < b - 1e-6) out.push_back(p[i]);
+          }
+          out.push_back(pb);
+          return out;
+        };
+        const std::string tag =
+            std::to_string(ci + 1) + (dir == 0 ? "f" : "b") + std::to_string(lane + 1);
+        double s_from = 0.0;
+        Vec2 p_from = p.front();
+        int prev = -1;
+        auto link = [&](int piece) {
+          if (prev >= 0) pieces[prev].next = piece;
+          prev = piece;
+          runs[dir].push_back(piece);
+        };
+        for (std::size_t k = 1; k + 1 < nodes.size(); ++k) {
+          const int si = signal_of[nodes[k]];
+          if (si < 0) continue;
+          const double half = 0.5 * plan.intersections[si].width[other] + sw;
+          const double se = cum[k] - half, sx = cum[k] + half;
+          const Vec2 pe = pointAt(se), px = pointAt(sx);
+          Piece in;
+          in.name = "link_" + tag + "_" + std::to_string(runs[dir].size() / 2 + 1);
+          in.pts = slice(s_from, p_from, se, pe);
+          in.kind = PieceKind::kLink;
+          const int in_id = addPiece(std::move(in));
+          link(in_id);
+          Piece th;
+          th.name = "through_" + tag + "_" + plan.intersections[si].id;
+          th.pts = slice(se, pe, sx, px);
+          th.kind = PieceKind::kThrough;
+          th.intersection = si;
+          th.axis = c.axis;
+          const int th_id = addPiece(std::move(th));
+          pieces[in_id].through = th_id;
+          link(th_id);
+          Approach a;
+          a.corridor = static_cast<int>(ci);
+          a.dir = dir;
+          a.lane = lane;
+          a.axis = c.axis;
+          a.link_in = in_id;
+          a.through = th_id;
+          a.entry = pe;
+          a.exit = px;
+          a.u = (p[k + 1] - p[k - 1]).normalized();
+          at_node[nodes[k]].push_back(a);
+          s_from = sx;
+          p_from = px;
+        }
+        Piece out;
+        out.name = "link_" + tag + "_" + std::to_string(runs[dir].size() / 2 + 1);
+        out.pts = slice(s_from, p_from, cum.back(), p.back());
+        out.kind = PieceKind::kLink;
+        link(addPiece(std::move(out)));
+        for (auto& node_approaches : at_node) {
+          for (auto& a : node_approaches.second) {
+            if (a.corridor == static_cast<int>(ci) && a.dir == dir && a.lane == lane &&
+                a.link_out < 0) {
+              a.link_out = pieces[a.through].next;
+            }
+          }
+        }
+        first[dir] = runs[dir].front();
+        last[dir] = runs[dir].back();
       }
-      std::sort(ring.stops.begin(), ring.stops.end(),
-                [](const StopLine& a, const StopLine& b) { return a.stop < b.stop; });
-      rings.push_back(std::move(ring));
+      for (int dir = 0; dir < 2; ++dir) {
+        const Piece& a = pieces[last[dir]];
+        const Vec2 end = a.pts.back();
+        const std::vector<Vec2>& line =
+            dir == 0 ? centre : std::vector<Vec2>(centre.rbegin(), centre.rend());
+        Piece loop;
+        loop.name =
+            "loop_" + std::to_string(ci + 1) + (dir == 0 ? "f" : "b") + std::to_string(lane + 1);
+        loop.kind = PieceKind::kLoop;
+        loop.pts.push_back(end);
+        appendLoop(line.back(), (line.back() - line[line.size() - 2]).normalized(), r, lane,
+                   &loop.pts);
+        loop.pts.push_back(pieces[first[1 - dir]].pts.front());
+        const int id = addPiece(std::move(loop));
+        pieces[last[dir]].next = id;
+        pieces[id].next = first[1 - dir];
+      }
+      std::vector<int> circuit = runs[0];
+      circuit.push_back(pieces[last[0]].next);
+      circuit.insert(circuit.end(), runs[1].begin(), runs[1].end());
+      circuit.push_back(pieces[last[1]].next);
+      circuits.push_back(std::move(circuit));
+      inside_total += 2.0 * inside;
     }
   }
-  double inside_total = 0.0;
-  for (const auto& r : rings) {
-    inside_total += r.inside_length;
-    out.lanes.push_back({r.name, r.pts});
+  // Turn connectors: a cubic Bezier from the box's entry on one lane to its exit on the other.
+  for (auto& [node, approaches] : at_node) {
+    for (auto& a : approaches) {
+      for (const auto& b : approaches) {
+        if (b.axis == a.axis || b.lane != a.lane || !turns) continue;
+        const double cross = a.u.x() * b.u.y() - a.u.y() * b.u.x();
+        const bool left = cross > 0.5, right = cross < -0.5;
+        if (!(a.lane == 0 ? left : right)) continue;
+        const double k = 0.39 * (b.exit - a.entry).norm();
+        const Vec2 c1 = a.entry + k * a.u, c2 = b.exit - k * b.u;
+        Piece tp;
+        tp.name = std::string(left ? "left_" : "right_") + pieces[a.through].name.substr(8);
+        tp.kind = left ? PieceKind::kLeft : PieceKind::kRight;
+        tp.intersection = pieces[a.through].intersection;
+        tp.axis = a.axis;
+        tp.next = b.link_out;
+        constexpr int kSteps = 12;
+        for (int i = 0; i <= kSteps; ++i) {
+          const double u = static_cast<double>(i) / kSteps, w = 1.0 - u;
+          tp.pts.push_back(i == 0        ? a.entry
+                           : i == kSteps ? b.exit
+                                         : w * w * w * a.entry + 3 * w * w * u * c1 +
+                                               3 * w * u * u * c2 + u * u * u * b.exit);
+        }
+        const int id = addPiece(std::move(tp));
+        (left ? pieces[a.link_in].left : pieces[a.link_in].right) = id;
+      }
+    }
   }
+  for (const auto& p : pieces) out.lanes.push_back({p.name, p.pts});
 
   // ---------------------------------------------------------------- cars
   const int car_bound = cityCarBound(world);
   const double steps_warm = std::ceil(idm.warm_up / idm.step);
   const std::size_t steps = static_cast<std::size_t>(std::ceil(duration / idm.step));
   const double sqrt_ab = std::sqrt(idm.max_accel * idm.comfort_decel);
-  for (std::size_t ri = 0; ri < rings.size() && inside_total > 0; ++ri) {
-    const LaneRing& ring = rings[ri];
-    const double want = cp.vehicles_per_km2 * area_km2 * ring.length / inside_total;
+  std::vector<Car> cars;
+  std::vector<const catalog::CarModel*> models;
+  std::vector<std::string> colors;
+  for (std::size_t ri = 0; ri < circuits.size() && inside_total > 0; ++ri) {
+    const std::vector<int>& circuit = circuits[ri];
+    std::vector<double> starts{0.0};
+    for (int id : circuit) starts.push_back(starts.back() + pieces[id].length);
+    const double length = starts.back();
+    const double want = cp.vehicles_per_km2 * area_km2 * length / inside_total;
     int n = static_cast<int>(std::floor(want + rng.unit()));
-    n = std::min(n, static_cast<int>(ring.length / 15.0));
-    std::vector<Car> cars;
-    std::vector<const catalog::CarModel*> models;
-    std::vector<std::string> colors;
-    const double base = n > 0 ? ring.length / n : 0.0;
-    auto inZone = [&](double s, double half_len) {
-      for (const auto& st : ring.stops) {
-        if (ring.wrap(s) + half_len > st.stop - 0.5 && ring.wrap(s) - half_len < st.exit + 0.5)
-          return &st;
+    n = std::min(n, static_cast<int>(length / 15.0));
+    const double base = n > 0 ? length / n : 0.0;
+    // A box on the circuit that a car's body at s would touch.
+    auto inZone = [&](double s, double half_len) -> double {
+      for (std::size_t q = 0; q + 1 < circuit.size(); ++q) {
+        if (pieces[circuit[q + 1]].kind != PieceKind::kThrough) continue;
+        const double stop = starts[q + 1] - kStopBack, exit = starts[q + 2];
+        if (s + half_len > stop - 0.5 && s - half_len < exit + 0.5) return stop;
       }
-      return static_cast<const StopLine*>(nullptr);
+      return -1.0;
     };
+    std::vector<double> placed;
+    const std::size_t first_car = cars.size();
     for (int i = 0; i < n; ++i) {
       Car car;
       const catalog::CarModel& m = catalog::pickModel(rng);
       const std::string color = catalog::pick(rng, catalog::carColors());
       car.length = m.length;
       car.v0 = rng.uniform(11.0, 14.0);
-      car.s = i * base + rng.uniform(0.0, 0.4 * base);
-      if (const StopLine* st = inZone(car.s, 0.5 * car.length))
-        car.s = st->stop - 0.5 * car.length - 0.5;
-      if (!cars.empty() && car.s - cars.back().s < 0.5 * (car.length + cars.back().length) + 8.0)
+      double s = i * base + rng.uniform(0.0, 0.4 * base);
+      const double stop = inZone(s, 0.5 * car.length);
+      if (stop >= 0) s = stop - 0.5 * car.length - 0.5;
+      if (!placed.empty() && s - placed.back() < 0.5 * (car.length + cars.back().length) + 8.0)
         continue;
-      cars.push_back(car);
+      std::size_t q = 0;
+      while (q + 1 < circuit.size() && starts[q + 1] <= s) ++q;
+      car.path.push_back(circuit[q]);
+      car.base.push_back(0.0);
+      car.s = s - starts[q];
+      placed.push_back(s);
+      cars.push_back(std::move(car));
       models.push_back(&m);
       colors.push_back(color);
     }
-    if (cars.size() >= 2) {
-      const Car& f = cars.front();
-      const Car& l = cars.back();
-      if (f.s + ring.length - l.s < 0.5 * (f.length + l.length) + 8.0) {
-        cars.pop_back();
-        models.pop_back();
-        colors.pop_back();
+    // The last car of the circuit keeps its distance to the first one around the loop.
+    if (placed.size() >= 2 && placed.front() + length - placed.back() <
+                                  0.5 * (cars[first_car].length + cars.back().length) + 8.0) {
+      cars.pop_back();
+      models.pop_back();
+      colors.pop_back();
+    }
+  }
+  const std::size_t nc = cars.size();
+  for (std::size_t i = 0; i < nc; ++i) {
+    cars[i].turn_rng = deriveSeed(seed, 0x5455524E00000000ULL + i);
+  }
+  // Appends pieces to the car's path until it reaches `ahead` metres beyond its centre.
+  auto extend = [&](Car& c, double ahead) {
+    while (c.base.back() + pieces[c.path.back()].length < c.s + ahead) {
+      const Piece& p = pieces[c.path.back()];
+      int next = p.next;
+      if (p.through >= 0) {
+        next = p.through;
+        Rng r(c.turn_rng);
+        c.turn_rng = r.next();
+        const double u = r.unit();
+        if (p.left >= 0 && u < kLeftTurnProbability) next = p.left;
+        if (p.right >= 0 && u < kRightTurnProbability) next = p.right;
+      }
+      c.base.push_back(c.base.back() + p.length);
+      c.path.push_back(next);
+    }
+  };
+  for (auto& c : cars) extend(c, kLookAhead + 50.0);
+  std::vector<std::vector<double>> track(nc);
+  struct Occupant {
+    std::size_t car;
+    double rel;  // the car's centre from the piece's start (m)
+  };
+  std::vector<std::vector<Occupant>> occupants(pieces.size());
+  struct Step {
+    double s = 0.0, v = 0.0;
+    long committed = -1;
+  };
+  std::vector<Step> next(nc);
+  for (std::size_t k = 0; k <= static_cast<std::size_t>(steps_warm) + steps; ++k) {
+    const double t = (static_cast<double>(k) - steps_warm) * idm.step;
+    if (t >= -1e-9) {
+      for (std::size_t i = 0; i < nc; ++i) track[i].push_back(cars[i].s);
+    }
+    if (k == static_cast<std::size_t>(steps_warm) + steps) break;
+    for (auto& o : occupants) o.clear();
+    for (std::size_t i = 0; i < nc; ++i) {
+      const Car& c = cars[i];
+      const double rear = c.s - 0.5 * c.length, front = c.s + 0.5 * c.length;
+      for (std::size_t q = c.at > 0 ? c.at - 1 : 0; q < c.path.size(); ++q) {
+        if (c.base[q] > front) break;
+        if (c.base[q] + pieces[c.path[q]].length < rear) continue;
+        occupants[c.path[q]].push_back({i, c.s - c.base[q]});
       }
     }
-    const std::size_t nc = cars.size();
-    if (nc == 0) continue;
-    std::vector<std::vector<double>> track(nc);
-    std::vector<Car> next = cars;
-    for (std::size_t k = 0; k <= static_cast<std::size_t>(steps_warm) + steps; ++k) {
-      const double t = (static_cast<double>(k) - steps_warm) * idm.step;
-      if (t >= -1e-9) {
-        for (std::size_t i = 0; i < nc; ++i) track[i].push_back(cars[i].s);
-      }
-      if (k == static_cast<std::size_t>(steps_warm) + steps) break;
-      for (std::size_t i = 0; i < nc; ++i) {
-        const Car& c = cars[i];
-        const Car& lead = cars[(i + 1) % nc];
-        double lead_s = lead.s;
-        if (i + 1 == nc) lead_s += ring.length;
-        const double gap = nc == 1 ? 1e9 : lead_s - c.s - 0.5 * (c.length + lead.length);
-        const double lead_v = nc == 1 ? c.v : lead.v;
-        // The next stop line ahead of the front.
-        const double front = c.s + 0.5 * c.length;
-        double dist = 1e9;
-        int stop_idx = -1;
-        if (!ring.stops.empty()) {
-          const double fw = ring.wrap(front);
-          auto it = std::lower_bound(ring.stops.begin(), ring.stops.end(), fw,
-                                     [](const StopLine& s, double v) { return s.stop < v; });
-          double lap = 0.0;
-          if (it == ring.stops.end()) {
-            it = ring.stops.begin();
-            lap = ring.length;
+    for (std::size_t i = 0; i < nc; ++i) {
+      const Car& c = cars[i];
+      const double front = c.s + 0.5 * c.length;
+      // The car ahead on the path: the nearest centre ahead of this one on the pieces to come.
+      double gap = 1e9, lead_v = c.v;
+      bool has_lead = false;
+      for (std::size_t q = c.at > 0 ? c.at - 1 : 0; q < c.path.size(); ++q) {
+        if (c.base[q] > front + kLookAhead) break;
+        for (const Occupant& o : occupants[c.path[q]]) {
+          if (o.car == i) continue;
+          const double centre = c.base[q] + o.rel;
+          if (centre <= c.s) continue;
+          const double g = centre - 0.5 * cars[o.car].length - front;
+          if (g < gap) {
+            gap = g;
+            lead_v = cars[o.car].v;
+            has_lead = true;
           }
-          stop_idx = static_cast<int>(it - ring.stops.begin());
-          dist = it->stop + lap - fw;
         }
-        bool blocked = false;
-        // A commitment holds for the stop line it was made at, until the car has passed it
-        // (a stale one would let the car run the same signal's yellow a lap later).
-        int commit = c.committed == stop_idx ? c.committed : -1;
-        if (stop_idx >= 0 && dist < 200.0) {
-          const StopLine& st = ring.stops[stop_idx];
-          const SignalState state = plan.state(plan.intersections[st.intersection], st.axis, t);
+      }
+      // The next stop line ahead of the front: the end of a link before a box, less kStopBack.
+      double dist = 1e9, box = 0.0;
+      std::size_t stop_q = 0;
+      bool has_stop = false;
+      for (std::size_t q = c.at > 0 ? c.at - 1 : 0; q + 1 < c.path.size(); ++q) {
+        const Piece& nx = pieces[c.path[q + 1]];
+        if (nx.intersection < 0) continue;
+        const double stop = c.base[q + 1] - kStopBack;
+        if (stop < front) continue;
+        dist = stop - front;
+        box = nx.length;
+        stop_q = q;
+        has_stop = true;
+        break;
+      }
+      bool blocked = false;
+      // A commitment holds for the stop line it was made at, until the car has passed it.
+      long commit = c.committed == static_cast<long>(stop_q) && has_stop ? c.committed : -1;
+      if (has_stop && dist < 200.0) {
+        const Piece& conn = pieces[c.path[stop_q + 1]];
+        const auto& si = plan.intersections[conn.intersection];
+        if (conn.kind == PieceKind::kThrough) {
+          const SignalState state = plan.state(si, conn.axis, t);
           if (state == SignalState::kRed || state == SignalState::kLeftArrow) {
             blocked = true;
-          } else if (state == SignalState::kYellow && commit != stop_idx) {
+          } else if (state == SignalState::kYellow && commit != static_cast<long>(stop_q)) {
             if (dist >= c.v * c.v / (2.0 * idm.yellow_stop_decel) - 1e-9) {
               blocked = true;
             } else {
-              commit = stop_idx;
+              commit = static_cast<long>(stop_q);
             }
           }
-          // Do not enter the box without room behind the leader beyond it.
-          const double box = st.exit - st.stop;
-          if (!blocked && commit != stop_idx && nc > 1 && gap > dist &&
-              gap + 3.0 * lead_v < dist + box + c.length + idm.min_gap) {
-            blocked = true;
-          }
+        } else if (!turnOpen(plan, si, conn.axis, conn.kind, t)) {
+          blocked = true;
         }
-        auto idmAccel = [&](double s_gap, double dv, double s0) {
-          const double s_star = s0 + std::max(0.0, c.v * idm.time_gap + c.v * dv / (2.0 * sqrt_ab));
-          const double g = std::max(s_gap, 0.01);
-          return -idm.max_accel * (s_star / g) * (s_star / g);
-        };
-        const double r = c.v / c.v0;
-        double acc = idm.max_accel * (1.0 - r * r * r * r);
-        if (nc > 1) acc += idmAccel(gap, c.v - lead_v, idm.min_gap);
-        if (blocked) {
-          acc = std::min(acc, idm.max_accel * (1.0 - r * r * r * r) + idmAccel(dist, c.v, 0.5));
+        // Do not enter the box without room behind the leader beyond it.
+        if (!blocked && commit != static_cast<long>(stop_q) && has_lead && gap > dist &&
+            gap + 3.0 * lead_v < dist + box + c.length + idm.min_gap) {
+          blocked = true;
         }
-        acc = std::max(acc, -9.0);
-        double v1 = c.v + acc * idm.step;
-        double ds = 0.0;
-        if (v1 < 0) {
-          ds = acc < 0 ? c.v * c.v / (-2.0 * acc) : 0.0;
-          v1 = 0.0;
-        } else {
-          ds = 0.5 * (c.v + v1) * idm.step;
-        }
-        if (nc > 1 && ds > std::max(0.0, gap - idm.min_gap)) {
-          ds = std::max(0.0, gap - idm.min_gap);
-          v1 = std::min(v1, lead_v);
-        }
-        if (blocked && ds > std::max(0.0, dist)) {
-          ds = std::max(0.0, dist);
-          v1 = 0.0;
-        }
-        // A car past its stop line but short of the box (it went on yellow and was slowed by the
-        // car ahead) stays kGuard short of the box while its signal is red at the end of the
-        // step (kGuard: more than the written trajectories' tolerance).
-        if (!ring.stops.empty()) {
-          const double fw = ring.wrap(front);
-          for (const StopLine& st : ring.stops) {
-            const double entry = st.stop + kStopBack, guard = entry - kGuard;
-            if (fw <= st.stop || fw > entry || fw + ds <= guard) continue;
-            const SignalState end_state =
-                plan.state(plan.intersections[st.intersection], st.axis, t + idm.step);
-            if (end_state == SignalState::kRed || end_state == SignalState::kLeftArrow) {
-              ds = std::max(0.0, guard - fw);
-              v1 = 0.0;
-            }
-          }
-        }
-        Car& nx = next[i];
-        nx = c;
-        nx.s = c.s + ds;
-        nx.v = v1;
-        nx.committed = commit;
       }
-      cars.swap(next);
+      auto idmAccel = [&](double s_gap, double dv, double s0) {
+        const double s_star = s0 + std::max(0.0, c.v * idm.time_gap + c.v * dv / (2.0 * sqrt_ab));
+        const double g = std::max(s_gap, 0.01);
+        return -idm.max_accel * (s_star / g) * (s_star / g);
+      };
+      const double r = c.v / c.v0;
+      double acc = idm.max_accel * (1.0 - r * r * r * r);
+      if (has_lead) acc += idmAccel(gap, c.v - lead_v, idm.min_gap);
+      if (blocked) {
+        acc = std::min(acc, idm.max_accel * (1.0 - r * r * r * r) + idmAccel(dist, c.v, 0.5));
+      }
+      acc = std::max(acc, -9.0);
+      double v1 = c.v + acc * idm.step;
+      double ds = 0.0;
+      if (v1 < 0) {
+        ds = acc < 0 ? c.v * c.v / (-2.0 * acc) : 0.0;
+        v1 = 0.0;
+      } else {
+        ds = 0.5 * (c.v + v1) * idm.step;
+      }
+      if (has_lead && ds > std::max(0.0, gap - idm.min_gap)) {
+        ds = std::max(0.0, gap - idm.min_gap);
+        v1 = std::min(v1, lead_v);
+      }
+      if (blocked && ds > std::max(0.0, dist)) {
+        ds = std::max(0.0, dist);
+        v1 = 0.0;
+      }
+      // A car past its stop line but short of the box (it went on yellow and was slowed by the
+      // car ahead, or its turn's window closed) stays kGuard short of the box while its signal
+      // does not let it in at the end of the step (kGuard: more than the written trajectories'
+      // tolerance).
+      for (std::size_t q = c.at > 0 ? c.at - 1 : 0; q + 1 < c.path.size(); ++q) {
+        const Piece& conn = pieces[c.path[q + 1]];
+        if (c.base[q + 1] > front + kStopBack + 1.0) break;
+        if (conn.intersection < 0) continue;
+        const double entry = c.base[q + 1], stop = entry - kStopBack, guard = entry - kGuard;
+        if (front <= stop || front > entry || front + ds <= guard) continue;
+        const auto& si = plan.intersections[conn.intersection];
+        bool closed = false;
+        if (conn.kind == PieceKind::kThrough) {
+          const SignalState end_state = plan.state(si, conn.axis, t + idm.step);
+          closed = end_state == SignalState::kRed || end_state == SignalState::kLeftArrow;
+        } else {
+          closed = !turnArrow(plan, si, conn.axis, conn.kind, t + idm.step);
+        }
+        if (closed) {
+          ds = std::max(0.0, guard - front);
+          v1 = 0.0;
+        }
+      }
+      Step& nx = next[i];
+      nx.s = c.s + ds;
+      nx.v = v1;
+      nx.committed = commit;
     }
     for (std::size_t i = 0; i < nc; ++i) {
-      TrafficEpisode::Car car;
-      car.vehicle_class = models[i]->vehicle_class;
-      car.make = models[i]->make;
-      car.model = models[i]->model;
-      car.color = colors[i];
-      car.size = Vec3(models[i]->length, models[i]->width, models[i]->height);
-      car.lane = static_cast<int>(ri);
-      for (const Sample& q : simplify(track[i], idm.step, ring, 0.1)) {
-        const double t = roundMilli(q.t);
-        if (!car.knots.empty() && t <= car.knots[car.knots.size() - 2]) continue;
-        car.knots.push_back(t);
-        car.knots.push_back(roundMilli(q.s));
-      }
-      out.cars.push_back(std::move(car));
+      Car& c = cars[i];
+      c.s = next[i].s;
+      c.v = next[i].v;
+      c.committed = next[i].committed;
+      extend(c, kLookAhead + 50.0);
+      while (c.at + 1 < c.path.size() && c.base[c.at + 1] <= c.s) ++c.at;
     }
+  }
+  for (std::size_t i = 0; i < nc; ++i) {
+    const Car& c = cars[i];
+    TrafficEpisode::Car car;
+    car.vehicle_class = models[i]->vehicle_class;
+    car.make = models[i]->make;
+    car.model = models[i]->model;
+    car.color = colors[i];
+    car.size = Vec3(models[i]->length, models[i]->width, models[i]->height);
+    // The pieces the car drives over the episode, with a margin behind and ahead.
+    const double lo = track[i].front() - 10.0, hi = track[i].back() + 10.0;
+    std::size_t a = 0, b = c.path.size();
+    while (a + 1 < c.path.size() && c.base[a + 1] <= lo) ++a;
+    for (std::size_t q = a; q < c.path.size(); ++q) {
+      if (c.base[q] > hi) {
+        b = q;
+        break;
+      }
+    }
+    car.path.assign(c.path.begin() + static_cast<long>(a), c.path.begin() + static_cast<long>(b));
+    std::vector<double> s = track[i];
+    for (double& v : s) v -= c.base[a];
+    const LaneRing line = pathLine(out.lanes, car.path);
+    for (const Sample& q : simplify(s, idm.step, line, 0.1)) {
+      const double tk = roundMilli(q.t);
+      if (!car.knots.empty() && tk <= car.knots[car.knots.size() - 2]) continue;
+      car.knots.push_back(tk);
+      car.knots.push_back(roundMilli(q.s));
+    }
+    out.cars.push_back(std::move(car));
   }
   if (static_cast<int>(out.cars.size()) > car_bound) {
     throw GenerationError("city traffic: " + std::to_string(out.cars.size()) +
@@ -627,18 +905,10 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
   return out;
 }
 
-LaneRing ringOf(const TrafficEpisode::Lane& lane) {
-  LaneRing r;
-  r.name = lane.name;
-  r.pts = lane.points;
-  r.finish();
-  return r;
-}
-
-// Knots [from, to) of `car` decoded along its ring.
+// Knots [from, to) of `car` decoded along its path.
 Trajectory decodeKnots(const TrafficEpisode& e, const TrafficEpisode::Car& car, std::size_t from,
                        std::size_t to) {
-  const LaneRing ring = ringOf(e.lanes.at(static_cast<std::size_t>(car.lane)));
+  const LaneRing ring = pathLine(e.lanes, car.path);
   Trajectory out;
   out.reserve(to - from);
   for (std::size_t k = from; k < to; ++k) {
@@ -714,7 +984,7 @@ ScenarioEntity episodeCarEntity(const TrafficEpisode& e, std::size_t car, Trajec
   en.attributes.set("make", c.make);
   en.attributes.set("model", c.model);
   en.attributes.set("color", c.color);
-  en.attributes.set("lane", e.lanes.at(static_cast<std::size_t>(c.lane)).name);
+  en.attributes.set("lane", e.lanes.at(static_cast<std::size_t>(c.path.front())).name);
   const TrajectoryPoint p0 = window.empty() ? TrajectoryPoint{} : window.front();
   en.box = boxFromPose(Vec3(roundMilli(p0.x), roundMilli(p0.y), roundMilli(p0.z)),
                        roundMilli(geometry::wrapPi(p0.yaw)), c.size);

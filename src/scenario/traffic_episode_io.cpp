@@ -61,7 +61,9 @@ std::string trafficEpisodeJson(const TrafficEpisode& e) {
   w.key("cars").beginArray();
   for (const auto& c : e.cars) {
     w.beginObject();
-    w.key("lane").value(c.lane).key("vehicle_class").value(c.vehicle_class);
+    w.key("path").beginArray();
+    for (int p : c.path) w.value(p);
+    w.endArray().key("vehicle_class").value(c.vehicle_class);
     w.key("make").value(c.make).key("model").value(c.model).key("color").value(c.color);
     w.key("size").numbers({c.size.x(), c.size.y(), c.size.z()});
     w.key("knots").beginArray();
@@ -104,8 +106,8 @@ TrafficEpisode parseTrafficEpisode(const std::string& text, const std::string& f
     TrafficEpisode::Lane lane;
     lane.name = l.string("name");
     const std::vector<double> p = flatNumbers(l.array("points"), l.at("points"), file);
-    if (p.size() < 8 || p.size() % 2 != 0 || p[0] != p[p.size() - 2] || p[1] != p.back()) {
-      l.error("points", "expected a closed polyline x0, y0, x1, y1, ... of at least 4 points");
+    if (p.size() < 4 || p.size() % 2 != 0) {
+      l.error("points", "expected a polyline x0, y0, x1, y1, ... of at least 2 points");
     }
     for (std::size_t k = 0; k + 1 < p.size(); k += 2) lane.points.emplace_back(p[k], p[k + 1]);
     l.finish();
@@ -115,11 +117,26 @@ TrafficEpisode parseTrafficEpisode(const std::string& text, const std::string& f
   for (std::size_t i = 0; i < cars.size(); ++i) {
     Obj c(cars[i], idx("cars", i), file);
     TrafficEpisode::Car car;
-    const std::int64_t lane = c.integer("lane");
-    if (lane < 0 || lane >= static_cast<std::int64_t>(e.lanes.size())) {
-      c.error("lane", "expected a lane index from 0 to " + std::to_string(e.lanes.size() - 1));
+    const json& path = c.array("path");
+    if (path.empty()) c.error("path", "expected at least one lane piece");
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      if (!path[k].is_number_integer() || path[k].get<std::int64_t>() < 0 ||
+          path[k].get<std::int64_t>() >= static_cast<std::int64_t>(e.lanes.size())) {
+        throw ConfigError(file + ": " + idx(c.at("path"), k) +
+                          ": expected a lane index from 0 to " +
+                          std::to_string(e.lanes.size() - 1) + ", got " + path[k].dump());
+      }
+      const int id = path[k].get<int>();
+      if (k > 0) {
+        const auto& a = e.lanes[static_cast<std::size_t>(car.path.back())].points.back();
+        const auto& b = e.lanes[static_cast<std::size_t>(id)].points.front();
+        if ((a - b).norm() > 1e-6) {
+          throw ConfigError(file + ": " + idx(c.at("path"), k) +
+                            ": expected a lane piece that starts where the previous one ends");
+        }
+      }
+      car.path.push_back(id);
     }
-    car.lane = static_cast<int>(lane);
     car.vehicle_class = c.string("vehicle_class");
     car.make = c.string("make");
     car.model = c.string("model");

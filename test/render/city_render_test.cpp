@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "hameritt/generation/generator.h"
@@ -347,39 +348,59 @@ Eigen::Vector3d meanColour(const FrameSet& f, const RenderRequest& r, int instan
   return sum / std::max(n, 1);
 }
 
-TEST(CityRender, TrafficLightLampsFollowTheSignalPlan) {
-  // One signalised intersection beside the first mast, its axis 0 along the mast's x axis.
-  const auto& mast = firstOf(EntityClass::kTrafficLight, 0.0);
-  scenario::SimConfig cfg = citySimConfig();
-  scenario::SignalPlan plan;
+// A close-up of the first traffic-light mast's head, looking along axis 0 at its +x face, with
+// one signalised intersection beside the mast whose axis 0 runs along the mast's x axis.
+struct MastCloseUp {
+  const scenario::Entity& mast = firstOf(EntityClass::kTrafficLight, 0.0);
   scenario::SignalizedIntersection is;
-  is.id = "signal_00";
-  is.position = mast.box.center2() + geometry::Vec2(5.0, 5.0);
-  is.heading[0] = mast.box.yaw;
-  is.heading[1] = mast.box.yaw + 0.5 * M_PI;
-  is.width[0] = is.width[1] = 20.0;
-  plan.intersections = {is};
-  cfg.signals = plan;
-  Renderer renderer(cityWorld(), cfg);
-  // Times when axis 0 shows red, then green.
-  double t_red = -1, t_green = -1;
-  for (double t = 0.25; t < plan.cycle(); t += 0.5) {
-    const auto st = plan.state(is, 0, t);
-    if (t_red < 0 && st == scenario::SignalState::kRed) t_red = t;
-    if (t_green < 0 && st == scenario::SignalState::kGreen) t_green = t;
+  scenario::SignalPlan plan;
+  std::unique_ptr<Renderer> renderer;
+  RenderRequest r;
+  int id = -1;
+  double top = 0.0;
+
+  MastCloseUp() {
+    scenario::SimConfig cfg = citySimConfig();
+    is.id = "signal_00";
+    is.position = mast.box.center2() + geometry::Vec2(5.0, 5.0);
+    is.heading[0] = mast.box.yaw;
+    is.heading[1] = mast.box.yaw + 0.5 * M_PI;
+    is.width[0] = is.width[1] = 20.0;
+    plan.intersections = {is};
+    cfg.signals = plan;
+    renderer = std::make_unique<Renderer>(cityWorld(), cfg);
+    const Eigen::Vector3d x(std::cos(mast.box.yaw), std::sin(mast.box.yaw), 0.0);
+    const Eigen::Vector3d head(mast.box.center.x(), mast.box.center.y(), mast.box.maxZ() - 0.6);
+    r = request(head + 3.0 * x, head);
+    r.hidden_entities = allBut(mast.id);
+    id = renderer->instanceOf(mast.id);
+    top = mast.box.maxZ();
   }
+  // The first time (on a 0.5 s grid) at which axis 0 shows `state`, or -1.
+  double firstTime(scenario::SignalState state) const {
+    for (double t = 0.25; t < plan.cycle(); t += 0.5) {
+      if (plan.state(is, 0, t) == state) return t;
+    }
+    return -1.0;
+  }
+  FrameSet frameAt(double t) {
+    r.time = t;
+    return renderer->render(r);
+  }
+};
+
+TEST(CityRender, TrafficLightLampsFollowTheSignalPlan) {
+  MastCloseUp m;
+  // Times when axis 0 shows red, then green.
+  const double t_red = m.firstTime(scenario::SignalState::kRed);
+  const double t_green = m.firstTime(scenario::SignalState::kGreen);
   ASSERT_GE(t_red, 0.0);
   ASSERT_GE(t_green, 0.0);
-  // A close-up of the mast's head, looking along axis 0 at its +x face.
-  const Eigen::Vector3d x(std::cos(mast.box.yaw), std::sin(mast.box.yaw), 0.0);
-  const Eigen::Vector3d head(mast.box.center.x(), mast.box.center.y(), mast.box.maxZ() - 0.6);
-  RenderRequest r = request(head + 3.0 * x, head);
-  r.hidden_entities = allBut(mast.id);
-  const int id = renderer.instanceOf(mast.id);
-  const double top = mast.box.maxZ();
+  const RenderRequest& r = m.r;
+  const int id = m.id;
+  const double top = m.top;
   auto lamps = [&](double t) {
-    r.time = t;
-    const FrameSet f = renderer.render(r);
+    const FrameSet f = m.frameAt(t);
     // Red lamp (top 0.4 m) and green lamp (0.8-1.2 m below the top), away from the band edges.
     return std::make_pair(meanColour(f, r, id, top - 0.35, top - 0.05),
                           meanColour(f, r, id, top - 1.15, top - 0.85));
@@ -393,9 +414,70 @@ TEST(CityRender, TrafficLightLampsFollowTheSignalPlan) {
   EXPECT_GT(red_at_red.x(), 2.0 * red_at_red.y());          // red, not white
   EXPECT_GT(green_at_green.y(), 2.0 * green_at_green.x());  // green
   // Negative control: without a signal plan every lamp is dark at both times.
-  r.time = t_red;
-  const FrameSet f = cityRenderer().render(r);
+  m.r.time = t_red;
+  const FrameSet f = cityRenderer().render(m.r);
   EXPECT_LT(meanColour(f, r, id, top - 0.35, top - 0.05).x(), 0.5 * red_at_red.x());
+}
+
+// Share of an entity's pixels whose world height lies in [z0, z1), on the image's left (side <
+// 0) or right (side > 0) of the entity's mean column, that are lit green (G above 160 and
+// half as much again as R).
+double greenShare(const FrameSet& f, const RenderRequest& r, int instance, double z0, double z1,
+                  int side) {
+  const int w = r.intrinsics.width;
+  double cols = 0, n_all = 0;
+  forEachPixelHeight(f, r, instance, [&](std::size_t i, double) {
+    cols += static_cast<double>(i % static_cast<std::size_t>(w));
+    n_all += 1;
+  });
+  const double mid = cols / std::max(1.0, n_all);
+  int n = 0, lit = 0;
+  forEachPixelHeight(f, r, instance, [&](std::size_t i, double z) {
+    const double col = static_cast<double>(i % static_cast<std::size_t>(w));
+    if (z < z0 || z >= z1 || (side < 0 ? col >= mid : col < mid)) return;
+    ++n;
+    lit += f.rgb[3 * i + 1] > 160 && f.rgb[3 * i + 1] > 1.5 * f.rgb[3 * i];
+  });
+  EXPECT_GT(n, 15);
+  return static_cast<double>(lit) / std::max(n, 1);
+}
+
+TEST(CityRender, ProtectedLeftArrowShowsAGreenArrowBesideTheRedLamp) {
+  MastCloseUp m;
+  const double t_arrow = m.firstTime(scenario::SignalState::kLeftArrow);
+  const double t_red = m.firstTime(scenario::SignalState::kRed);
+  const double t_green = m.firstTime(scenario::SignalState::kGreen);
+  ASSERT_GE(t_arrow, 0.0);
+  ASSERT_GE(t_red, 0.0);
+  ASSERT_GE(t_green, 0.0);
+  struct Lamps {
+    double red = 0, left = 0, right = 0;  // red lamp's R; green share of the green lamp's halves
+  };
+  auto lamps = [&](double t) {
+    const FrameSet f = m.frameAt(t);
+    return Lamps{meanColour(f, m.r, m.id, m.top - 0.35, m.top - 0.05).x(),
+                 greenShare(f, m.r, m.id, m.top - 1.15, m.top - 0.85, -1),
+                 greenShare(f, m.r, m.id, m.top - 1.15, m.top - 0.85, 1)};
+  };
+  const Lamps arrow = lamps(t_arrow), red = lamps(t_red), green = lamps(t_green);
+  std::printf(
+      "red lamp R: arrow %.0f, red %.0f, green %.0f; green share of the green lamp's left and "
+      "right halves: arrow %.2f %.2f, red %.2f %.2f, green %.2f %.2f\n",
+      arrow.red, red.red, green.red, arrow.left, arrow.right, red.left, red.right, green.left,
+      green.right);
+  // On the arrow the red lamp is lit, as on red, and not on green.
+  EXPECT_GT(arrow.red, 3.0 * green.red);
+  // The green lamp's place shows some green on the arrow, none on red (the negative control).
+  EXPECT_GT(arrow.left, 0.15);
+  EXPECT_LT(red.left + red.right, 0.02);
+  // An arrow pointing left, not the round lamp (the negative control, lit all over): its head
+  // makes more of the left half green than of the right.
+  EXPECT_GT(green.left, 0.9);
+  EXPECT_GT(green.right, 0.9);
+  EXPECT_LT(arrow.left, 0.6);
+  EXPECT_GT(arrow.left, 1.3 * arrow.right);
+  EXPECT_LT(green.left, 1.3 * green.right);  // the same criterion fails the round lamp
+  EXPECT_GT(arrow.right, 0.05);              // the shaft
 }
 
 }  // namespace

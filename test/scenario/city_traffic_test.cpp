@@ -71,7 +71,7 @@ struct OverlapReport {
 };
 
 // Overlaps of the cars' footprints, sampled every `dt`, and the smallest gap between cars of
-// one lane that follow each other (same heading).
+// one lane that follow each other (same heading, less than a metre apart across it).
 OverlapReport checkCars(const std::vector<ScenarioEntity>& cars, double duration, double dt) {
   OverlapReport r;
   std::vector<OrientedBox> boxes(cars.size());
@@ -96,8 +96,10 @@ OverlapReport checkCars(const std::vector<ScenarioEntity>& cars, double duration
                 ++r.overlaps;
                 continue;
               }
+              // One lane: the same heading, the centres less than a metre apart across it.
+              const Vec2 d = b.center2() - a.center2();
               const bool same_lane =
-                  cars[i].entity.attributes.str("lane") == cars[j].entity.attributes.str("lane");
+                  std::abs(std::cos(a.yaw) * d.y() - std::sin(a.yaw) * d.x()) < 1.0;
               if (same_lane && std::cos(a.yaw - b.yaw) > 0.95) {
                 ++r.close_pairs;
                 r.min_gap = std::min(r.min_gap, geometry::footprintDistance(a, b));
@@ -122,39 +124,73 @@ void localCoords(const SignalizedIntersection& i, int axis, const Vec2& p, doubl
 
 struct EntryReport {
   int entries = 0;
-  int on_red = 0;
+  int turns = 0;   // entries of cars that turn in the box
+  int on_red = 0;  // entries against the signal
 };
 
-// Entries of a car's front into an intersection box (its own carriageway, from the far side of
-// the crosswalk before the cross street to that after it), with the signal shown to the car's
-// axis at that moment.
+// Whether `front` lies in intersection si's box of `axis` (its carriageway, from the far side of
+// the crosswalk before the cross street to that after it).
+bool inBox(const SignalizedIntersection& si, const SignalPlan& plan, int axis, const Vec2& front) {
+  double along = 0, across = 0;
+  localCoords(si, axis, front, &along, &across);
+  return std::abs(along) < 0.5 * si.width[1 - axis] + plan.sidewalk &&
+         std::abs(across) < 0.5 * si.width[axis];
+}
+
+// Entries of a car's front into an intersection box from outside both streets' boxes, running
+// along the axis, with the signal shown to the car's axis at that moment. A car whose heading
+// has turned by more than 45 degrees when its front leaves the box turns: it may enter on the
+// left arrow only (a right turn: on either street's arrow); a car going straight on enters on
+// green or yellow. judge_turns = false judges
+// every entry as straight on (a negative control).
 EntryReport checkEntries(const std::vector<ScenarioEntity>& cars, const SignalPlan& plan,
-                         double duration, double dt) {
+                         double duration, double dt, bool judge_turns = true) {
   EntryReport r;
   for (const auto& car : cars) {
-    std::vector<char> was_in(plan.intersections.size() * 2, 0);
-    for (double t = 0.0; t <= duration; t += dt) {
+    const double half = 0.5 * car.entity.box.size.x();
+    auto frontAt = [&](double t, double* yaw) -> Vec2 {
       const TrajectoryPoint q = sampleTrajectory(car.trajectory, t);
-      const Vec2 front = Vec2(q.x, q.y) + 0.5 * car.entity.box.size.x() * unitOf(q.yaw);
+      *yaw = q.yaw;
+      return Vec2(q.x, q.y) + half * unitOf(q.yaw);
+    };
+    std::vector<char> was_in(plan.intersections.size(), 0);
+    for (double t = 0.0; t <= duration; t += dt) {
+      double yaw = 0;
+      const Vec2 front = frontAt(t, &yaw);
       for (std::size_t k = 0; k < plan.intersections.size(); ++k) {
         const auto& si = plan.intersections[k];
         if ((front - si.position).squaredNorm() > 60.0 * 60.0) {
-          was_in[2 * k] = was_in[2 * k + 1] = 0;
+          was_in[k] = 0;
           continue;
         }
-        for (int axis = 0; axis < 2; ++axis) {
-          if (std::abs(std::cos(q.yaw - si.heading[axis])) < 0.9) continue;
-          double along = 0, across = 0;
-          localCoords(si, axis, front, &along, &across);
-          const bool in = std::abs(along) < 0.5 * si.width[1 - axis] + plan.sidewalk &&
-                          std::abs(across) < 0.5 * si.width[axis];
-          if (in && !was_in[2 * k + axis]) {
+        const bool in0 = inBox(si, plan, 0, front), in1 = inBox(si, plan, 1, front);
+        if (!was_in[k]) {
+          for (int axis = 0; axis < 2; ++axis) {
+            if (!(axis == 0 ? in0 : in1) || std::abs(std::cos(yaw - si.heading[axis])) < 0.9)
+              continue;
+            // The heading when the front leaves the box again.
+            double yaw_out = yaw;
+            for (double u = t + dt; u <= duration; u += dt) {
+              const Vec2 f = frontAt(u, &yaw_out);
+              if (!inBox(si, plan, 0, f) && !inBox(si, plan, 1, f)) break;
+            }
+            const double turned = geometry::wrapPi(yaw_out - yaw);
+            const bool turning = judge_turns && std::abs(turned) > 0.25 * geometry::kPi;
             ++r.entries;
+            r.turns += turning;
             const SignalState st = plan.state(si, axis, t);
-            if (st != SignalState::kGreen && st != SignalState::kYellow) ++r.on_red;
+            const bool arrow = st == SignalState::kLeftArrow;
+            const bool cross_arrow = plan.state(si, 1 - axis, t) == SignalState::kLeftArrow;
+            if (!turning) {
+              r.on_red += st != SignalState::kGreen && st != SignalState::kYellow;
+            } else if (turned > 0) {
+              r.on_red += !arrow;  // left
+            } else {
+              r.on_red += !arrow && !cross_arrow;  // right: on either street's arrow
+            }
           }
-          was_in[2 * k + axis] = in;
         }
+        was_in[k] = in0 || in1;
       }
     }
   }
@@ -229,6 +265,41 @@ TEST(CityTraffic, CarsNeverOverlapAndKeepTheStandstillGap) {
   late[0].trajectory.front().t = 0.0;
   EXPECT_GT(checkCars(late, s.sim.duration, 0.05).overlaps, 0);
 
+  // Negative control on a curve: a copy of a turning car 0.4 s behind it, present only over the
+  // turn (10 km away otherwise), overlaps it.
+  std::vector<ScenarioEntity> turn_copy = traffic;
+  bool found_turn = false;
+  for (std::size_t i = 0; i < traffic.size() && !found_turn; ++i) {
+    const Trajectory& tr = traffic[i].trajectory;
+    for (double t = 3.0; t + 8.0 <= s.sim.duration && !found_turn; t += 1.0) {
+      const TrajectoryPoint a = sampleTrajectory(tr, t), b = sampleTrajectory(tr, t + 6.0);
+      if (!insideTile(cityWorld(), Vec2(a.x, a.y)) ||
+          std::abs(geometry::wrapPi(b.yaw - a.yaw)) < 1.2)
+        continue;
+      ScenarioEntity copy = traffic[i];
+      copy.entity.id += "_copy";
+      Trajectory ct;
+      TrajectoryPoint away = tr.front();
+      away.x += 1e4;
+      away.t = 0.0;
+      ct.push_back(away);
+      away.t = t - 2.001;
+      ct.push_back(away);
+      for (double u = t - 2.0; u <= t + 8.0 + 1e-9; u += 0.05) {
+        TrajectoryPoint p = sampleTrajectory(tr, u - 0.4);
+        p.t = u;
+        ct.push_back(p);
+      }
+      away.t = t + 8.1;
+      ct.push_back(away);
+      copy.trajectory = ct;
+      turn_copy.push_back(copy);
+      found_turn = true;
+    }
+  }
+  ASSERT_TRUE(found_turn);
+  EXPECT_GT(checkCars(turn_copy, s.sim.duration, 0.05).overlaps, 0);
+
   const OverlapReport r = checkCars(traffic, s.sim.duration, 0.05);
   EXPECT_EQ(r.overlaps, 0);
   EXPECT_GT(r.close_pairs, 1000);
@@ -250,9 +321,24 @@ TEST(CityTraffic, NoCarEntersAnIntersectionOnRed) {
   const EntryReport r = checkEntries(traffic, plan, s.sim.duration, 0.05);
   EXPECT_GE(plan.intersections.size(), 20u);
   EXPECT_GT(r.entries, 500);
+  EXPECT_GT(r.turns, 20);
   EXPECT_EQ(r.on_red, 0);
-  std::printf("intersections %zu, entries %d, on red %d (shifted plan: %d of %d)\n",
-              plan.intersections.size(), r.entries, r.on_red, wrong.on_red, wrong.entries);
+  // Negative controls of the turns: judged as going straight on, the turning cars enter on the
+  // arrow; with the plan moved on by the arrow's length, they enter on green.
+  const EntryReport straight = checkEntries(traffic, plan, s.sim.duration, 0.05, false);
+  EXPECT_EQ(straight.turns, 0);
+  EXPECT_GE(straight.on_red, r.turns);
+  SignalPlan early = plan;
+  for (auto& i : early.intersections)
+    i.offset = std::fmod(i.offset - plan.left + plan.cycle(), plan.cycle());
+  const EntryReport off_arrow = checkEntries(traffic, early, s.sim.duration, 0.05);
+  EXPECT_EQ(off_arrow.turns, r.turns);
+  EXPECT_GE(off_arrow.on_red, r.turns);
+  std::printf(
+      "intersections %zu, entries %d (turning %d), against the signal %d (shifted plan: %d of "
+      "%d; turns judged straight: %d; plan moved on by the arrow: %d)\n",
+      plan.intersections.size(), r.entries, r.turns, r.on_red, wrong.on_red, wrong.entries,
+      straight.on_red, off_arrow.on_red);
 }
 
 TEST(CityTraffic, PedestriansCrossOnTheSignalsAndNeverUnderACar) {

@@ -4,9 +4,10 @@ hameritt_generate --world city writes (numpy; nothing of hameritt's own readers)
 
   * every traffic car's trajectory, sampled every 0.1 s, against the signal timeline recomputed
     here from the written plan: no car's front enters an intersection box while its axis shows
-    red or the left arrow;
+    red, nor the left arrow when it goes straight on; a car that turns enters on the arrow only;
   * no two cars' footprints ever overlap (all pairs, every 0.1 s, separating-axis test), and a
-    follower in the same lane keeps the standstill gap and a time gap;
+    follower in the same lane (same heading, less than a metre across) keeps the standstill gap
+    and a time gap;
   * pedestrians who cross at a signal are on the carriageway only while its traffic is red;
     the share of jaywalkers among the crossers is the configured probability (3 sigma); some
     queue at the bus stops of the written world.json;
@@ -90,31 +91,53 @@ def car_states(cars, times):
     return np.array(xs), np.array(ys), np.array(yaws), size[:, 0], size[:, 1]
 
 
-def red_entries(cars, plan, times, states):
-    """(entries, entries on red or the left arrow): a car's front entering an intersection box
-    (its carriageway between the outer edges of the crosswalks) while it runs along the axis."""
+def red_entries(cars, plan, times, states, judge_turns=True):
+    """(entries, turning entries, entries against the signal): a car's front entering an
+    intersection box (its carriageway between the outer edges of the crosswalks, from outside
+    both streets' boxes) while it runs along the axis. A car whose heading has turned by more
+    than 45 degrees when its front leaves the box again turns: it may enter only on its axis'
+    left arrow (a right turn: on either street's arrow); a car going straight on enters on green
+    or yellow only. judge_turns=False judges
+    every entry as straight on (a negative control)."""
     xs, ys, yaws, lengths, _ = states
     fx = xs + 0.5 * lengths[:, None] * np.cos(yaws)
     fy = ys + 0.5 * lengths[:, None] * np.sin(yaws)
-    entries = bad = 0
+    entries = turns = bad = 0
     for inter in plan["intersections"]:
+        dx, dy = fx - inter["x"], fy - inter["y"]
+        if np.min(dx * dx + dy * dy) > 60.0 ** 2:
+            continue
+        boxes = []
         for axis in (0, 1):
             h = inter["heading"][axis]
             ux, uy = math.cos(h), math.sin(h)
-            dx, dy = fx - inter["x"], fy - inter["y"]
             along = dx * ux + dy * uy
             across = ux * dy - uy * dx
-            aligned = np.abs(np.cos(yaws - h)) > 0.9
-            inside = (aligned & (np.abs(along) < 0.5 * inter["width"][1 - axis] + plan["sidewalk"])
-                      & (np.abs(across) < 0.5 * inter["width"][axis]))
-            enter = inside[:, 1:] & ~inside[:, :-1]
+            boxes.append((np.abs(along) < 0.5 * inter["width"][1 - axis] + plan["sidewalk"])
+                         & (np.abs(across) < 0.5 * inter["width"][axis]))
+        anywhere = boxes[0] | boxes[1]
+        for axis in (0, 1):
+            aligned = np.abs(np.cos(yaws - inter["heading"][axis])) > 0.9
+            enter = boxes[axis][:, 1:] & ~anywhere[:, :-1] & aligned[:, 1:]
             car_i, k = np.nonzero(enter)
             if len(k) == 0:
                 continue
             st = phase(plan, inter, axis, times[k + 1])
-            entries += len(k)
-            bad += int(np.sum((st == "R") | (st == "L")))
-    return entries, bad
+            cross = phase(plan, inter, 1 - axis, times[k + 1])
+            for i, kk, s, c in zip(car_i, k + 1, st, cross):
+                out = np.nonzero(~anywhere[i, kk:])[0]
+                end = kk + out[0] if len(out) else len(times) - 1
+                turned = yaws[i, end] - yaws[i, kk]
+                turning = judge_turns and abs(turned) > 0.25 * math.pi
+                entries += 1
+                turns += turning
+                if not turning:
+                    bad += s in ("R", "L")
+                elif turned > 0:  # left
+                    bad += s != "L"
+                else:  # right: on either street's arrow
+                    bad += s != "L" and c != "L"
+    return entries, turns, bad
 
 
 def corners(x, y, yaw, length, width):
@@ -140,18 +163,21 @@ def sat_overlap(ca, cb, yaw_a, yaw_b):
     return ~separated
 
 
-def overlaps_and_gaps(cars, times, states):
+def overlaps_and_gaps(cars, times, states, bounds):
     """(overlapping pair samples, same-lane follower samples, smallest bumper gap, smallest time
-    gap of a follower moving faster than 3 m/s)."""
+    gap of a follower moving faster than 3 m/s, both heading the same way within 6 degrees). Two
+    cars inside the tile (`bounds`: lo, hi) follow each other in a lane when their headings agree
+    and their centres are less than a metre apart across the heading (beyond the tile the loops
+    of a street's two lanes widen across each other's line)."""
     xs, ys, yaws, lengths, widths = states
+    lo, hi = bounds
+    inside = (xs >= lo[0]) & (xs <= hi[0]) & (ys >= lo[1]) & (ys <= hi[1])
     n = len(cars)
-    lanes = np.array([c["lane"] for c in cars])
     reach = 0.5 * np.hypot(lengths, widths)
     overl = follow = 0
     min_gap = min_tgap = float("inf")
     ii, jj = np.triu_indices(n, 1)
     lim = reach[ii] + reach[jj]
-    same = lanes[ii] == lanes[jj]
     for k in range(len(times)):
         d = np.hypot(xs[ii, k] - xs[jj, k], ys[ii, k] - ys[jj, k])
         near = d < lim
@@ -160,13 +186,16 @@ def overlaps_and_gaps(cars, times, states):
             ca = corners(xs[a, k], ys[a, k], yaws[a, k], lengths[a], widths[a])
             cb = corners(xs[b, k], ys[b, k], yaws[b, k], lengths[b], widths[b])
             overl += int(np.sum(sat_overlap(ca, cb, yaws[a, k], yaws[b, k])))
-        # Followers: same lane, same heading, within 40 m.
-        f = same & (d < 40.0)
+        # Followers: same heading, within 40 m, less than a metre apart across the heading.
+        f = (d < 40.0) & inside[ii, k] & inside[jj, k]
         if not np.any(f):
             continue
         a, b = ii[f], jj[f]
         ok = np.cos(yaws[a, k] - yaws[b, k]) > 0.95
         a, b = a[ok], b[ok]
+        lat = np.abs(np.cos(yaws[a, k]) * (ys[b, k] - ys[a, k])
+                     - np.sin(yaws[a, k]) * (xs[b, k] - xs[a, k]))
+        a, b = a[lat < 1.0], b[lat < 1.0]
         if len(a) == 0:
             continue
         # Which one leads: the other's centre is ahead along the heading.
@@ -179,7 +208,8 @@ def overlaps_and_gaps(cars, times, states):
         min_gap = min(min_gap, float(gap.min()))
         if k + 1 < len(times):
             v = np.hypot(xs[back, k + 1] - xs[back, k], ys[back, k + 1] - ys[back, k]) / DT
-            moving = v > 3.0
+            # The time gap on straight lanes only: on a curve the chord is shorter than the lane.
+            moving = (v > 3.0) & (np.cos(yaws[lead, k] - yaws[back, k]) > 0.995)
             if np.any(moving):
                 min_tgap = min(min_tgap, float(np.min(gap[moving] / v[moving])))
     return overl, follow, min_gap, min_tgap
@@ -212,12 +242,13 @@ def crossings_off_red(peds, plan, times):
     return checked, bad
 
 
-def lane_at(points, s):
-    """x, y of arc lengths s (wrapped) along a closed polyline given as x0, y0, x1, y1, ..."""
-    p = np.asarray(points, dtype=float).reshape(-1, 2)
+def path_at(lanes, path, s):
+    """x, y of arc lengths s (clamped) along a car's path: its lane pieces (each given as x0, y0,
+    x1, y1, ...) joined end to start."""
+    p = np.concatenate([np.asarray(lanes[i]["points"], dtype=float).reshape(-1, 2)[(0 if k == 0 else 1):]
+                        for k, i in enumerate(path)])
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p, axis=0).T))])
-    w = np.mod(s, cum[-1])
-    return np.interp(w, cum, p[:, 0]), np.interp(w, cum, p[:, 1])
+    return np.interp(s, cum, p[:, 0]), np.interp(s, cum, p[:, 1])
 
 
 def sha_ok(path, ref):
@@ -228,7 +259,7 @@ def sha_ok(path, ref):
 def episode_cars(ref, sim, sim_path):
     """The traffic cars of a scenario that references a traffic episode file, as entities with a
     [t, x, y, z, yaw] trajectory over the scenario's window: the knots (t, s) along the lane
-    shifted by the offset, the yaw that of the chord from s - 1.5 m to s + 1.5 m."""
+    of its path shifted by the offset, the yaw that of the chord from s - 1.5 m to s + 1.5 m."""
     path = os.path.join(os.path.dirname(sim_path), ref["file"])
     with open(path, "rb") as f:
         raw = f.read()
@@ -246,14 +277,16 @@ def episode_cars(ref, sim, sim_path):
         a = max(0, int(np.searchsorted(k[:, 0], t0, side="right")) - 1)
         b = min(len(k), int(np.searchsorted(k[:, 0], t0 + dur, side="left")) + 1)
         k = k[a:b]
-        pts = ep["lanes"][car["lane"]]["points"]
-        x, y = lane_at(pts, k[:, 1])
-        xa, ya = lane_at(pts, k[:, 1] - 1.5)
-        xb, yb = lane_at(pts, k[:, 1] + 1.5)
+        lanes, path = ep["lanes"], car["path"]
+        for a_, b_ in zip(path, path[1:]):
+            check(lanes[a_]["points"][-2:] == lanes[b_]["points"][:2], "a path's pieces join")
+        x, y = path_at(lanes, path, k[:, 1])
+        xa, ya = path_at(lanes, path, k[:, 1] - 1.5)
+        xb, yb = path_at(lanes, path, k[:, 1] + 1.5)
         yaw = np.arctan2(yb - ya, xb - xa)
         traj = [[t - t0, xi, yi, 0.0, w] for t, xi, yi, w in zip(k[:, 0], x, y, yaw)]
         out.append({"id": cid, "class": "car", "role": "traffic", "size": car["size"],
-                    "attributes": {"lane": ep["lanes"][car["lane"]]["name"]},
+                    "attributes": {"lane": ep["lanes"][car["path"][0]]["name"]},
                     "pose": {"x": x[0], "y": y[0], "z": 0.0, "yaw": yaw[0]},
                     "trajectory": traj})
     return out
@@ -292,10 +325,12 @@ def judge_scenario(sim, world, name, controls):
     check(len(cars) >= 100 and len(peds) >= 300, name + ": cars and pedestrians",
           "%d, %d" % (len(cars), len(peds)))
 
-    entries, bad = red_entries(cars, plan, times, states)
-    check(entries > 300 and bad == 0, name + ": no car enters on red",
+    entries, turns, bad = red_entries(cars, plan, times, states)
+    check(entries > 300 and bad == 0, name + ": no car enters against its signal",
           "%d entries, %d on red" % (entries, bad))
-    overl, follow, min_gap, min_tgap = overlaps_and_gaps(cars, times, states)
+    check(turns > 20, name + ": cars turn at the intersections", "%d turning entries" % turns)
+    bounds = (world["bounds"]["min"], world["bounds"]["max"])
+    overl, follow, min_gap, min_tgap = overlaps_and_gaps(cars, times, states, bounds)
     check(overl == 0, name + ": no two cars overlap", "%d overlapping samples" % overl)
     check(follow > 1000, name + ": same-lane followers sampled", str(follow))
     # The standstill gap is 2 m; the written keyframes keep positions within 5 cm of the
@@ -332,8 +367,19 @@ def judge_scenario(sim, world, name, controls):
         cyc = 2 * (plan["left"] + plan["green"] + plan["yellow"] + plan["all_red"])
         shifted["intersections"] = [dict(i, offset=(i["offset"] + 0.5 * cyc) % cyc)
                                     for i in plan["intersections"]]
-        e2, bad2 = red_entries(cars, shifted, times, states)
+        e2, _, bad2 = red_entries(cars, shifted, times, states)
         check(bad2 > e2 // 4, "control: shifted plan flags red entries", "%d of %d" % (bad2, e2))
+        # Turning cars judged as going straight on: their entries on the arrow are flagged.
+        _, t3, bad3 = red_entries(cars, plan, times, states, judge_turns=False)
+        check(t3 == 0 and bad3 >= turns, "control: turns on the arrow flagged as straight",
+              "%d of %d turns" % (bad3, turns))
+        # The plan shifted by the arrow's length: the turning cars now enter on green.
+        early = dict(plan)
+        early["intersections"] = [dict(i, offset=(i["offset"] - plan["left"]) % cyc)
+                                  for i in plan["intersections"]]
+        _, t4, bad4 = red_entries(cars, early, times, states)
+        check(t4 == turns and bad4 >= turns, "control: a turn off the arrow is flagged",
+              "%d flagged, %d turns" % (bad4, turns))
         c2, off2 = crossings_off_red(peds, shifted, times)
         check(off2 > 0, "control: shifted plan flags crossers", "%d of %d" % (off2, c2))
         # One car three seconds late: the car behind runs into it.
@@ -341,18 +387,21 @@ def judge_scenario(sim, world, name, controls):
         tr = [[p[0] + 3.0] + p[1:] for p in late[0]["trajectory"]]
         late[0]["trajectory"] = [[0.0] + tr[0][1:]] + tr
         short = times[times <= 120.0]  # the controls' overlap checks: the first two minutes
-        o2, _, _, _ = overlaps_and_gaps(late, short, car_states(late, short))
+        o2, _, _, _ = overlaps_and_gaps(late, short, car_states(late, short), bounds)
         check(o2 > 0, "control: a late car overlaps", str(o2))
         # A car added 0.8 s behind another, in its lane: too close.
-        tail = dict(cars[0])
-        tr = [[p[0] + 0.8] + p[1:] for p in cars[0]["trajectory"]]
+        lo, hi = bounds
+        lead = next(c for c in cars if lo[0] + 50 < c["trajectory"][0][1] < hi[0] - 50
+                    and lo[1] + 50 < c["trajectory"][0][2] < hi[1] - 50)
+        tail = dict(lead)
+        tr = [[p[0] + 0.8] + p[1:] for p in lead["trajectory"]]
         tail["trajectory"] = [[0.0] + tr[0][1:]] + tr
         close = cars + [tail]
-        _, _, g3, tg3 = overlaps_and_gaps(close, short, car_states(close, short))
+        _, _, g3, tg3 = overlaps_and_gaps(close, short, car_states(close, short), bounds)
         check(g3 < 2.0 - 0.11 or tg3 < 1.0, "control: a car 0.8 s behind another breaks the gap",
               "%.3f m %.3f s" % (g3, tg3))
-    return (len(cars), len(peds), entries, follow, min_gap, min_tgap, checked, moving.mean(),
-            ped_in.min() / km2)
+    return (len(cars), len(peds), entries, turns, follow, min_gap, min_tgap, checked,
+            moving.mean(), ped_in.min() / km2)
 
 
 def main():
@@ -409,7 +458,7 @@ def main():
         for i, sim in enumerate(sims):
             check(sim["world"]["params"].get("type") == "city", "scenario %d is a city scenario" % i)
             figures = judge_scenario(sim, world, "scenario %d" % i, controls=(i == 0))
-            print("scenario %d: %d cars, %d pedestrians, %d box entries, %d follower samples "
+            print("scenario %d: %d cars, %d pedestrians, %d box entries (%d turning), %d follower samples "
                   "(smallest gap %.3f m, time gap %.3f s), %d crosswalk samples, %.1f moving "
                   "cars/km^2 (mean), %.1f pedestrians/km^2 (min)"
                   % ((i,) + figures))

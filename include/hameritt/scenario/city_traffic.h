@@ -47,18 +47,20 @@ struct CityPedestrian {
 
 // A traffic episode: the ambient cars of a city world simulated once over `length` seconds,
 // shared by every scenario of a batch that draws it (each sees a window of it). Compact: each
-// lane ring's polyline is stored once, and each car's motion as knots (t, s) of its arc length
-// s along its ring (unwrapped: it grows by the ring's length each lap), between which the car
-// moves at constant speed; every simulated position lies within 10 cm of the interpolation.
+// lane piece's polyline (a link between boxes, a straight or turning connector across a box, a
+// loop beyond the tile) is stored once; each car's path is a list of pieces, each starting
+// where the previous one ends, and its motion knots (t, s) of its arc length s along the joined
+// path, between which the car moves at constant speed; every simulated position lies within
+// 10 cm of the interpolation.
 struct TrafficEpisode {
   struct Lane {
     std::string name;
-    std::vector<geometry::Vec2> points;  // closed: the last point is the first
+    std::vector<geometry::Vec2> points;  // open, at least 2 points
   };
   struct Car {
     std::string vehicle_class, make, model, color;
     geometry::Vec3 size{4.5, 1.8, 1.5};  // length, width, height (m)
-    int lane = 0;                        // index into `lanes`
+    std::vector<int> path;               // indices into `lanes`, driven in order
     std::vector<double> knots;           // t0, s0, t1, s1, ... (t strictly increasing from 0)
   };
   int index = 0;
