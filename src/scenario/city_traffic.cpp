@@ -896,23 +896,35 @@ Trajectory episodeCarWindow(const TrafficEpisode& e, std::size_t car, double off
   return window(decodeKnots(e, c, a > 0 ? a - 1 : 0, std::min(n, b + 1)), offset, duration);
 }
 
+namespace {
+
+// A scenario entity `id` of class `cls` and role `role` moving along `window` (its attributes
+// and box are the caller's).
+ScenarioEntity movingEntity(const std::string& id, EntityClass cls, const char* role,
+                            Trajectory window) {
+  ScenarioEntity se;
+  se.entity.id = id;
+  se.entity.cls = cls;
+  se.role = role;
+  se.trajectory = std::move(window);
+  return se;
+}
+
+}  // namespace
+
 ScenarioEntity episodeCarEntity(const TrafficEpisode& e, std::size_t car, Trajectory window,
                                 const std::string& id) {
   const TrafficEpisode::Car& c = e.cars.at(car);
-  ScenarioEntity se;
+  ScenarioEntity se = movingEntity(id, EntityClass::kCar, "traffic", std::move(window));
   Entity& en = se.entity;
-  en.id = id;
-  en.cls = EntityClass::kCar;
   en.attributes.set("vehicle_class", c.vehicle_class);
   en.attributes.set("make", c.make);
   en.attributes.set("model", c.model);
   en.attributes.set("color", c.color);
   en.attributes.set("lane", e.lanes.at(static_cast<std::size_t>(c.lane)).name);
-  const TrajectoryPoint p0 = window.empty() ? TrajectoryPoint{} : window.front();
+  const TrajectoryPoint p0 = se.trajectory.empty() ? TrajectoryPoint{} : se.trajectory.front();
   en.box = boxFromPose(Vec3(roundMilli(p0.x), roundMilli(p0.y), roundMilli(p0.z)),
                        roundMilli(geometry::wrapPi(p0.yaw)), c.size);
-  se.role = "traffic";
-  se.trajectory = std::move(window);
   return se;
 }
 
@@ -925,16 +937,12 @@ Trajectory episodePedestrianWindow(const TrafficEpisode& e, std::size_t ped, dou
 
 ScenarioEntity cityPedestrianEntity(const CityPedestrian& p, Trajectory window,
                                     const std::string& id) {
-  ScenarioEntity se;
+  ScenarioEntity se = movingEntity(id, EntityClass::kPedestrian, "pedestrian", std::move(window));
   Entity& en = se.entity;
-  en.id = id;
-  en.cls = EntityClass::kPedestrian;
   en.attributes.set("clothing_color", p.clothing_color);
   en.attributes.set("activity", p.activity);
-  const TrajectoryPoint p0 = window.empty() ? p.pose : window.front();
+  const TrajectoryPoint p0 = se.trajectory.empty() ? p.pose : se.trajectory.front();
   en.box = boxFromPose(Vec3(p0.x, p0.y, 0.0), p0.yaw, Vec3(0.5, 0.6, p.height));
-  se.role = "pedestrian";
-  se.trajectory = std::move(window);
   return se;
 }
 
