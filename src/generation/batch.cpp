@@ -30,7 +30,8 @@ std::vector<ScenarioClass> parseClassList(const std::string& s) {
   std::size_t start = 0;
   while (start <= s.size()) {
     const std::size_t comma = s.find(',', start);
-    const std::string name = s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const std::string name =
+        s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     ScenarioClass c;
     if (!parseScenarioClass(name, &c)) {
       throw ConfigError(
@@ -80,9 +81,13 @@ std::string manifestJson(const World& world, const BatchRequest& req,
 
 std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConfig& config,
                                          const BatchRequest& req) {
-  if (req.classes.empty() && !req.spec) throw ConfigError("--class: at least one scenario class is required");
-  if (req.count < 1) throw ConfigError("--count: expected a positive number of scenarios, got " + std::to_string(req.count));
-  if (req.jobs < 1) throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
+  if (req.classes.empty() && !req.spec)
+    throw ConfigError("--class: at least one scenario class is required");
+  if (req.count < 1)
+    throw ConfigError("--count: expected a positive number of scenarios, got " +
+                      std::to_string(req.count));
+  if (req.jobs < 1)
+    throw ConfigError("--jobs: expected at least 1, got " + std::to_string(req.jobs));
   if (req.out_dir.empty()) throw ConfigError("--out: an output directory is required");
   if (req.first < 0) {
     throw ConfigError("--first: expected a non-negative index, got " + std::to_string(req.first));
@@ -132,13 +137,16 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
         if (!req.spec) e.cls = req.classes[static_cast<std::size_t>(index) % req.classes.size()];
         e.seed = req.exact_seed ? req.seed : batchSeed(req.seed, static_cast<std::uint64_t>(index));
         Scenario s;
+        // Written by reference, a city scenario's shared traffic needs no trajectories in
+        // memory; a check of the whole scene (--verify) gets them all.
+        const bool lean = req.share_traffic && !req.check;
         if (req.spec) {
           e.cls = req.spec->spec().cls;
-          const generation::ScenarioDraw d = req.spec->draw(
-              e.seed, static_cast<std::uint64_t>(index), req.seed, req.sampler);
-          s = generateScenario(world, d.config, e.cls, e.seed, &d.plan);
+          const generation::ScenarioDraw d =
+              req.spec->draw(e.seed, static_cast<std::uint64_t>(index), req.seed, req.sampler);
+          s = generateScenario(world, d.config, e.cls, e.seed, &d.plan, lean);
         } else {
-          s = generateScenario(world, config, e.cls, e.seed);
+          s = generateScenario(world, config, e.cls, e.seed, nullptr, lean);
         }
         e.id = s.mission.scenario_id;
         if (req.check) req.check(s);

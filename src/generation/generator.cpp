@@ -71,14 +71,15 @@ double rangeDraw(Rng& rng, const Range& r) {
 class ScenarioBuilder {
  public:
   ScenarioBuilder(const World& world, const GeneratorConfig& cfg, ScenarioClass cls,
-                  std::uint64_t seed, const ScenarioPlan* plan)
+                  std::uint64_t seed, const ScenarioPlan* plan, bool traffic_by_reference)
       : world_(world),
         cfg_(cfg),
         cls_(cls),
         seed_(seed),
         rng_(seed),
         eval_(world, cfg.relations),
-        plan_(plan) {
+        plan_(plan),
+        traffic_by_reference_(traffic_by_reference) {
     slot_taken_.assign(world.slots().size(), 0);
     for (std::size_t i = 0; i < world.slots().size(); ++i) {
       if (world.slots()[i].occupant >= 0) slot_taken_[i] = 1;
@@ -1816,25 +1817,20 @@ class ScenarioBuilder {
   }
 
   // The city's signalised ambient traffic and crowd (scenario/city_traffic.h), drawn from a
-  // stream of its own over the mission's time limit. The cars come last: when they are a window
-  // of a shared traffic episode, a batch writes them as a reference (SimConfig::traffic) and a
-  // reader appends them again.
+  // stream of its own over the mission's time limit. The crowd and the cars come last: when they
+  // are a window of a shared traffic episode, a batch writes them as a reference
+  // (SimConfig::traffic) and a reader appends them again, pedestrians first.
   void addCityTraffic() {
     CityTraffic traffic = simulateCityTraffic(world_, deriveSeed(seed_, 0x4349545954524146ULL),
-                                              sc_.mission.time_limit);
+                                              sc_.mission.time_limit, {}, traffic_by_reference_);
+    TrafficEpisodeRef ref;
     for (auto& ped : traffic.pedestrians) {
-      Entity p;
-      p.id = nextPedId();
-      p.cls = EntityClass::kPedestrian;
-      p.attributes.set("clothing_color", ped.clothing_color);
-      p.attributes.set("activity", ped.activity);
-      p.box =
-          boxFromPose(Vec3(ped.pose.x, ped.pose.y, 0.0), ped.pose.yaw, Vec3(0.5, 0.6, ped.height));
-      p.block = world_.blockAt(p.box.center2());
-      add(std::move(p), "pedestrian", std::move(ped.trajectory));
+      ScenarioEntity se = cityPedestrianEntity(ped, std::move(ped.trajectory), nextPedId());
+      se.entity.block = world_.blockAt(se.entity.box.center2());
+      ref.pedestrian_ids.push_back(se.entity.id);
+      add(std::move(se.entity), "pedestrian", std::move(se.trajectory));
     }
     const TrafficEpisode& ep = traffic.episode->episode;
-    TrafficEpisodeRef ref;
     for (std::size_t i = 0; i < traffic.cars.size(); ++i) {
       ScenarioEntity se =
           episodeCarEntity(ep, i, std::move(traffic.cars[i].trajectory), nextCarId());
@@ -1951,14 +1947,15 @@ class ScenarioBuilder {
   std::vector<int> car_ids_, ped_ids_;
   std::vector<Group> extra_groups_;
   const ScenarioPlan* plan_;
+  bool traffic_by_reference_ = false;
 };
 
 }  // namespace
 
 Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
-                          std::uint64_t seed, const ScenarioPlan* plan) {
+                          std::uint64_t seed, const ScenarioPlan* plan, bool traffic_by_reference) {
   try {
-    return ScenarioBuilder(world, config, cls, seed, plan).build();
+    return ScenarioBuilder(world, config, cls, seed, plan, traffic_by_reference).build();
   } catch (const GenerationError& e) {
     throw GenerationError(std::string(toString(cls)) + " seed " + std::to_string(seed) + ": " +
                           e.what());

@@ -195,15 +195,16 @@ MapData parseDocuments(const json& mission, const json& sim, const std::string& 
   parseMission(mission, mr, &d);
   parseSimConfig(sim, sr, &d);
   if (sim.is_object() && sim.contains("traffic")) {
-    // A batch's city scenario: its traffic cars are a window of a shared traffic episode file,
-    // resolved (and checked) by the simulator's reader.
+    // A batch's city scenario: its traffic cars and crowd are a window of a shared traffic
+    // episode file, resolved (and checked) by the simulator's reader.
     const scenario::SimConfig full = scenario::loadSimConfig(sim_file);
-    const std::size_t n = full.traffic ? full.traffic->car_ids.size() : 0;
+    const std::size_t n =
+        full.traffic ? full.traffic->car_ids.size() + full.traffic->pedestrian_ids.size() : 0;
     for (std::size_t i = full.entities.size() - n; i < full.entities.size(); ++i) {
       const scenario::ScenarioEntity& se = full.entities[i];
       MoverData mv;
       mv.id = se.entity.id;
-      mv.cls = "car";
+      mv.cls = scenario::toString(se.entity.cls);
       mv.role = se.role;
       mv.position = Vec2(se.entity.box.center.x(), se.entity.box.center.y());
       mv.yaw = se.entity.box.yaw;

@@ -905,6 +905,199 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
   return out;
 }
 
+// The pose of `tr` at t0 as a one-point trajectory at t = 0: the first point of
+// window(tr, t0, length), without copying the rest.
+Trajectory firstPose(const Trajectory& tr, double t0) {
+  TrajectoryPoint p = sampleTrajectory(tr, t0);
+  p.t = 0.0;
+  p.x = roundMilli(p.x);
+  p.y = roundMilli(p.y);
+  p.yaw = roundMilli(p.yaw);
+  return {p};
+}
+
+// Holds the last pose of `tr` until `horizon` (a pedestrian pausing at the end).
+void holdUntil(Trajectory* tr, double horizon) {
+  if (tr->empty() || tr->back().t >= horizon) return;
+  TrajectoryPoint q = tr->back();
+  q.t = roundMilli(horizon);
+  if (q.t > tr->back().t) tr->push_back(q);
+}
+
+// The crowd of a city world over [0, horizon] with the signal plan `plan` (at the same clock):
+// every pedestrian keeps one activity, repeated until the horizon, so that the crowd moves in
+// any window of it. Walkers stroll 60-300 m along a block's sidewalk and pause 2-20 s between
+// strolls; crossers walk back and forth between two sidewalk points on either side of a
+// crosswalk (at a signalised intersection: waiting at the kerb until the crossed street is red;
+// jaywalkers mid-block, off the signals); queuers stand at a bus stop.
+std::vector<CityPedestrian> runPedestrians(const World& world, const SignalPlan& plan,
+                                           std::uint64_t seed, double horizon) {
+  const CityParams& cp = world.params().city;
+  const double sw = cp.sidewalk_width;
+  const double area_km2 = tileArea(world) / 1e6;
+  Rng rng(deriveSeed(seed, 0x43524F5744ULL));
+  std::vector<CityPedestrian> out;
+  std::vector<int> bus_stops, local_edges;
+  for (int e = 0; e < static_cast<int>(world.entities().size()); ++e) {
+    if (world.entities()[e].cls == EntityClass::kBusStop) bus_stops.push_back(e);
+  }
+  for (int e = 0; e < static_cast<int>(world.edges().size()); ++e) {
+    const StreetEdge& se = world.edges()[e];
+    const Vec2 a = world.nodes()[se.a].position, b = world.nodes()[se.b].position;
+    if (!isArterial(world, se) && (b - a).norm() > 50.0 &&
+        !(onBoundary(world, a) && onBoundary(world, b))) {
+      local_edges.push_back(e);
+    }
+  }
+  std::vector<int> queue_len(bus_stops.size(), 0);
+  const int n_peds = static_cast<int>(std::lround(cp.pedestrians_per_km2 * area_km2));
+  // Appends a timed point (strictly after the last one).
+  auto push = [](Trajectory* tr, double t, const Vec2& p, double yaw) {
+    TrajectoryPoint q;
+    q.t = roundMilli(t);
+    if (!tr->empty() && q.t <= tr->back().t) q.t = tr->back().t + 0.001;
+    q.x = roundMilli(p.x());
+    q.y = roundMilli(p.y());
+    q.yaw = roundMilli(geometry::wrapPi(yaw));
+    tr->push_back(q);
+  };
+  auto heading = [](const Vec2& a, const Vec2& b) {
+    return std::atan2(b.y() - a.y(), b.x() - a.x());
+  };
+  out.reserve(static_cast<std::size_t>(std::max(0, n_peds)));
+  for (int i = 0; i < n_peds; ++i) {
+    CityPedestrian ped;
+    ped.clothing_color = catalog::pick(rng, catalog::clothingColors());
+    ped.height = roundMilli(rng.uniform(1.55, 1.9));
+    const double speed = rng.uniform(1.1, 1.6);
+    const double u = rng.unit();
+    if (u < cp.bus_queue_share && !bus_stops.empty()) {
+      const std::size_t k =
+          static_cast<std::size_t>(rng.uniformInt(0, static_cast<long>(bus_stops.size()) - 1));
+      if (queue_len[k] < 8) {
+        const Entity& stop = world.entities()[bus_stops[k]];
+        const Vec2 dir = unit(stop.box.yaw);
+        const Vec2 p =
+            stop.box.center2() + (0.5 * stop.box.size.x() + 0.6 + 0.7 * queue_len[k]) * dir;
+        ++queue_len[k];
+        ped.activity = "queuing";
+        ped.pose = {0.0, roundMilli(p.x()), roundMilli(p.y()), 0.0,
+                    roundMilli(geometry::wrapPi(stop.box.yaw + geometry::kPi))};
+        out.push_back(std::move(ped));
+        continue;
+      }
+    }
+    double t = rng.uniform(0.0, 30.0);  // the first departure
+    const double d0 = rng.uniform(5.0, 40.0), d1 = rng.uniform(5.0, 40.0);
+    if (u < cp.bus_queue_share + cp.crossing_share) {
+      const bool jay = rng.bernoulli(cp.jaywalk_probability);
+      Vec2 start, a, b, end;
+      double cross_speed = speed;
+      const SignalizedIntersection* signal = nullptr;
+      int other = 0;
+      if (jay && !local_edges.empty()) {
+        const StreetEdge& se = world.edges()[local_edges[static_cast<std::size_t>(
+            rng.uniformInt(0, static_cast<long>(local_edges.size()) - 1))]];
+        const Vec2 pa = world.nodes()[se.a].position, pb = world.nodes()[se.b].position;
+        const Vec2 ue = (pb - pa).normalized(), ne = leftOf(ue);
+        const Vec2 mid = pa + rng.uniform(0.35, 0.65) * (pb - pa);
+        const double side = rng.bernoulli(0.5) ? 1.0 : -1.0,
+                     along = rng.bernoulli(0.5) ? 1.0 : -1.0;
+        const double h = 0.5 * se.width + 0.5 * sw;
+        a = mid + side * h * ne;
+        b = mid - side * h * ne;
+        start = a - along * d0 * ue;
+        end = b + along * d1 * ue;
+        cross_speed = 1.25 * speed;
+        ped.activity = "jaywalking";
+      } else if (!jay && !plan.intersections.empty()) {
+        signal = &plan.intersections[static_cast<std::size_t>(
+            rng.uniformInt(0, static_cast<long>(plan.intersections.size()) - 1))];
+        const int axis = static_cast<int>(rng.uniformInt(0, 1));
+        other = 1 - axis;
+        const double side = rng.bernoulli(0.5) ? 1.0 : -1.0, dir = rng.bernoulli(0.5) ? 1.0 : -1.0;
+        const Vec2 ua = unit(signal->heading[axis]), na = leftOf(ua);
+        const double c = 0.5 * signal->width[other] + 0.5 * sw,
+                     h = 0.5 * signal->width[axis] + 0.5 * sw;
+        a = signal->position + side * c * ua - dir * h * na;
+        b = signal->position + side * c * ua + dir * h * na;
+        start = a - dir * d0 * na;
+        end = b + dir * d1 * na;
+        // Off the carriageway before the crossed street moves again.
+        const double clear = plan.green + plan.yellow + plan.all_red;  // other green -> ours
+        cross_speed = std::max(speed, 2.0 * h / std::max(1.0, clear - 1.0));
+        ped.activity = "crossing";
+      }
+      if (!ped.activity.empty()) {
+        // Walk while the other axis is green (its left arrow over): the crossed street is red.
+        const double cyc = plan.cycle(), half = 0.5 * cyc;
+        const double clear = plan.green + plan.yellow + plan.all_red;
+        const double length = (b - a).norm();
+        const double walk_lo = plan.left,
+                     walk_hi = std::max(walk_lo,
+                                        std::min(plan.left + plan.green,
+                                                 plan.left + clear - length / cross_speed - 0.5));
+        Trajectory tr;
+        push(&tr, 0.0, start, heading(start, a));
+        for (bool forward = true; t < horizon; forward = !forward) {
+          const Vec2 &p0 = forward ? start : end, &k0 = forward ? a : b, &k1 = forward ? b : a,
+                     &p1 = forward ? end : start;
+          const double y0 = heading(p0, k0), y1 = heading(k0, k1), y2 = heading(k1, p1);
+          if (t > tr.back().t + 1e-3) push(&tr, t, p0, y0);
+          const double ta = t + (k0 - p0).norm() / speed;
+          push(&tr, ta, k0, y0);
+          double t_cross = ta;
+          if (signal) {
+            // Phase of the other axis' cycle at arrival.
+            double tau = std::fmod(ta - signal->offset - (other == 1 ? half : 0.0), cyc);
+            if (tau < 0) tau += cyc;
+            if (tau < walk_lo) {
+              t_cross = ta + walk_lo - tau;
+            } else if (tau > walk_hi) {
+              t_cross = ta + cyc - tau + walk_lo;
+            }
+          }
+          if (t_cross > ta + 1e-3) push(&tr, t_cross, k0, y1);
+          const double tb = std::max(ta, t_cross) + length / cross_speed;
+          push(&tr, tb, k1, y1);
+          const double te = tb + (p1 - k1).norm() / speed;
+          push(&tr, te, p1, y2);
+          t = te + rng.uniform(2.0, 20.0);
+        }
+        holdUntil(&tr, horizon);
+        ped.pose = tr.front();
+        ped.trajectory = std::move(tr);
+        out.push_back(std::move(ped));
+        continue;
+      }
+    }
+    // Strolls along a block's sidewalk ring.
+    const Block& blk = world.blocks()[static_cast<std::size_t>(
+        rng.uniformInt(0, static_cast<long>(world.blocks().size()) - 1))];
+    const double len = geometry::polylineLength(blk.sidewalk);
+    double s = rng.uniform(0.0, len);
+    ped.activity = "walking";
+    Trajectory tr;
+    while (t < horizon) {
+      const double dist = rng.uniform(60.0, 300.0) * (rng.bernoulli(0.5) ? 1.0 : -1.0);
+      Trajectory leg = walkRing(blk.sidewalk, s, s + dist, speed, t);
+      // walkRing() holds the start at t = 0 first when t > 0: kept for the first stroll only.
+      std::size_t from = tr.empty() || leg.size() < 2 || leg.front().t > 0.0 ? 0 : 1;
+      for (std::size_t k = from; k < leg.size(); ++k) {
+        if (!tr.empty() && leg[k].t <= tr.back().t) continue;
+        tr.push_back(leg[k]);
+      }
+      s += dist;
+      t = tr.back().t + rng.uniform(2.0, 20.0);
+    }
+    holdUntil(&tr, horizon);
+    ped.pose = tr.front();
+    ped.trajectory = std::move(tr);
+    out.push_back(std::move(ped));
+  }
+  return out;
+}
+
 // Knots [from, to) of `car` decoded along its path.
 Trajectory decodeKnots(const TrafficEpisode& e, const TrafficEpisode::Car& car, std::size_t from,
                        std::size_t to) {
@@ -973,23 +1166,53 @@ Trajectory episodeCarWindow(const TrafficEpisode& e, std::size_t car, double off
   return window(decodeKnots(e, c, a > 0 ? a - 1 : 0, std::min(n, b + 1)), offset, duration);
 }
 
+namespace {
+
+// A scenario entity `id` of class `cls` and role `role` moving along `window` (its attributes
+// and box are the caller's).
+ScenarioEntity movingEntity(const std::string& id, EntityClass cls, const char* role,
+                            Trajectory window) {
+  ScenarioEntity se;
+  se.entity.id = id;
+  se.entity.cls = cls;
+  se.role = role;
+  se.trajectory = std::move(window);
+  return se;
+}
+
+}  // namespace
+
 ScenarioEntity episodeCarEntity(const TrafficEpisode& e, std::size_t car, Trajectory window,
                                 const std::string& id) {
   const TrafficEpisode::Car& c = e.cars.at(car);
-  ScenarioEntity se;
+  ScenarioEntity se = movingEntity(id, EntityClass::kCar, "traffic", std::move(window));
   Entity& en = se.entity;
-  en.id = id;
-  en.cls = EntityClass::kCar;
   en.attributes.set("vehicle_class", c.vehicle_class);
   en.attributes.set("make", c.make);
   en.attributes.set("model", c.model);
   en.attributes.set("color", c.color);
   en.attributes.set("lane", e.lanes.at(static_cast<std::size_t>(c.path.front())).name);
-  const TrajectoryPoint p0 = window.empty() ? TrajectoryPoint{} : window.front();
+  const TrajectoryPoint p0 = se.trajectory.empty() ? TrajectoryPoint{} : se.trajectory.front();
   en.box = boxFromPose(Vec3(roundMilli(p0.x), roundMilli(p0.y), roundMilli(p0.z)),
                        roundMilli(geometry::wrapPi(p0.yaw)), c.size);
-  se.role = "traffic";
-  se.trajectory = std::move(window);
+  return se;
+}
+
+Trajectory episodePedestrianWindow(const TrafficEpisode& e, std::size_t ped, double offset,
+                                   double duration) {
+  const Trajectory& tr = e.pedestrians.at(ped).trajectory;
+  if (tr.empty()) return {};
+  return window(tr, offset, duration);
+}
+
+ScenarioEntity cityPedestrianEntity(const CityPedestrian& p, Trajectory window,
+                                    const std::string& id) {
+  ScenarioEntity se = movingEntity(id, EntityClass::kPedestrian, "pedestrian", std::move(window));
+  Entity& en = se.entity;
+  en.attributes.set("clothing_color", p.clothing_color);
+  en.attributes.set("activity", p.activity);
+  const TrajectoryPoint p0 = se.trajectory.empty() ? p.pose : se.trajectory.front();
+  en.box = boxFromPose(Vec3(p0.x, p0.y, 0.0), p0.yaw, Vec3(0.5, 0.6, p.height));
   return se;
 }
 
@@ -1028,6 +1251,7 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
     const std::uint64_t seed =
         deriveSeed(world.params().seed, 0x43415252554EULL + static_cast<std::uint64_t>(index));
     TrafficEpisode e = runCars(world, seed, kTrafficEpisodeLength, idm);
+    e.pedestrians = runPedestrians(world, e.plan, seed, kTrafficEpisodeLength);
     e.index = index;
     auto text = std::make_shared<const std::string>(trafficEpisodeJson(e));
     // Read back from its bytes: a reader of the file decodes exactly these trajectories.
@@ -1040,14 +1264,12 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
 }
 
 CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
-                                const IdmParams& idm) {
+                                const IdmParams& idm, bool first_pose_only) {
   if (world.params().type != WorldType::kCity) {
     throw GenerationError("city traffic needs a city world");
   }
   if (!(duration > 0)) throw GenerationError("city traffic needs a positive duration");
   const CityParams& cp = world.params().city;
-  const double sw = cp.sidewalk_width;
-  const double area_km2 = tileArea(world) / 1e6;
   Rng rng(deriveSeed(seed, 0x5045444553ULL));
   CityTraffic out;
   if (duration <= 0.5 * kTrafficEpisodeLength) {
@@ -1058,149 +1280,32 @@ CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double d
     out.offset = roundMilli(
         idm.step * std::floor(rng.uniform(0.0, kTrafficEpisodeLength - duration) / idm.step));
     out.plan = shiftedSignalPlan(out.episode->episode.plan, out.offset);
+    out.cars.reserve(out.episode->trajectories.size());
     for (const auto& tr : out.episode->trajectories) {
-      out.cars.push_back({window(tr, out.offset, duration)});
+      out.cars.push_back(
+          {first_pose_only ? firstPose(tr, out.offset) : window(tr, out.offset, duration)});
     }
   } else {
-    // Longer than an episode's offset range: the scenario's own cars.
-    out.episode = decodedEpisode(runCars(world, seed, duration, idm));
+    // Longer than an episode's offset range: the scenario's own cars and crowd.
+    TrafficEpisode e = runCars(world, seed, duration, idm);
+    e.pedestrians = runPedestrians(world, e.plan, seed, duration);
+    out.episode = decodedEpisode(std::move(e));
     out.plan = out.episode->episode.plan;
     for (const auto& tr : out.episode->trajectories) out.cars.push_back({tr});
   }
-  const SignalPlan& plan = out.plan;
-
-  // ---------------------------------------------------------------- pedestrians
-  std::vector<int> bus_stops, local_edges;
-  for (int e = 0; e < static_cast<int>(world.entities().size()); ++e) {
-    if (world.entities()[e].cls == EntityClass::kBusStop) bus_stops.push_back(e);
-  }
-  for (int e = 0; e < static_cast<int>(world.edges().size()); ++e) {
-    const StreetEdge& se = world.edges()[e];
-    const Vec2 a = world.nodes()[se.a].position, b = world.nodes()[se.b].position;
-    if (!isArterial(world, se) && (b - a).norm() > 50.0 &&
-        !(onBoundary(world, a) && onBoundary(world, b))) {
-      local_edges.push_back(e);
-    }
-  }
-  std::vector<int> queue_len(bus_stops.size(), 0);
-  const int n_peds = static_cast<int>(std::lround(cp.pedestrians_per_km2 * area_km2));
-  // Appends a timed point (strictly after the last one).
-  auto push = [](Trajectory* tr, double t, const Vec2& p, double yaw) {
-    TrajectoryPoint q;
-    q.t = roundMilli(t);
-    if (!tr->empty() && q.t <= tr->back().t) q.t = tr->back().t + 0.001;
-    q.x = roundMilli(p.x());
-    q.y = roundMilli(p.y());
-    q.yaw = roundMilli(geometry::wrapPi(yaw));
-    tr->push_back(q);
-  };
-  auto heading = [](const Vec2& a, const Vec2& b) {
-    return std::atan2(b.y() - a.y(), b.x() - a.x());
-  };
-  for (int i = 0; i < n_peds; ++i) {
-    CityPedestrian ped;
-    ped.clothing_color = catalog::pick(rng, catalog::clothingColors());
-    ped.height = roundMilli(rng.uniform(1.55, 1.9));
-    const double speed = rng.uniform(1.1, 1.6);
-    const double u = rng.unit();
-    if (u < cp.bus_queue_share && !bus_stops.empty()) {
-      const std::size_t k =
-          static_cast<std::size_t>(rng.uniformInt(0, static_cast<long>(bus_stops.size()) - 1));
-      if (queue_len[k] < 8) {
-        const Entity& stop = world.entities()[bus_stops[k]];
-        const Vec2 dir = unit(stop.box.yaw);
-        const Vec2 p =
-            stop.box.center2() + (0.5 * stop.box.size.x() + 0.6 + 0.7 * queue_len[k]) * dir;
-        ++queue_len[k];
-        ped.activity = "queuing";
-        ped.pose = {0.0, roundMilli(p.x()), roundMilli(p.y()), 0.0,
-                    roundMilli(geometry::wrapPi(stop.box.yaw + geometry::kPi))};
-        out.pedestrians.push_back(std::move(ped));
-        continue;
-      }
-    }
-    const double t_start = rng.uniform(0.0, std::max(1.0, 0.6 * duration));
-    const double d0 = rng.uniform(5.0, 40.0), d1 = rng.uniform(5.0, 40.0);
-    if (u < cp.bus_queue_share + cp.crossing_share) {
-      const bool jay = rng.bernoulli(cp.jaywalk_probability);
-      Vec2 start, a, b, end;
-      double t_cross = 0.0, cross_speed = speed;
-      if (jay && !local_edges.empty()) {
-        const StreetEdge& se = world.edges()[local_edges[static_cast<std::size_t>(
-            rng.uniformInt(0, static_cast<long>(local_edges.size()) - 1))]];
-        const Vec2 pa = world.nodes()[se.a].position, pb = world.nodes()[se.b].position;
-        const Vec2 ue = (pb - pa).normalized(), ne = leftOf(ue);
-        const Vec2 mid = pa + rng.uniform(0.35, 0.65) * (pb - pa);
-        const double side = rng.bernoulli(0.5) ? 1.0 : -1.0,
-                     along = rng.bernoulli(0.5) ? 1.0 : -1.0;
-        const double h = 0.5 * se.width + 0.5 * sw;
-        a = mid + side * h * ne;
-        b = mid - side * h * ne;
-        start = a - along * d0 * ue;
-        end = b + along * d1 * ue;
-        cross_speed = 1.25 * speed;
-        t_cross = t_start + d0 / speed;
-        ped.activity = "jaywalking";
-      } else if (!jay && !plan.intersections.empty()) {
-        const auto& si = plan.intersections[static_cast<std::size_t>(
-            rng.uniformInt(0, static_cast<long>(plan.intersections.size()) - 1))];
-        const int axis = static_cast<int>(rng.uniformInt(0, 1)), other = 1 - axis;
-        const double side = rng.bernoulli(0.5) ? 1.0 : -1.0, dir = rng.bernoulli(0.5) ? 1.0 : -1.0;
-        const Vec2 ua = unit(si.heading[axis]), na = leftOf(ua);
-        const double c = 0.5 * si.width[other] + 0.5 * sw, h = 0.5 * si.width[axis] + 0.5 * sw;
-        a = si.position + side * c * ua - dir * h * na;
-        b = si.position + side * c * ua + dir * h * na;
-        start = a - dir * d0 * na;
-        end = b + dir * d1 * na;
-        // Walk while the other axis is green; off the carriageway before this axis moves again.
-        const double cyc = plan.cycle(), half = 0.5 * cyc;
-        const double clear = plan.green + plan.yellow + plan.all_red;  // other green start -> ours
-        const double length = 2.0 * h;
-        cross_speed = std::max(speed, length / std::max(1.0, clear - 1.0));
-        const double walk_lo = plan.left,
-                     walk_hi = std::max(walk_lo,
-                                        std::min(plan.left + plan.green,
-                                                 plan.left + clear - length / cross_speed - 0.5));
-        // Phase of the other axis' cycle at arrival.
-        const double t_arrive = t_start + d0 / speed;
-        double tau = std::fmod(t_arrive - si.offset - (other == 1 ? half : 0.0), cyc);
-        if (tau < 0) tau += cyc;
-        double wait = 0.0;
-        if (tau < walk_lo) {
-          wait = walk_lo - tau;
-        } else if (tau > walk_hi) {
-          wait = cyc - tau + walk_lo;
-        }
-        t_cross = t_arrive + wait;
-        ped.activity = "crossing";
-      }
-      if (!ped.activity.empty()) {
-        Trajectory tr;
-        const double y0 = heading(start, a), y1 = heading(a, b), y2 = heading(b, end);
-        push(&tr, 0.0, start, y0);
-        if (t_start > 0) push(&tr, t_start, start, y0);
-        const double ta = t_start + d0 / speed;
-        push(&tr, ta, a, y0);
-        if (t_cross > ta + 1e-3) push(&tr, t_cross, a, y1);
-        const double tb = std::max(ta, t_cross) + (b - a).norm() / cross_speed;
-        push(&tr, tb, b, y1);
-        push(&tr, tb + d1 / speed, end, y2);
-        ped.pose = tr.front();
-        ped.trajectory = std::move(tr);
-        out.pedestrians.push_back(std::move(ped));
-        continue;
-      }
-    }
-    // A stroll along a block's sidewalk ring.
-    const Block& blk = world.blocks()[static_cast<std::size_t>(
-        rng.uniformInt(0, static_cast<long>(world.blocks().size()) - 1))];
-    const double len = geometry::polylineLength(blk.sidewalk);
-    const double s0 = rng.uniform(0.0, len);
-    const double dist = rng.uniform(60.0, 300.0) * (rng.bernoulli(0.5) ? 1.0 : -1.0);
-    ped.activity = "walking";
-    ped.trajectory = walkRing(blk.sidewalk, s0, s0 + dist, speed, t_start);
-    ped.pose = ped.trajectory.front();
-    out.pedestrians.push_back(std::move(ped));
+  const TrafficEpisode& e = out.episode->episode;
+  const bool first_only = first_pose_only && out.episode->text;
+  out.pedestrians.resize(e.pedestrians.size());
+  for (std::size_t i = 0; i < e.pedestrians.size(); ++i) {
+    const CityPedestrian& from = e.pedestrians[i];
+    CityPedestrian& p = out.pedestrians[i];
+    p.activity = from.activity;
+    p.clothing_color = from.clothing_color;
+    p.height = from.height;
+    p.pose = from.pose;
+    if (from.trajectory.empty()) continue;
+    p.trajectory = first_only ? firstPose(from.trajectory, out.offset)
+                              : window(from.trajectory, out.offset, duration);
   }
   return out;
 }

@@ -286,13 +286,15 @@ void writeSignalPlan(JsonWriter& w, const SignalPlan& sp) {
 namespace {
 
 // sim_config.json into w (emptied first). traffic_by_reference: a city scenario's episode cars
-// are left out of "entities" and named by the "traffic" reference instead.
+// and pedestrians are left out of "entities" and named by the "traffic" reference instead.
 void writeSimConfig(JsonWriter& w, const SimConfig& s, bool traffic_by_reference = false) {
   // Room for the whole document up front (a trajectory point takes about 60 characters):
   // growing a 100 KB buffer by doubling would copy it several times.
   std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;
   const std::size_t written =
-      s.entities.size() - (s.traffic && traffic_by_reference ? s.traffic->car_ids.size() : 0);
+      s.entities.size() - (s.traffic && traffic_by_reference
+                               ? s.traffic->car_ids.size() + s.traffic->pedestrian_ids.size()
+                               : 0);
   for (std::size_t k = 0; k < written; ++k) points += s.entities[k].trajectory.size() + 8;
   for (const auto& a : s.aircraft) points += a.trajectory.size() + 4;
   w.clear(8192 + 64 * points);
@@ -409,6 +411,9 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s, bool traffic_by_reference
     w.key("sha256").value(r.sha256);
     w.key("cars").beginArray();
     for (const auto& id : r.car_ids) w.value(id);
+    w.endArray();
+    w.key("pedestrians").beginArray();
+    for (const auto& id : r.pedestrian_ids) w.value(id);
     w.endArray().endObject();
   }
   if (s.spec) {

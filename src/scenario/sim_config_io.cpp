@@ -196,8 +196,8 @@ namespace {
 
 // sim_config.json's "traffic": the reference to a traffic episode file, resolved: the file is
 // read (relative to the directory of `file`), its SHA-256 checked, the window checked to lie
-// within the episode and the signal plan to be the episode's shifted by the offset; the cars are
-// appended to s.entities.
+// within the episode and the signal plan to be the episode's shifted by the offset; the
+// pedestrians and then the cars are appended to s.entities.
 TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& file,
                                        std::set<std::string>* ids) {
   TrafficEpisodeRef r;
@@ -211,6 +211,7 @@ TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& 
     t.error("sha256", "expected 64 lower-case hex digits, got '" + r.sha256 + "'");
   }
   r.car_ids = strings(t.array("cars"), t.at("cars"), file);
+  r.pedestrian_ids = strings(t.array("pedestrians"), t.at("pedestrians"), file);
   t.finish();
   if (r.file.empty() || r.file.find('\0') != std::string::npos) {
     t.error("file", "expected a file name");
@@ -245,6 +246,11 @@ TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& 
     t.error("cars", "expected " + std::to_string(e.cars.size()) + " ids (one per car of " + path +
                         "), got " + std::to_string(r.car_ids.size()));
   }
+  if (r.pedestrian_ids.size() != e.pedestrians.size()) {
+    t.error("pedestrians", "expected " + std::to_string(e.pedestrians.size()) +
+                               " ids (one per pedestrian of " + path + "), got " +
+                               std::to_string(r.pedestrian_ids.size()));
+  }
   const SignalPlan want = shiftedSignalPlan(e.plan, r.offset);
   bool same = s.signals && s.signals->cycle() == want.cycle() &&
               s.signals->intersections.size() == want.intersections.size();
@@ -256,6 +262,15 @@ TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& 
   if (!same) {
     throw ConfigError(file + ": signals: expected the signal plan of " + path +
                       " with every offset shifted by traffic.offset (" + fmt(r.offset) + " s)");
+  }
+  for (std::size_t i = 0; i < e.pedestrians.size(); ++i) {
+    if (!ids->insert(r.pedestrian_ids[i]).second) {
+      throw ConfigError(file + ": " + idx("traffic.pedestrians", i) + ": duplicate id \"" +
+                        r.pedestrian_ids[i] + "\"");
+    }
+    s.entities.push_back(cityPedestrianEntity(e.pedestrians[i],
+                                              episodePedestrianWindow(e, i, r.offset, s.duration),
+                                              r.pedestrian_ids[i]));
   }
   for (std::size_t i = 0; i < e.cars.size(); ++i) {
     if (!ids->insert(r.car_ids[i]).second) {

@@ -44,6 +44,7 @@ std::vector<double> flatNumbers(const json& a, const std::string& path, const st
 std::string trafficEpisodeJson(const TrafficEpisode& e) {
   std::size_t knots = 0;
   for (const auto& c : e.cars) knots += c.knots.size();
+  for (const auto& p : e.pedestrians) knots += 4 * p.trajectory.size() + 8;
   JsonWriter w(false, 4096 + 12 * knots);
   w.beginObject();
   w.key("format").value(kEpisodeFormat).key("schema_version").value(kSchemaVersion);
@@ -68,6 +69,17 @@ std::string trafficEpisodeJson(const TrafficEpisode& e) {
     w.key("size").numbers({c.size.x(), c.size.y(), c.size.z()});
     w.key("knots").beginArray();
     for (double v : c.knots) w.value(v);
+    w.endArray().endObject();
+  }
+  w.endArray();
+  w.key("pedestrians").beginArray();
+  for (const auto& p : e.pedestrians) {
+    w.beginObject();
+    w.key("activity").value(p.activity).key("clothing_color").value(p.clothing_color);
+    w.key("height").value(p.height);
+    w.key("pose").numbers({p.pose.x, p.pose.y, p.pose.yaw});
+    w.key("keyframes").beginArray();
+    for (const auto& q : p.trajectory) w.value(q.t).value(q.x).value(q.y).value(q.yaw);
     w.endArray().endObject();
   }
   w.endArray();
@@ -167,6 +179,44 @@ TrafficEpisode parseTrafficEpisode(const std::string& text, const std::string& f
     }
     c.finish();
     e.cars.push_back(std::move(car));
+  }
+  const json& peds = root.array("pedestrians");
+  for (std::size_t i = 0; i < peds.size(); ++i) {
+    Obj o(peds[i], idx("pedestrians", i), file);
+    CityPedestrian p;
+    p.activity = o.string("activity");
+    if (p.activity != "walking" && p.activity != "crossing" && p.activity != "jaywalking" &&
+        p.activity != "queuing") {
+      o.error("activity",
+              "expected walking, crossing, jaywalking or queuing, got \"" + p.activity + "\"");
+    }
+    p.clothing_color = o.string("clothing_color");
+    p.height = o.numberIn("height", 0.5, 2.5);
+    const std::vector<double> pose = flatNumbers(o.array("pose"), o.at("pose"), file);
+    if (pose.size() != 3) o.error("pose", "expected 3 numbers (x, y, yaw)");
+    p.pose.x = pose[0];
+    p.pose.y = pose[1];
+    p.pose.yaw = pose[2];
+    const std::vector<double> k = flatNumbers(o.array("keyframes"), o.at("keyframes"), file);
+    if (k.size() % 4 != 0 || (p.activity == "queuing") != k.empty()) {
+      o.error("keyframes", p.activity == "queuing"
+                               ? "expected none for a pedestrian who queues"
+                               : "expected t, x, y, yaw quadruples, the first at t = 0");
+    }
+    for (std::size_t q = 0; q < k.size(); q += 4) {
+      if (q == 0 ? k[0] != 0.0 : !(k[q] > k[q - 4])) {
+        throw ConfigError(file + ": " + idx(o.at("keyframes"), q) +
+                          (q == 0 ? ": expected the first keyframe at t = 0, got "
+                                  : ": expected t increasing, got ") +
+                          fmt(k[q]));
+      }
+      p.trajectory.push_back({k[q], k[q + 1], k[q + 2], 0.0, k[q + 3]});
+    }
+    if (!p.trajectory.empty() && p.trajectory.back().t < e.length) {
+      o.error("keyframes", "expected keyframes up to the episode's length " + fmt(e.length) + " s");
+    }
+    o.finish();
+    e.pedestrians.push_back(std::move(p));
   }
   root.finish();
   return e;

@@ -52,10 +52,14 @@ void Semantics::simConfig() {
 }
 
 void Semantics::trafficReference(IdSet& ids) {
-  const json& cars = arrayOrEmpty(doc_.at("traffic"), "cars");
-  for (std::size_t i = 0; i < cars.size(); ++i) {
-    if (cars[i].is_string())
-      ids.noteId(cars[i].get<std::string>(), jsonPointerAppend("/traffic/cars", i));
+  for (const char* key : {"cars", "pedestrians"}) {
+    const json& list = arrayOrEmpty(doc_.at("traffic"), key);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (list[i].is_string()) {
+        ids.noteId(list[i].get<std::string>(),
+                   jsonPointerAppend(std::string("/traffic/") + key, i));
+      }
+    }
   }
   // The reader resolves the reference; its message names the file, the field and what it
   // expected. Issues elsewhere in the document are reported by the other checks.

@@ -417,6 +417,7 @@ TEST(CityTraffic, DensitiesJaywalkingAndBusQueues) {
   // Jaywalking: the share of street crossings made mid-block, within three standard deviations
   // of the configured probability; every jaywalker crosses at least 15 m from a street node.
   int crossings = 0, jay = 0, queuing = 0, near_node = 0, far_from_stop = 0;
+  int jaywalkers_seen = 0, jaywalkers_crossing = 0;
   std::vector<Vec2> stops;
   for (const auto& e : w.entities()) {
     if (e.cls == EntityClass::kBusStop) stops.push_back(e.box.center2());
@@ -426,11 +427,27 @@ TEST(CityTraffic, DensitiesJaywalkingAndBusQueues) {
     if (act == "crossing" || act == "jaywalking") ++crossings;
     if (act == "jaywalking") {
       ++jay;
-      // The two middle samples bound the crossing itself.
+      // The crossings: keyframe steps across a street, centred on its centreline and square to
+      // it. A jaywalker crosses back and forth, each time at least 15 m from a street node.
       const auto& tr = p->trajectory;
-      const Vec2 mid(0.5 * (tr[tr.size() - 2].x + tr[tr.size() - 3].x),
-                     0.5 * (tr[tr.size() - 2].y + tr[tr.size() - 3].y));
-      for (const auto& n : w.nodes()) near_node += (n.position - mid).norm() < 15.0 ? 1 : 0;
+      int crossed = 0;
+      for (std::size_t k = 0; k + 1 < tr.size(); ++k) {
+        const Vec2 a(tr[k].x, tr[k].y), c(tr[k + 1].x, tr[k + 1].y);
+        if ((c - a).norm() < 1.0) continue;
+        const Vec2 mid = 0.5 * (a + c);
+        for (const auto& e : w.edges()) {
+          const Vec2 pa = w.nodes()[e.a].position, pb = w.nodes()[e.b].position;
+          const Vec2 ue = (pb - pa).normalized();
+          const double along = (mid - pa).dot(ue);
+          if (along < 0 || along > (pb - pa).norm()) continue;
+          if ((mid - pa - along * ue).norm() > 0.05) continue;
+          if (std::abs((c - a).normalized().dot(ue)) > 0.1) continue;
+          ++crossed;
+          for (const auto& n : w.nodes()) near_node += (n.position - mid).norm() < 15.0 ? 1 : 0;
+        }
+      }
+      ++jaywalkers_seen;
+      jaywalkers_crossing += crossed > 0 ? 1 : 0;
     }
     if (act == "queuing") {
       ++queuing;
@@ -440,20 +457,35 @@ TEST(CityTraffic, DensitiesJaywalkingAndBusQueues) {
       far_from_stop += best > 8.5 ? 1 : 0;
     }
   }
+  // The share over the crowds of all the world's episodes: a scenario's crowd is one episode's
+  // (about 120 crossers, too few to tell the probability from twice it).
+  int all_crossings = 0, all_jay = 0;
+  for (int k = 0; k < static_cast<int>(cp.traffic_episodes); ++k) {
+    for (const auto& p : cityTrafficEpisode(w, k)->episode.pedestrians) {
+      all_crossings += p.activity == "crossing" || p.activity == "jaywalking" ? 1 : 0;
+      all_jay += p.activity == "jaywalking" ? 1 : 0;
+    }
+  }
   const double pj = cp.jaywalk_probability;
-  const double sigma = std::sqrt(pj * (1 - pj) / crossings);
-  const double share = static_cast<double>(jay) / crossings;
+  const double sigma = std::sqrt(pj * (1 - pj) / all_crossings);
+  const double share = static_cast<double>(all_jay) / all_crossings;
   EXPECT_GT(crossings, 50);
+  EXPECT_GT(jay, 0);
+  EXPECT_GT(all_crossings, 8 * 50);
   EXPECT_LE(std::abs(share - pj), 3 * sigma);
   // Negative control: the same count judged against a probability twice as high fails.
-  EXPECT_GT(std::abs(share - 2 * pj), 3 * std::sqrt(2 * pj * (1 - 2 * pj) / crossings));
+  EXPECT_GT(std::abs(share - 2 * pj), 3 * std::sqrt(2 * pj * (1 - 2 * pj) / all_crossings));
   EXPECT_EQ(near_node, 0);
+  EXPECT_GT(jaywalkers_seen, 0);
+  EXPECT_EQ(jaywalkers_crossing, jaywalkers_seen);
   EXPECT_GT(queuing, 0);
   EXPECT_EQ(far_from_stop, 0);
   std::printf(
       "per km^2: moving cars %.1f (mean), cars present %.1f (min), pedestrians %.1f (min); "
-      "crossings %d, jaywalking %d (share %.3f, p %.2f, 3 sigma %.3f), queuing %d\n",
-      moving_mean, present_min / km2, ped_min / km2, crossings, jay, share, pj, 3 * sigma, queuing);
+      "crossers %d, jaywalking %d (%d crossing in the scenario), queuing %d; over the %d "
+      "episodes: crossers %d, jaywalking %d (share %.3f, p %.2f, 3 sigma %.3f)\n",
+      moving_mean, present_min / km2, ped_min / km2, crossings, jay, jaywalkers_crossing, queuing,
+      static_cast<int>(cp.traffic_episodes), all_crossings, all_jay, share, pj, 3 * sigma);
 }
 
 TEST(CityTraffic, DeterministicAndWrittenWithItsSignalPlan) {
@@ -550,6 +582,9 @@ TEST(CityTrafficEpisode, BatchReferencesReadBackAsTheGeneratedScenario) {
     const SimConfig back = loadSimConfig(path);
     ASSERT_TRUE(back.traffic.has_value());
     EXPECT_GE(back.traffic->car_ids.size(), 100u);
+    EXPECT_GE(back.traffic->pedestrian_ids.size(), 300u);
+    // The crowd is not inline: only the mission's own entities are listed.
+    EXPECT_EQ(text.find("jaywalking"), std::string::npos) << path;
     const Scenario again = generateScenario(cityWorld(), quickConfig(), e.cls, e.seed);
     EXPECT_EQ(simConfigJson(back), simConfigJson(again.sim)) << path;
     EXPECT_EQ(simConfigJson(again.sim, true), text);
@@ -587,6 +622,10 @@ TEST(CityTrafficEpisode, BatchReferencesReadBackAsTheGeneratedScenario) {
   k = j;
   k["traffic"]["cars"].erase(k["traffic"]["cars"].size() - 1);
   EXPECT_NE(failure(k.dump()).find("traffic.cars: expected"), std::string::npos);
+  k = j;
+  ASSERT_GE(k["traffic"]["pedestrians"].size(), 300u);
+  k["traffic"]["pedestrians"].erase(k["traffic"]["pedestrians"].size() - 1);
+  EXPECT_NE(failure(k.dump()).find("traffic.pedestrians: expected"), std::string::npos);
   // A signal plan not shifted with the offset.
   k = j;
   const double t0 = j["traffic"]["offset"].get<double>();

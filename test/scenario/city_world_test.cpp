@@ -276,7 +276,7 @@ TEST(CityWorld, EveryMissionClassGeneratesValidScenariosClearOfTheBuildings) {
   }
   EXPECT_EQ(scenarios, 6);
   EXPECT_EQ(paths, 6);  // the generator found a perception path in every one
-  EXPECT_EQ(movers, 3388);  // targets, confusers, the traffic and the crowd
+  EXPECT_EQ(movers, 3430);  // targets, confusers, the traffic and the crowd
   std::printf("city scenarios %d, perception paths %d, moving entities %d\n", scenarios, paths,
               movers);
 }

@@ -257,9 +257,10 @@ def sha_ok(path, ref):
 
 
 def episode_cars(ref, sim, sim_path):
-    """The traffic cars of a scenario that references a traffic episode file, as entities with a
-    [t, x, y, z, yaw] trajectory over the scenario's window: the knots (t, s) along the lane
-    of its path shifted by the offset, the yaw that of the chord from s - 1.5 m to s + 1.5 m."""
+    """The episode (decoded JSON) and the traffic cars of a scenario that references a traffic
+    episode file, as entities with a [t, x, y, z, yaw] trajectory over the scenario's window:
+    the knots (t, s) along the lane of its path shifted by the offset, the yaw that of the chord
+    from s - 1.5 m to s + 1.5 m."""
     path = os.path.join(os.path.dirname(sim_path), ref["file"])
     with open(path, "rb") as f:
         raw = f.read()
@@ -289,6 +290,32 @@ def episode_cars(ref, sim, sim_path):
                     "attributes": {"lane": ep["lanes"][car["path"][0]]["name"]},
                     "pose": {"x": x[0], "y": y[0], "z": 0.0, "yaw": yaw[0]},
                     "trajectory": traj})
+    return ep, out
+
+
+def episode_pedestrians(ref, ep, sim):
+    """The crowd of a scenario that references a traffic episode: each pedestrian's keyframes
+    (t, x, y, yaw) around the window, shifted by the offset; a queuing one stands at its pose."""
+    t0, dur = ref["offset"], sim["duration"]
+    check(len(ref["pedestrians"]) == len(ep["pedestrians"]), "one id per episode pedestrian")
+    out = []
+    for pid, p in zip(ref["pedestrians"], ep["pedestrians"]):
+        k = np.asarray(p["keyframes"], dtype=float).reshape(-1, 4)
+        pose = {"x": p["pose"][0], "y": p["pose"][1], "z": 0.0, "yaw": p["pose"][2]}
+        traj = []
+        if len(k):
+            check(k[0, 0] == 0.0 and k[-1, 0] >= ep["length"] and np.all(np.diff(k[:, 0]) > 0),
+                  "keyframes from 0 to the episode's end, t increasing")
+            a = max(0, int(np.searchsorted(k[:, 0], t0, side="right")) - 1)
+            b = min(len(k), int(np.searchsorted(k[:, 0], t0 + dur, side="left")) + 1)
+            traj = [[t - t0, x, y, 0.0, w] for t, x, y, w in k[a:b]]
+            x0, y0, _ = sample(traj, np.array([0.0]))
+            pose = {"x": float(x0[0]), "y": float(y0[0]), "z": 0.0, "yaw": traj[0][4]}
+        out.append({"id": pid, "class": "pedestrian", "role": "pedestrian",
+                    "size": [0.5, 0.6, p["height"]],
+                    "attributes": {"activity": p["activity"],
+                                   "clothing_color": p["clothing_color"]},
+                    "pose": pose, "trajectory": traj})
     return out
 
 
@@ -298,7 +325,8 @@ def load(d):
         with open(path) as f:
             sim = json.load(f)
         if "traffic" in sim:
-            sim["entities"] += episode_cars(sim["traffic"], sim, path)
+            ep, cars = episode_cars(sim["traffic"], sim, path)
+            sim["entities"] += episode_pedestrians(sim["traffic"], ep, sim) + cars
         out.append(sim)
     return out
 
@@ -425,9 +453,12 @@ def main():
                 ep = json.load(f)
             car_min = len(ep["cars"]) * ep["length"] / 60.0
             knots = sum(len(c["knots"]) // 2 for c in ep["cars"])
-            print("%s: %d bytes, %d cars, %d knots, %.0f bytes per car-minute"
+            frames = sum(len(p["keyframes"]) // 4 for p in ep["pedestrians"])
+            check(len(ep["pedestrians"]) >= 300, "episode pedestrians", str(len(ep["pedestrians"])))
+            print("%s: %d bytes, %d cars, %d knots, %.0f bytes per car-minute, "
+                  "%d pedestrians, %d keyframes"
                   % (os.path.basename(path), os.path.getsize(path), len(ep["cars"]), knots,
-                     os.path.getsize(path) / car_min))
+                     os.path.getsize(path) / car_min, len(ep["pedestrians"]), frames))
         for path in sorted(glob.glob(os.path.join(d, "*", "sim_config.json"))):
             print("%s: %d bytes" % (os.path.relpath(path, d), os.path.getsize(path)))
 

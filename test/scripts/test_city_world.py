@@ -139,6 +139,24 @@ def main():
             check(filecmp.cmp(path, other, shallow=False), "byte-identical across --jobs " + path)
         episodes = glob.glob(os.path.join(dirs[0], "traffic_episode_*.json"))
         check(1 <= len(episodes) <= 6, "traffic episode files beside world.json", str(episodes))
+        # Negative controls: the schemas refuse a crowd pedestrian with an unknown activity or
+        # an odd keyframe field, and a reference without its pedestrian ids.
+        with open(sorted(episodes)[0]) as f:
+            ep = json.load(f)
+        check(len(ep["pedestrians"]) >= 300, "episode pedestrians", str(len(ep["pedestrians"])))
+        ep["pedestrians"][0]["activity"] = "flying"
+        check(list(validators["traffic_episode"].iter_errors(ep)),
+              "control: jsonschema refuses an unknown pedestrian activity")
+        ep["pedestrians"][0] = dict(ep["pedestrians"][0], activity="walking", speed=1.2)
+        check(list(validators["traffic_episode"].iter_errors(ep)),
+              "control: jsonschema refuses an unknown pedestrian key")
+        sim_path = sorted(glob.glob(os.path.join(dirs[0], "*", "sim_config.json")))[0]
+        with open(sim_path) as f:
+            sim = json.load(f)
+        check("pedestrians" in sim["traffic"], "a reference names its pedestrians")
+        del sim["traffic"]["pedestrians"]
+        check(list(validators["sim_config"].iter_errors(sim)),
+              "control: jsonschema refuses a reference without its pedestrian ids")
         check(docs == 2 * 6 + 2 + len(episodes), "documents in the batch", str(docs))
         files = sorted(f for f in glob.glob(os.path.join(dirs[0], "**", "*.json"), recursive=True)
                        if f not in episodes)

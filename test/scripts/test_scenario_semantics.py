@@ -1076,6 +1076,34 @@ def load(path):
         return json.load(f)
 
 
+def episode_crowd(sim, sim_path):
+    """The crowd of a city scenario that a batch wrote by reference to a traffic episode file,
+    as the entities the self-contained file lists: each pedestrian's keyframes around the
+    window shifted by the offset, its pose at the window's start (a queuing one at its pose)."""
+    ref = sim["traffic"]
+    ep = load(os.path.join(os.path.dirname(sim_path), ref["file"]))
+    t0, dur = ref["offset"], sim["duration"]
+    out = []
+    for pid, p in zip(ref["pedestrians"], ep["pedestrians"]):
+        k = p["keyframes"]
+        rows = [k[i:i + 4] for i in range(0, len(k), 4)]
+        traj = []
+        x, y, yaw = p["pose"]
+        if rows:
+            a = max(0, bisect.bisect_right([r[0] for r in rows], t0) - 1)
+            b = min(len(rows), bisect.bisect_left([r[0] for r in rows], t0 + dur) + 1)
+            traj = [[r[0] - t0, r[1], r[2], 0.0, r[3]] for r in rows[a:b]]
+            (ta, xa, ya, _, wa), (tb, xb, yb, _, wb) = traj[0], traj[min(1, len(traj) - 1)]
+            u = 0.0 if tb <= ta else min(1.0, max(0.0, -ta / (tb - ta)))
+            x, y, yaw = xa + u * (xb - xa), ya + u * (yb - ya), wa if u < 0.5 else wb
+        out.append({"id": pid, "class": "pedestrian", "role": "pedestrian",
+                    "attributes": {"clothing_color": p["clothing_color"],
+                                   "activity": p["activity"]},
+                    "pose": {"x": x, "y": y, "z": 0.0, "yaw": yaw},
+                    "size": [0.5, 0.6, p["height"]], "trajectory": traj})
+    return out
+
+
 def main(world="suburb", count=150, min_checks=MIN_CHECKS):
     """Checks a batch of `count` scenarios generated with --world `world`."""
     start = time.time()
@@ -1112,6 +1140,8 @@ def main(world="suburb", count=150, min_checks=MIN_CHECKS):
         for d in dirs:
             mission = load(os.path.join(tmp, d, "mission.json"))
             sim = load(os.path.join(tmp, d, "sim_config.json"))
+            if "traffic" in sim:
+                sim["entities"] += episode_crowd(sim, os.path.join(tmp, d, "sim_config.json"))
             entry = listed.get(d)
             if entry is not None:
                 ck.check((entry["id"], entry["class"], entry["seed"]) == (mission["scenario_id"], mission["class"], mission["seed"])

@@ -34,9 +34,10 @@ struct CityCar {
   Trajectory trajectory;
 };
 
-// One pedestrian of the crowd. activity: walking (a sidewalk stroll), crossing (at a signalised
-// crosswalk while the crossed street is red), jaywalking (mid-block, off the signals) or queuing
-// (standing at a bus stop; the trajectory is empty and `pose` is where).
+// One pedestrian of the crowd. activity: walking (strolls along a block's sidewalk, pausing
+// between them), crossing (back and forth over a signalised crosswalk, each time while the
+// crossed street is red), jaywalking (back and forth across a local street mid-block, off the
+// signals) or queuing (standing at a bus stop; the trajectory is empty and `pose` is where).
 struct CityPedestrian {
   std::string activity;
   std::string clothing_color;
@@ -45,13 +46,14 @@ struct CityPedestrian {
   Trajectory trajectory;
 };
 
-// A traffic episode: the ambient cars of a city world simulated once over `length` seconds,
-// shared by every scenario of a batch that draws it (each sees a window of it). Compact: each
-// lane piece's polyline (a link between boxes, a straight or turning connector across a box, a
-// loop beyond the tile) is stored once; each car's path is a list of pieces, each starting
-// where the previous one ends, and its motion knots (t, s) of its arc length s along the joined
-// path, between which the car moves at constant speed; every simulated position lies within
-// 10 cm of the interpolation.
+// A traffic episode: the ambient cars and crowd of a city world simulated once over `length`
+// seconds, shared by every scenario of a batch that draws it (each sees a window of it).
+// Compact: each lane piece's polyline (a link between boxes, a straight or turning connector
+// across a box, a loop beyond the tile) is stored once; each car's path is a list of pieces,
+// each starting where the previous one ends, and its motion knots (t, s) of its arc length s
+// along the joined path, between which the car moves at constant speed; every simulated
+// position lies within 10 cm of the interpolation. A pedestrian walks straight lines between
+// keyframes (t, x, y, yaw), stored exactly as a scenario's trajectory holds them.
 struct TrafficEpisode {
   struct Lane {
     std::string name;
@@ -69,6 +71,7 @@ struct TrafficEpisode {
   SignalPlan plan;  // at episode time
   std::vector<Lane> lanes;
   std::vector<Car> cars;
+  std::vector<CityPedestrian> pedestrians;  // over [0, length] and a little beyond
 };
 
 // The length of every traffic episode (s): a scenario of duration d starts at an offset in
@@ -95,6 +98,16 @@ Trajectory episodeCarWindow(const TrafficEpisode& e, std::size_t car, double off
 ScenarioEntity episodeCarEntity(const TrafficEpisode& e, std::size_t car, Trajectory window,
                                 const std::string& id);
 
+// Pedestrian `ped`'s trajectory over the episode window [offset, offset + duration], shifted to
+// start at 0 (empty for a pedestrian who stands).
+Trajectory episodePedestrianWindow(const TrafficEpisode& e, std::size_t ped, double offset,
+                                   double duration);
+
+// The scenario entity (role "pedestrian") of a crowd pedestrian moving along `window` (its box
+// at the window's first pose, or at `p.pose` when it stands).
+ScenarioEntity cityPedestrianEntity(const CityPedestrian& p, Trajectory window,
+                                    const std::string& id);
+
 // The signal plan a scenario sees when it starts at `offset` of a plan: every offset shifted.
 SignalPlan shiftedSignalPlan(const SignalPlan& plan, double offset);
 
@@ -112,8 +125,9 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
 struct CityTraffic {
   SignalPlan plan;
   std::vector<CityCar> cars;
-  std::vector<CityPedestrian> pedestrians;
-  // Set when the cars are a window of a shared episode (car i is the episode's car i).
+  std::vector<CityPedestrian> pedestrians;  // trajectories: the scenario's window
+  // The episode the cars and pedestrians are a window of (car i is the episode's car i, and
+  // pedestrian i its pedestrian i); shared by a batch when episode->text is set.
   std::shared_ptr<const SharedTrafficEpisode> episode;
   double offset = 0.0;
 };
@@ -124,8 +138,12 @@ SignalPlan citySignalPlan(const World& world, std::uint64_t seed);
 
 // The traffic and crowd of a city scenario of `duration` seconds (world.params().city holds the
 // densities and signal timing). Throws GenerationError when the world is not a city.
+// first_pose_only: when the traffic is a window of a shared episode, each car's and moving
+// pedestrian's trajectory is only its first point (its pose at t = 0), for a caller that writes
+// the episode reference instead of the trajectories (a batch); a scenario of its own cars is
+// returned whole.
 CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
-                                const IdmParams& idm = {});
+                                const IdmParams& idm = {}, bool first_pose_only = false);
 
 // Upper bounds on the number of cars and pedestrians simulateCityTraffic() returns for `world`
 // (the generator sizes its id pools with them).

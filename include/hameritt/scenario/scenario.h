@@ -325,16 +325,17 @@ struct SignalPlan {
   SignalState state(const SignalizedIntersection& i, int axis, double t) const;
 };
 
-// The ambient cars of a city scenario taken from a traffic episode file that a batch shares
-// (scenario/city_traffic.h): the scenario's t = 0 is the episode's t = offset. In memory the cars
-// are also the last car_ids.size() entities; simConfigJson() writes them inline, and a batch
-// writes this reference instead.
+// The ambient cars and crowd of a city scenario taken from a traffic episode file that a batch
+// shares (scenario/city_traffic.h): the scenario's t = 0 is the episode's t = offset. In memory
+// they are also the last entities (pedestrian_ids.size() pedestrians, then car_ids.size() cars);
+// simConfigJson() writes them inline, and a batch writes this reference instead.
 struct TrafficEpisodeRef {
   std::string file;  // relative to the directory of sim_config.json
   int episode = 0;
   double offset = 0.0;
   std::string sha256;                       // of the file's bytes, lowercase hex
   std::vector<std::string> car_ids;         // the entity id of each of the episode's cars, in order
+  std::vector<std::string> pedestrian_ids;  // and of each of its pedestrians
   std::shared_ptr<const std::string> text;  // the file's bytes (set by the generator)
 };
 
@@ -353,7 +354,7 @@ struct SimConfig {
   Perturbations perturbations;
   std::optional<SpecProvenance> spec;  // written only for scenarios generated from a spec
   std::optional<SignalPlan> signals;   // the city's signal plan; absent in the suburb
-  std::optional<TrafficEpisodeRef> traffic;  // city only: where the ambient cars come from
+  std::optional<TrafficEpisodeRef> traffic;  // city only: where the ambient traffic comes from
 };
 
 struct Scenario {
