@@ -83,12 +83,11 @@ bool FollowScorer::add(const FollowSample& s) {
   } else if (!outside_since_) {
     outside_since_ = s.t;
   }
+  if (outside_since_ && s.t - *outside_since_ > criteria_.max_outside_s) exceeded_ = true;
   return true;
 }
 
-bool FollowScorer::failedEarly() const {
-  return outside_since_ && samples_.back().t - *outside_since_ > criteria_.max_outside_s;
-}
+bool FollowScorer::failedEarly() const { return exceeded_; }
 
 FollowPhaseScore FollowScorer::score(double koz_seconds, bool collision, bool ended) const {
   FollowPhaseScore r;

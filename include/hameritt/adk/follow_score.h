@@ -49,7 +49,8 @@ class FollowScorer {
   bool add(const FollowSample& sample);
   // The phase's duration has been flown (a sample at or after start + duration).
   bool complete() const;
-  // The phase can no longer succeed: outside the envelope for longer than max_outside_s.
+  // The phase can no longer succeed: it has been outside the envelope for longer than
+  // max_outside_s at a stretch (it stays so once it has happened).
   bool failedEarly() const;
 
   // The score so far; `koz_seconds` and `collision` over the phase, from the constraint monitor
@@ -66,6 +67,7 @@ class FollowScorer {
   std::optional<double> start_;
   std::vector<FollowSample> samples_;
   std::optional<double> outside_since_;
+  bool exceeded_ = false;
 };
 
 }  // namespace hameritt::adk
