@@ -341,6 +341,28 @@ std::string metricsJson(const MissionMetrics& m) {
     o["koz_seconds"] = a.koz_seconds;
     j["avoid"] = o;
   }
+  if (m.follow) {
+    const FollowPhaseScore& f = *m.follow;
+    ordered_json o;
+    o["phase"] = f.phase;
+    o["target"] = f.target;
+    o["state"] = toString(f.state);
+    o["success"] = f.success;
+    o["failure"] = f.failure;
+    o["start_time"] = opt(f.start_time);
+    o["duration"] = f.duration;
+    o["elapsed"] = f.elapsed;
+    o["samples"] = f.envelope.samples;
+    o["inside_fraction"] = f.envelope.inside_fraction;
+    o["longest_outside"] = f.envelope.longest_outside_s;
+    o["rms_distance_error"] = f.envelope.rms_distance_error_m;
+    o["p95_distance_error"] = f.envelope.p95_distance_error_m;
+    o["rms_height_error"] = f.envelope.rms_height_error_m;
+    o["line_of_sight_fraction"] = f.envelope.line_of_sight_fraction;
+    o["koz_seconds"] = f.koz_seconds;
+    o["collision"] = f.collision;
+    j["follow"] = o;
+  }
   return j.dump(2) + "\n";
 }
 

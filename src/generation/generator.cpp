@@ -122,6 +122,9 @@ class ScenarioBuilder {
       case ScenarioClass::kAvoid:
         buildAvoid();  // places the UAV itself, at the start of its reference flight
         break;
+      case ScenarioClass::kFollow:
+        buildFollow();
+        break;
     }
     if (plan_ && !plan_->kozs.empty()) addSpecKozs();
     if (cls_ != ScenarioClass::kAvoid) placeUavStart();
@@ -1411,6 +1414,43 @@ class ScenarioBuilder {
     std::vector<SceneRelation> rels;
     for (const auto& r : m.relations) rels.push_back(r);
     addConfusers(target, rels, aois, nullptr, 60.0);
+  }
+
+  // ------------------------------------------------------------------ follow
+  // The follow class: pursuit's scene (a car that drives off after the pedestrians reach it),
+  // in two phases: find it, then keep inside the envelope behind and above it for a drawn
+  // duration. The time limit is pursuit's plus that duration.
+  void buildFollow() {
+    buildPursuit();
+    Mission& m = sc_.mission;
+    const std::string target = m.objective.targets.front().id;
+    MissionPhase search;
+    search.id = "search_1";
+    search.type = PhaseType::kSearch;
+    search.targets = {target};
+    MissionPhase follow;
+    follow.id = "follow_1";
+    follow.type = PhaseType::kFollow;
+    follow.targets = {target};
+    FollowPhaseSpec& f = follow.follow;
+    f.distance = std::round(rangeDraw(rng_, cfg_.follow_distance));
+    f.distance_tolerance = std::round(rangeDraw(rng_, cfg_.follow_distance_tolerance));
+    f.height_tolerance = std::round(rangeDraw(rng_, cfg_.follow_height_tolerance));
+    // h* +- H inside the altitude band (the band is at least 15 m, H at most 7 m: validate()).
+    f.height =
+        std::clamp(std::round(rangeDraw(rng_, cfg_.follow_height)),
+                   uav_.altitude_min + f.height_tolerance, uav_.altitude_max - f.height_tolerance);
+    const double duration = std::round(rangeDraw(rng_, cfg_.follow_duration));
+    follow.duration = duration;
+    m.phases = {search, follow};
+    m.time_limit += duration;
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  " Then follow it for %.0f s: %.0f +- %.0f m behind it and %.0f +- %.0f m above "
+                  "it.",
+                  duration, f.distance, f.distance_tolerance, f.height, f.height_tolerance);
+    m.objective.text =
+        "Find the " + lookText(m.objective.targets.front()) + " that pedestrians chase." + text;
   }
 
   // ------------------------------------------------------------------ avoid

@@ -91,6 +91,7 @@ bool targetSlotAllowed(const World& world, int slot, ScenarioClass cls) {
     case ScenarioClass::kAreaSearch:
       return insideBy20(world, s.position);
     case ScenarioClass::kPursuit:
+    case ScenarioClass::kFollow:
       return !s.driveway && pursuitSlotFits(world, s);
     case ScenarioClass::kRouteSearch:
       return false;

@@ -151,6 +151,16 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     if (phase.type == scenario::PhaseType::kAvoid) {
       avoid_ = std::make_unique<adk::AvoidScorer>(phase.avoid, time_limit);
       avoid_phase_ = phase.id;
+    } else if (phase.type == scenario::PhaseType::kFollow) {
+      follow_ = std::make_unique<adk::FollowScorer>(phase);
+      const auto it = scenario_index_.find(phase.targets.front());
+      if (it == scenario_index_.end()) {
+        throw ConfigError(mission_path + ": phase '" + phase.id + "': target '" +
+                          phase.targets.front() + "' is not an entity of " + sim_config_path);
+      }
+      follow_target_ = &sim_config_.entities[it->second];
+    } else if (phase.type == scenario::PhaseType::kSearch && !search_phase_) {
+      search_phase_ = &phase;
     }
   }
 
@@ -164,6 +174,10 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   state_pub_ = gate_->advertise<hameritt::MissionState>(nh, "adk/state", 10, true);
   metrics_pub_ = gate_->advertise<hameritt::MissionMetrics>(nh, "adk/metrics", 1, true);
   if (avoid_) avoid_pub_ = gate_->advertise<hameritt::AvoidStatus>(nh, "adk/avoid", 10, true);
+  if (follow_) follow_pub_ = gate_->advertise<hameritt::FollowStatus>(nh, "adk/follow", 10, true);
+  if (!mission_.phases.empty()) {
+    phase_pub_ = gate_->advertise<hameritt::PhaseState>(nh, "adk/phase", 10, true);
+  }
 
   if (gate_->enabled()) {
     // Lock-step: the turn carries the sim time (README "Lock-step missions").
@@ -203,6 +217,10 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   uav.header.stamp = stamp;
   gate_->publish(uav_pub_, uav);
   publishState();
+  if (!mission_.phases.empty()) {
+    publishPhase(0.0, mission_.phases.front(), adk::PhaseState::kActive,
+                 "the mission's first phase");
+  }
   ROS_INFO(
       "adk: %s (%s), mode %s, perfect perception %s, time limit %.1f s, %zu cameras, "
       "metrics to %s",
@@ -281,6 +299,19 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     for (const auto& e : monitor_->add(t, p)) gate_->publish(events_pub_, toMsg(e));
     metrics_->addState(t, p, v);
     if (avoid_) avoid_->add(avoidSample(t, p, v));
+    if (follow_ && follow_->started()) {
+      const adk::EntityTruth target = adk::scenarioEntityAt(*follow_target_, t);
+      adk::FollowSample f;
+      f.t = t;
+      f.vehicle = p;
+      f.target = target.position;
+      f.target_yaw = target.yaw;
+      // The sight line from the UAV to the middle of the car, past buildings, trees, fences
+      // and parked cars.
+      f.line_of_sight =
+          world_->occluders().clear(p, target.position + Eigen::Vector3d(0.0, 0.0, 0.75));
+      follow_->add(f);
+    }
   } catch (const adk::InputError& e) {
     HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", odom_sub_.getTopic().c_str(), e.what());
     return;
@@ -298,6 +329,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   if (t >= next_status_t_) {
     publishConstraints(t);
     if (avoid_) publishAvoid(t, avoid_->score(monitor_->violationDuration()));
+    if (follow_ && follow_->started()) publishFollow(t, followScore(false));
     next_status_t_ = t + status_period_;
   }
   judgeTrackAtLimit(t);
@@ -308,6 +340,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   // A target found before the mission started running ends it as soon as it runs.
   checkObjective(t);
   checkAvoid(t);
+  checkFollow(t);
   endAtSimulationEnd(false);
 }
 
@@ -369,6 +402,7 @@ void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {
   char buf[160];
   std::snprintf(buf, sizeof(buf), "crashed into %s at %.2f m/s", msg->entity_id.c_str(),
                 msg->speed);
+  crashed_ = true;
   if (lifecycle_->crash(std::max(t, 0.0), buf)) {
     publishState();
     finish();
@@ -376,7 +410,9 @@ void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {
 }
 
 void AdkRos::judgeTrackAtLimit(double t) {
-  if (lifecycle_->state() != adk::MissionState::kRunning || !metrics_->isTrack()) return;
+  if (lifecycle_->state() != adk::MissionState::kRunning || !metrics_->isTrack() || follow_) {
+    return;  // a follow mission is judged by its phases (checkFollow)
+  }
   const double limit = lifecycle_->timeLimit();
   if (t < limit || !metrics_->objectiveMet(limit)) return;  // else the time limit: timeout
   const std::string how = metrics_->targets().size() == 1 ? "the target" : "every target";
@@ -387,6 +423,22 @@ void AdkRos::judgeTrackAtLimit(double t) {
 }
 
 void AdkRos::checkObjective(double t) {
+  if (follow_) {
+    // The search phase ends at the find: the follow phase starts.
+    if (lifecycle_->state() != adk::MissionState::kRunning || follow_->started()) return;
+    const auto& targets = metrics_->targets();
+    if (!std::all_of(targets.begin(), targets.end(), [](const auto& tm) { return tm.found; })) {
+      return;
+    }
+    follow_->start(t);
+    follow_koz_start_ = monitor_->violationDuration();
+    const std::string how = found_by_sighting_ ? "target sighted" : "target claimed";
+    if (search_phase_) publishPhase(t, *search_phase_, adk::PhaseState::kSucceeded, how);
+    publishPhase(t, follow_->phase(), adk::PhaseState::kActive, how);
+    ROS_INFO("adk: %s at t = %.3f s: the follow phase '%s' starts (%.0f s)", how.c_str(), t,
+             follow_->phase().id.c_str(), *follow_->phase().duration);
+    return;
+  }
   if (lifecycle_->state() != adk::MissionState::kRunning || metrics_->isTrack()) return;
   if (!metrics_->objectiveMet(t)) return;
   // Says how the targets were found: sighted by a camera (~found_by_sighting) or claimed.
@@ -445,8 +497,70 @@ void AdkRos::checkAvoid(double t) {
   const adk::AvoidScore s = avoid_->score(monitor_->violationDuration());
   char at[64];
   std::snprintf(at, sizeof(at), "reached the goal at t = %.3f s", *s.reach_time);
+  for (const auto& phase : mission_.phases) {
+    if (phase.id != avoid_phase_) continue;
+    publishPhase(t, phase, s.success ? adk::PhaseState::kSucceeded : adk::PhaseState::kFailed,
+                 s.success ? std::string(at) : s.failure);
+  }
   if (s.success ? lifecycle_->succeed(t, at)
                 : lifecycle_->fail(t, std::string(at) + ", but " + s.failure)) {
+    publishState();
+    finish();
+  }
+}
+
+adk::FollowPhaseScore AdkRos::followScore(bool ended) const {
+  const double koz = follow_->started() ? monitor_->violationDuration() - follow_koz_start_ : 0.0;
+  return follow_->score(koz, crashed_, ended);
+}
+
+void AdkRos::publishFollow(double t, const adk::FollowPhaseScore& f) {
+  hameritt::FollowStatus m;
+  m.header.stamp = stampOf(t);
+  m.header.frame_id = "map";
+  m.phase = f.phase;
+  m.target = f.target;
+  m.state = adk::toString(f.state);
+  m.start_time = f.start_time ? *f.start_time : std::nan("");
+  m.duration = f.duration;
+  m.elapsed = f.elapsed;
+  m.outside = f.outside;
+  m.current_outside = f.current_outside_s;
+  m.inside_fraction = f.envelope.inside_fraction;
+  m.longest_outside = f.envelope.longest_outside_s;
+  m.rms_distance_error = f.envelope.rms_distance_error_m;
+  m.p95_distance_error = f.envelope.p95_distance_error_m;
+  m.rms_height_error = f.envelope.rms_height_error_m;
+  m.line_of_sight_fraction = f.envelope.line_of_sight_fraction;
+  m.koz_seconds = f.koz_seconds;
+  m.failure = f.failure;
+  gate_->publish(follow_pub_, m);
+}
+
+void AdkRos::publishPhase(double t, const scenario::MissionPhase& phase, adk::PhaseState state,
+                          const std::string& reason) {
+  hameritt::PhaseState m;
+  m.header.stamp = stampOf(t);
+  m.phase = phase.id;
+  m.type = scenario::toString(phase.type);
+  m.state = adk::toString(state);
+  m.reason = reason;
+  phase_states_[phase.id] = state;
+  gate_->publish(phase_pub_, m);
+}
+
+void AdkRos::checkFollow(double t) {
+  if (!follow_ || !follow_->started() || lifecycle_->state() != adk::MissionState::kRunning) {
+    return;
+  }
+  if (!follow_->complete() && !follow_->failedEarly() &&
+      monitor_->violationDuration() - follow_koz_start_ <= 0.0) {
+    return;
+  }
+  const adk::FollowPhaseScore f = followScore(true);
+  publishPhase(t, follow_->phase(), f.state, f.success ? "criteria met" : f.failure);
+  if (f.success ? lifecycle_->succeed(t, "the follow phase '" + f.phase + "' succeeded")
+                : lifecycle_->fail(t, "the follow phase '" + f.phase + "' failed: " + f.failure)) {
     publishState();
     finish();
   }
@@ -553,6 +667,19 @@ void AdkRos::finish() {
   if (avoid_) {
     m.avoid = avoid_->score(monitor_->violationDuration());
     publishAvoid(lifecycle_->endTime(), *m.avoid);
+  }
+  if (follow_) {
+    m.follow = followScore(true);
+    publishFollow(lifecycle_->endTime(), *m.follow);
+  }
+  // A phase still active when the mission ends has failed.
+  for (const auto& phase : mission_.phases) {
+    const auto it = phase_states_.find(phase.id);
+    if (it != phase_states_.end() && it->second == adk::PhaseState::kActive) {
+      const bool follow = follow_ && phase.id == follow_->phase().id;
+      publishPhase(lifecycle_->endTime(), phase, adk::PhaseState::kFailed,
+                   follow && !m.follow->failure.empty() ? m.follow->failure : reason);
+    }
   }
   std::string file;
   if (!output_dir_.empty()) {

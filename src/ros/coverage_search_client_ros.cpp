@@ -142,6 +142,14 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   if (mission_ && mission_->scenario_id == m->scenario_id) return;  // the same, again
   mission_ = std::move(*m);
   filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get());
+  // A follow phase states where to be: its envelope's d* behind and h* above the target.
+  for (const auto& phase : mission_->phases) {
+    if (phase.type != scenario::PhaseType::kFollow) continue;
+    pursuit_.standoff = phase.follow.distance;  // >= 0 (mission.json)
+    if (phase.follow.height > 0) pursuit_.height = phase.follow.height;
+    ROS_INFO("%s: follow phase '%s': standoff %.1f m behind, %.1f m above the target", kClientName,
+             phase.id.c_str(), pursuit_.standoff, pursuit_.height);
+  }
   if (pursue_) {
     chooser_ =
         std::make_unique<clients::ViewpointChooser>(*world_, sim_.uav, mission_->kozs, pursuit_);

@@ -168,6 +168,31 @@ hameritt::Mission toMsg(const scenario::Mission& mission) {
     x.text = scenario::relationText(r);
     m.relations.push_back(x);
   }
+  for (const auto& p : mission.phases) {
+    hameritt::MissionPhase x;
+    x.id = p.id;
+    x.type = scenario::toString(p.type);
+    x.targets = p.targets;
+    x.duration = p.duration.value_or(0.0);
+    x.follow_distance = p.follow.distance;
+    x.follow_distance_tolerance = p.follow.distance_tolerance;
+    x.follow_height = p.follow.height;
+    x.follow_height_tolerance = p.follow.height_tolerance;
+    x.follow_min_inside_fraction = p.follow.min_inside_fraction;
+    x.follow_max_outside_s = p.follow.max_outside_s;
+    x.track_min_visible_fraction = p.track.min_visible_fraction;
+    x.track_min_box_area = p.track.min_box_area;
+    x.track_min_tracked_fraction = p.track.min_tracked_fraction;
+    x.track_max_reacquire_s = p.track.max_reacquire_s;
+    x.avoid_goal.x = p.avoid.goal.x();
+    x.avoid_goal.y = p.avoid.goal.y();
+    x.avoid_goal.z = p.avoid.goal.z();
+    x.avoid_goal_radius = p.avoid.goal_radius;
+    x.avoid_shortest_path = p.avoid.shortest_path_m;
+    x.avoid_min_horizontal_separation = p.avoid.min_horizontal_separation;
+    x.avoid_min_vertical_separation = p.avoid.min_vertical_separation;
+    m.phases.push_back(x);
+  }
   return m;
 }
 
@@ -254,6 +279,36 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
     r.line_of_sight = x.line_of_sight;
     if (x.has_time) r.time = x.time;
     mission.relations.push_back(r);
+  }
+  for (std::size_t i = 0; i < m.phases.size(); ++i) {
+    const auto& x = m.phases[i];
+    scenario::MissionPhase p;
+    p.id = x.id;
+    if (!scenario::parsePhaseType(x.type, &p.type)) {
+      throw scenario::ConfigError("mission message: phases[" + std::to_string(i) +
+                                  "].type: expected search, follow, track or avoid, got '" +
+                                  x.type + "'");
+    }
+    p.targets = x.targets;
+    if (p.type == scenario::PhaseType::kFollow || p.type == scenario::PhaseType::kTrack) {
+      p.duration = x.duration;
+    }
+    p.follow.distance = x.follow_distance;
+    p.follow.distance_tolerance = x.follow_distance_tolerance;
+    p.follow.height = x.follow_height;
+    p.follow.height_tolerance = x.follow_height_tolerance;
+    p.follow.min_inside_fraction = x.follow_min_inside_fraction;
+    p.follow.max_outside_s = x.follow_max_outside_s;
+    p.track.min_visible_fraction = x.track_min_visible_fraction;
+    p.track.min_box_area = x.track_min_box_area;
+    p.track.min_tracked_fraction = x.track_min_tracked_fraction;
+    p.track.max_reacquire_s = x.track_max_reacquire_s;
+    p.avoid.goal = geometry::Vec3(x.avoid_goal.x, x.avoid_goal.y, x.avoid_goal.z);
+    p.avoid.goal_radius = x.avoid_goal_radius;
+    p.avoid.shortest_path_m = x.avoid_shortest_path;
+    p.avoid.min_horizontal_separation = x.avoid_min_horizontal_separation;
+    p.avoid.min_vertical_separation = x.avoid_min_vertical_separation;
+    mission.phases.push_back(p);
   }
   return mission;
 }

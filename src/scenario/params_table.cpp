@@ -70,6 +70,11 @@ constexpr RangeField kRangeFields[] = {
     {"noise_std", &GeneratorConfig::noise_std},
     {"salt_pepper", &GeneratorConfig::salt_pepper},
     {"motion_blur_px", &GeneratorConfig::motion_blur_px},
+    {"follow_distance", &GeneratorConfig::follow_distance},
+    {"follow_distance_tolerance", &GeneratorConfig::follow_distance_tolerance},
+    {"follow_height", &GeneratorConfig::follow_height},
+    {"follow_height_tolerance", &GeneratorConfig::follow_height_tolerance},
+    {"follow_duration", &GeneratorConfig::follow_duration},
 };
 
 struct IntField {
@@ -337,6 +342,17 @@ void GeneratorConfig::validate() const {
   if (band_width.min < 20) throw ConfigError("generator.band_width: expected at least 20 m so the band covers the street and kerbs");
   if (time_limit_area_search.min < 60 || time_limit_route_search.min < 60 || time_limit_pursuit.min < 60) {
     throw ConfigError("generator.time_limit_*: expected at least 60 s");
+  }
+  if (follow_distance_tolerance.min <= 0 || follow_height_tolerance.min <= 0 ||
+      follow_duration.min < 10) {
+    throw ConfigError(
+        "generator.follow_distance_tolerance/follow_height_tolerance/follow_duration: expected "
+        "positive tolerances and a duration of at least 10 s");
+  }
+  if (2 * follow_height_tolerance.max > uav_altitude_max.min - uav_altitude_min.max) {
+    throw ConfigError(
+        "generator.follow_height_tolerance: expected twice the largest tolerance to fit the "
+        "narrowest altitude band (uav_altitude_max.min - uav_altitude_min.max)");
   }
   if (depart_time.min < 10 || depart_time.max > time_limit_pursuit.min - 30) {
     throw ConfigError("generator.depart_time: expected 10 s to time_limit_pursuit.min - 30 s");

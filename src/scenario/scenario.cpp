@@ -12,7 +12,8 @@ struct ClassName {
 constexpr ClassName kClasses[] = {{ScenarioClass::kAreaSearch, "area_search"},
                                   {ScenarioClass::kRouteSearch, "route_search"},
                                   {ScenarioClass::kPursuit, "pursuit"},
-                                  {ScenarioClass::kAvoid, "avoid"}};
+                                  {ScenarioClass::kAvoid, "avoid"},
+                                  {ScenarioClass::kFollow, "follow"}};
 struct OpName {
   RelationOp op;
   const char* name;

@@ -35,7 +35,9 @@ import time
 SCHEMA_PLAN = "hameritt/campaign_plan"
 SCHEMA_MANIFEST = "hameritt/campaign_manifest"
 SCHEMA_VERSION = 1
-CLASSES = ("area_search", "route_search", "pursuit")
+CLASSES = ("area_search", "route_search", "pursuit", "follow")
+# What "all" means, as for hameritt_generate --class all: the three search classes.
+ALL_CLASSES = CLASSES[:3]
 MODES = ("maneuver_only", "perception_only", "end_to_end")
 # Fields of a merged manifest that belong to one run, not to the campaign: where and when a
 # unit ran, and what a ROS graph's scheduling decides (see compare_manifests).
@@ -126,10 +128,10 @@ def _bool_field(d, path, field, default, section=""):
     return v
 
 
-def _list_field(d, path, field, default, allowed, section=""):
+def _list_field(d, path, field, default, allowed, section="", all_values=None):
     v = d.get(field, default)
     if v == "all":
-        v = list(allowed)
+        v = list(all_values or allowed)
     if isinstance(v, str):
         v = [v]
     _expect(isinstance(v, list) and v and all(isinstance(x, str) and x in allowed for x in v)
@@ -156,7 +158,7 @@ def parse_config(text, path="campaign.yaml"):
     cfg = {
         "name": name,
         "seed": _int_field(raw, path, "seed", None, 0, 2**63 - 1),
-        "classes": _list_field(raw, path, "classes", "all", CLASSES),
+        "classes": _list_field(raw, path, "classes", "all", CLASSES, all_values=ALL_CLASSES),
         "count": _int_field(raw, path, "count", None, 1, 10000000),
         "shards": _int_field(raw, path, "shards", 1, 1, 10000),
     }

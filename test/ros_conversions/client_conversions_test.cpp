@@ -45,6 +45,44 @@ TEST(MissionConversions, RoundTripKeepsEveryField) {
   EXPECT_EQ(back.relations.back().related_attributes.integer("storeys", -1), 2);
 }
 
+// The phases of a mission, one of each type, survive the message byte for byte; an unknown
+// phase type is refused.
+TEST(MissionConversions, PhasesRoundTrip) {
+  scenario::Mission m = scenario::loadMission("scenarios/default/mission.json");
+  const std::string target = m.objective.targets.front().id;
+  scenario::MissionPhase search, follow, track, avoid;
+  search.id = "search_1";
+  search.targets = {target};
+  follow.id = "follow_1";
+  follow.type = scenario::PhaseType::kFollow;
+  follow.targets = {target};
+  follow.duration = 75.0;
+  follow.follow.distance = 12.0;
+  follow.follow.distance_tolerance = 6.0;
+  follow.follow.height = 31.0;
+  follow.follow.height_tolerance = 7.0;
+  track.id = "track_1";
+  track.type = scenario::PhaseType::kTrack;
+  track.targets = {target};
+  track.duration = 40.0;
+  track.track.min_box_area = 900.0;
+  avoid.id = "avoid_1";
+  avoid.type = scenario::PhaseType::kAvoid;
+  avoid.avoid.goal = geometry::Vec3(10.5, -20.25, 30.0);
+  avoid.avoid.shortest_path_m = 250.5;
+  m.phases = {search, follow, track, avoid};
+  const std::string json = scenario::missionJson(m);
+  hameritt::Mission msg = toMsg(m);
+  ASSERT_EQ(msg.phases.size(), 4u);
+  EXPECT_EQ(msg.phases[1].type, "follow");
+  EXPECT_DOUBLE_EQ(msg.phases[1].follow_height, 31.0);
+  EXPECT_EQ(scenario::missionJson(fromMsg(msg)), json);
+  msg.phases[1].follow_distance = 13.0;  // control: a changed field shows
+  EXPECT_NE(scenario::missionJson(fromMsg(msg)), json);
+  msg.phases[2].type = "escort";
+  EXPECT_THROW(fromMsg(msg), scenario::ConfigError);
+}
+
 TEST(MissionConversions, UavSpecRoundTripAndBadMessages) {
   const scenario::SimConfig cfg = scenario::loadSimConfig("scenarios/default/sim_config.json");
   const hameritt::UavSpec msg = toMsg(cfg.uav, cfg.scenario_id);

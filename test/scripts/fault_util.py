@@ -1,6 +1,6 @@
-"""Shared pieces of the write-fault, full-disk, duration-end and pursuit tests: a tally of
-checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics without a
-mission, and a mission.launch run read back."""
+"""Shared pieces of the write-fault, full-disk, duration-end, pursuit and follow tests: a tally
+of checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics without
+a mission, one generated scenario, and a mission.launch run read back."""
 import json
 import os
 import signal
@@ -75,6 +75,16 @@ def run_adk(out, log, name, params=(), env=None):
     except subprocess.TimeoutExpired:
         p.kill()
         return p.wait()
+
+
+def generate_one(tmp, cls, seed):
+    """The scenario of `hameritt_generate --class CLS --count 1 --seed SEED` under tmp."""
+    out = os.path.join(tmp, "scenarios")
+    subprocess.run(["rosrun", "hameritt", "hameritt_generate", "--class", cls, "--count", "1",
+                    "--seed", str(seed), "--out", out], check=True, stdout=subprocess.DEVNULL)
+    dirs = [d for d in sorted(os.listdir(out)) if d.startswith(cls + "-")]
+    assert len(dirs) == 1, dirs
+    return os.path.join(out, dirs[0])
 
 
 def launch_mission(args, out, log, label, check, guard):

@@ -58,6 +58,12 @@ class ConfigTest(unittest.TestCase):
         self.assertTrue(c["missions"]["record"])
         self.assertEqual(c["slurm"]["time"], "01:00:00")
 
+    def test_follow_class_is_accepted_but_not_part_of_all(self):
+        c = cfg_of("seed: 1\ncount: 2\nclasses: [follow, pursuit]\n")
+        self.assertEqual(c["classes"], ["follow", "pursuit"])
+        self.assertEqual([hc.class_of(c, i) for i in range(3)], ["follow", "pursuit", "follow"])
+        self.assertNotIn("follow", cfg_of("seed: 1\ncount: 2\nclasses: all\n")["classes"])
+
     def test_errors_name_the_file_and_the_field(self):
         cases = [
             ("seed: -1", "field 'seed'"),

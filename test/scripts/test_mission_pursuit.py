@@ -22,28 +22,17 @@ client's own account.
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
 
 from graph_util import private_master_port, start_master, stop_master
-from fault_util import Checks, launch_mission, metrics_validator
+from fault_util import Checks, generate_one, launch_mission, metrics_validator
 
 PORT = private_master_port(27000)
 SEED = int(os.environ.get("HAMERITT_PURSUIT_SEED", "1"))
 TIME_LIMIT = int(os.environ.get("HAMERITT_PURSUIT_TIME_LIMIT", "100"))
 METRICS = metrics_validator()
 check = Checks()
-
-
-def generate(tmp):
-    out = os.path.join(tmp, "scenarios")
-    subprocess.run(["rosrun", "hameritt", "hameritt_generate", "--class", "pursuit", "--count",
-                    "1", "--seed", str(SEED), "--out", out], check=True,
-                   stdout=subprocess.DEVNULL)
-    dirs = [d for d in sorted(os.listdir(out)) if d.startswith("pursuit-")]
-    assert len(dirs) == 1, dirs
-    return os.path.join(out, dirs[0])
 
 
 def run(tmp, scenario, pursue):
@@ -71,7 +60,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="hameritt_pursuit.")
     core = start_master(PORT)
     try:
-        scenario = generate(tmp)
+        scenario = generate_one(tmp, "pursuit", SEED)
         print("scenario %s (seed %d), time limit %d s" % (os.path.basename(scenario), SEED,
                                                           TIME_LIMIT))
         m, text = run(tmp, scenario, True)

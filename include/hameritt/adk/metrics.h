@@ -11,6 +11,7 @@
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/adk/coverage.h"
 #include "hameritt/adk/detection_scoring.h"
+#include "hameritt/adk/follow_score.h"
 #include "hameritt/adk/intervals.h"
 #include "hameritt/geometry/types.h"
 #include "hameritt/scenario/scenario.h"
@@ -52,7 +53,7 @@ struct EnergyModel {
 enum class Outcome { kSuccess, kTimeout, kCrashed, kAborted, kEnded, kFailed };
 // "success", "timeout", "crashed", "aborted", "ended" (the simulator stopped at its duration
 // before the time limit), "failed" (the objective was reached but a criterion of its phase was
-// broken on the way: an avoid mission that lost separation).
+// broken on the way: an avoid mission that lost separation, a follow phase that failed).
 const char* toString(Outcome o);
 
 // How the objective is judged.
@@ -113,6 +114,7 @@ struct MissionMetrics {
   std::vector<AoiStatus> aoi_time;
   double prior_weighted_coverage = 0.0;
   std::optional<AvoidScore> avoid;  // missions with an avoid phase
+  std::optional<FollowPhaseScore> follow;  // missions with a follow phase
 };
 
 // Collects the figures of one run.

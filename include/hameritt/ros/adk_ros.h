@@ -19,6 +19,8 @@
 #include "hameritt/CrashEvent.h"
 #include "hameritt/Detection.h"
 #include "hameritt/EntityStateArray.h"
+#include "hameritt/FollowStatus.h"
+#include "hameritt/PhaseState.h"
 #include "hameritt/SimulationEnd.h"
 #include "hameritt/adk/clock_watchdog.h"
 #include "hameritt/adk/constraint_monitor.h"
@@ -86,6 +88,16 @@ class AdkRos {
   // Track objectives are judged at the time limit: at t >= the limit, success when every
   // target was in view for the track fraction of it (before the time limit's timeout).
   void judgeTrackAtLimit(double t);
+  // Follow missions: the search phase ends at the find, which starts the follow phase; the
+  // mission ends when the follow phase has run its duration (succeeded when its criteria hold,
+  // adk/follow_score.h) or has been outside its envelope too long (failed).
+  void checkFollow(double t);
+  // adk/follow: the follow phase's score `f` at sim time t.
+  void publishFollow(double t, const adk::FollowPhaseScore& f);
+  // adk/phase: `phase` entered `state` at sim time t.
+  void publishPhase(double t, const scenario::MissionPhase& phase, adk::PhaseState state,
+                    const std::string& reason);
+  adk::FollowPhaseScore followScore(bool ended) const;
   // Ends the mission (lifecycle already ended): metrics.json, /adk/metrics, /adk/state.
   void finish();
 
@@ -118,6 +130,14 @@ class AdkRos {
   // The avoid phase of an avoid mission: scored from the odometry and the scripted aircraft.
   std::unique_ptr<adk::AvoidScorer> avoid_;
   std::string avoid_phase_;
+  // The follow phase of a follow mission (after its search phase): scored from the odometry and
+  // the target's scripted trajectory, line of sight against the world's occluders.
+  std::unique_ptr<adk::FollowScorer> follow_;
+  const scenario::MissionPhase* search_phase_ = nullptr;
+  const scenario::ScenarioEntity* follow_target_ = nullptr;
+  double follow_koz_start_ = 0.0;  // the monitor's violation seconds at the phase's start
+  bool crashed_ = false;
+  std::map<std::string, adk::PhaseState> phase_states_;  // the last published, by phase id
   std::unique_ptr<adk::ClockWatchdog> watchdog_;
   adk::GroundTruthHistory truth_{10.0};
 
@@ -137,7 +157,7 @@ class AdkRos {
   ros::WallTime finished_at_;
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
-      perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_;
+      perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_, follow_pub_, phase_pub_;
   ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };

@@ -63,6 +63,14 @@ struct GeneratorConfig {
   Range noise_std{0, 0.05};
   Range salt_pepper{0, 0.01};
   Range motion_blur_px{0, 3};
+  // Follow: the envelope's point follow_distance (d*) behind the target with its horizontal
+  // radius (D), follow_height (h*) above it with its tolerance (H; h* is raised or lowered
+  // so that h* +- H lies in the UAV's altitude band), and the follow phase's duration.
+  Range follow_distance{10, 20};
+  Range follow_distance_tolerance{5, 8};
+  Range follow_height{20, 35};
+  Range follow_height_tolerance{5, 7};
+  Range follow_duration{60, 120};
   // Plan a perception-only UAV flight over the targets (sim_config uav.perception_path); the
   // most expensive step of generation, so it can be switched off.
   bool perception_paths = true;

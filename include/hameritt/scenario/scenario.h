@@ -19,7 +19,9 @@ namespace hameritt::scenario {
 
 constexpr int kSchemaVersion = 1;
 
-enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit, kAvoid };
+// follow: pursuit's moving target, found, then followed inside an envelope (phases search ->
+// follow).
+enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit, kAvoid, kFollow };
 const char* toString(ScenarioClass c);
 bool parseScenarioClass(const std::string& s, ScenarioClass* out);
 

@@ -1,0 +1,133 @@
+// The follow class: pursuit's moving target in two phases (search, then follow) whose envelope
+// and duration come from config/generator.json's ranges; the files validate (schema and
+// semantic rules), round-trip, are deterministic; the pursuit class is unchanged by it; and the
+// follow_phase rule catches doctored missions (the negative controls).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "hameritt/scenario/mission_io.h"
+#include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/sim_config_io.h"
+#include "hameritt/scenario/validation.h"
+#include "test_util.h"
+
+using namespace hameritt::scenario;
+using hameritt::scenario::testing::messageOf;
+using hameritt::scenario::testing::shippedCityWorld;
+using hameritt::scenario::testing::shippedConfig;
+using hameritt::scenario::testing::shippedWorld;
+
+namespace {
+
+std::vector<ValidationIssue> issues(const nlohmann::json& doc) {
+  return validateDocument(doc, "doc.json", defaultConfigDir() + "/schema");
+}
+
+std::string rules(const std::vector<ValidationIssue>& v) {
+  std::string out;
+  for (const auto& i : v) out += i.rule + " " + i.path + "; ";
+  return out;
+}
+
+bool within(double v, const Range& r) { return v >= std::round(r.min) && v <= std::round(r.max); }
+
+void expectWellPosed(const Scenario& s) {
+  SCOPED_TRACE(s.mission.scenario_id);
+  const GeneratorConfig& c = shippedConfig();
+  EXPECT_EQ(s.mission.scenario_id.rfind("follow-", 0), 0u);
+  EXPECT_EQ(s.mission.objective.type, "track");
+  ASSERT_EQ(s.mission.objective.targets.size(), 1u);
+  const std::string target = s.mission.objective.targets[0].id;
+  ASSERT_EQ(s.mission.phases.size(), 2u);
+  const MissionPhase& search = s.mission.phases[0];
+  const MissionPhase& follow = s.mission.phases[1];
+  EXPECT_EQ(search.type, PhaseType::kSearch);
+  EXPECT_EQ(follow.type, PhaseType::kFollow);
+  EXPECT_EQ(search.targets, std::vector<std::string>{target});
+  EXPECT_EQ(follow.targets, std::vector<std::string>{target});
+  ASSERT_TRUE(follow.duration.has_value());
+  EXPECT_TRUE(within(*follow.duration, c.follow_duration)) << *follow.duration;
+  const FollowPhaseSpec& f = follow.follow;
+  EXPECT_TRUE(within(f.distance, c.follow_distance)) << f.distance;
+  EXPECT_TRUE(within(f.distance_tolerance, c.follow_distance_tolerance));
+  EXPECT_TRUE(within(f.height_tolerance, c.follow_height_tolerance));
+  // h* +- H inside the UAV's altitude band.
+  EXPECT_GE(f.height - f.height_tolerance, s.sim.uav.altitude_min - 1e-9);
+  EXPECT_LE(f.height + f.height_tolerance, s.sim.uav.altitude_max + 1e-9);
+  EXPECT_DOUBLE_EQ(f.min_inside_fraction, 0.8);
+  EXPECT_DOUBLE_EQ(f.max_outside_s, 10.0);
+  // The time limit leaves the search pursuit's time and the whole follow phase.
+  EXPECT_GE(s.mission.time_limit, c.time_limit_pursuit.min + *follow.duration - 1.0);
+  // The target drives (a trajectory with more than the waiting samples).
+  bool moving = false;
+  for (const auto& e : s.sim.entities) {
+    if (e.entity.id == target) moving = e.trajectory.size() > 2;
+  }
+  EXPECT_TRUE(moving);
+  const std::string mj = missionJson(s.mission), sj = simConfigJson(s.sim);
+  EXPECT_TRUE(issues(nlohmann::json::parse(mj)).empty())
+      << rules(issues(nlohmann::json::parse(mj)));
+  EXPECT_TRUE(issues(nlohmann::json::parse(sj)).empty())
+      << rules(issues(nlohmann::json::parse(sj)));
+  EXPECT_EQ(missionJson(parseMission(mj, "mission.json")), mj);
+  EXPECT_EQ(simConfigJson(parseSimConfig(sj, "sim_config.json")), sj);
+}
+
+TEST(FollowGeneratorTest, ScenariosAreWellPosedInTheSuburbAndTheCity) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    expectWellPosed(
+        generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kFollow, seed));
+  }
+  expectWellPosed(generateScenario(shippedCityWorld(), shippedConfig(), ScenarioClass::kFollow, 1));
+}
+
+TEST(FollowGeneratorTest, DeterministicAndPursuitUnchanged) {
+  const Scenario a = generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kFollow, 7);
+  const Scenario b = generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kFollow, 7);
+  const Scenario c = generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kFollow, 8);
+  EXPECT_EQ(missionJson(a.mission), missionJson(b.mission));
+  EXPECT_EQ(simConfigJson(a.sim), simConfigJson(b.sim));
+  EXPECT_NE(missionJson(a.mission), missionJson(c.mission));  // control: the seed matters
+  // The follow scene is pursuit's with the same seed: the target, its look and its trajectory.
+  const Scenario p = generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kPursuit, 7);
+  EXPECT_TRUE(p.mission.phases.empty());
+  ASSERT_EQ(p.mission.objective.targets.size(), 1u);
+  EXPECT_EQ(p.mission.objective.targets[0].id, a.mission.objective.targets[0].id);
+  EXPECT_EQ(p.mission.objective.targets[0].model, a.mission.objective.targets[0].model);
+  EXPECT_DOUBLE_EQ(a.mission.time_limit, p.mission.time_limit + *a.mission.phases[1].duration);
+}
+
+TEST(FollowGeneratorTest, FollowPhaseRuleCatchesDoctoredMissions) {
+  const Scenario s = generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kFollow, 4);
+  const nlohmann::json good = nlohmann::json::parse(missionJson(s.mission));
+  ASSERT_TRUE(issues(good).empty()) << rules(issues(good));
+  nlohmann::json m = good;
+  m["phases"].erase(1);  // the follow phase gone
+  EXPECT_NE(rules(issues(m)).find("follow_phase /phases"), std::string::npos) << rules(issues(m));
+  m = good;
+  m["phases"][1]["targets"][0] = "car_9999";  // another target than the search's
+  EXPECT_NE(rules(issues(m)).find("follow_phase /phases/1/targets"), std::string::npos)
+      << rules(issues(m));
+  m = good;
+  m["phases"][1]["duration"] = m["time_limit"].get<double>() + 1.0;
+  EXPECT_NE(rules(issues(m)).find("follow_phase /phases/1/duration"), std::string::npos)
+      << rules(issues(m));
+  m = good;
+  m.erase("phases");
+  EXPECT_NE(rules(issues(m)).find("follow_phase /phases"), std::string::npos) << rules(issues(m));
+}
+
+TEST(FollowGeneratorTest, ConfigRangesAreChecked) {
+  GeneratorConfig c = shippedConfig();
+  c.follow_height_tolerance = {5, 9};  // 18 m does not fit a 15 m band
+  EXPECT_NE(messageOf([&] { c.validate(); }).find("generator.follow_height_tolerance"),
+            std::string::npos);
+  c = shippedConfig();
+  c.follow_duration = {5, 60};
+  EXPECT_NE(messageOf([&] { c.validate(); }).find("follow_duration"), std::string::npos);
+  c = shippedConfig();
+  EXPECT_EQ(messageOf([&] { c.validate(); }), "(no error)");
+}
+
+}  // namespace
