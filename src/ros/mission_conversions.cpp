@@ -125,7 +125,40 @@ hameritt::Mission toMsg(const scenario::Mission& mission) {
     x.has_alt_max = k.alt_max.has_value();
     x.alt_max = k.alt_max.value_or(0.0);
     x.window = toMsg(k.window);
+    for (const auto& q : k.motion) {
+      x.motion_t.push_back(q.t);
+      geometry_msgs::Point pt;
+      pt.x = q.x;
+      pt.y = q.y;
+      x.motion.push_back(pt);
+    }
     m.keep_out_zones.push_back(x);
+  }
+  for (const auto& p : mission.phases) {
+    hameritt::MissionPhase x;
+    x.id = p.id;
+    x.type = scenario::toString(p.type);
+    x.targets = p.targets;
+    x.has_duration = p.duration.has_value();
+    x.duration = p.duration.value_or(0.0);
+    x.follow_distance = p.follow.distance;
+    x.follow_distance_tolerance = p.follow.distance_tolerance;
+    x.follow_height = p.follow.height;
+    x.follow_height_tolerance = p.follow.height_tolerance;
+    x.follow_min_inside_fraction = p.follow.min_inside_fraction;
+    x.follow_max_outside_s = p.follow.max_outside_s;
+    x.track_min_visible_fraction = p.track.min_visible_fraction;
+    x.track_min_box_area = p.track.min_box_area;
+    x.track_min_tracked_fraction = p.track.min_tracked_fraction;
+    x.track_max_reacquire_s = p.track.max_reacquire_s;
+    x.avoid_goal.x = p.avoid.goal.x();
+    x.avoid_goal.y = p.avoid.goal.y();
+    x.avoid_goal.z = p.avoid.goal.z();
+    x.avoid_goal_radius = p.avoid.goal_radius;
+    x.avoid_shortest_path_m = p.avoid.shortest_path_m;
+    x.avoid_min_horizontal_separation = p.avoid.min_horizontal_separation;
+    x.avoid_min_vertical_separation = p.avoid.min_vertical_separation;
+    m.phases.push_back(x);
   }
   for (const auto& p : mission.priors) {
     hameritt::AreaPrior x;
@@ -212,7 +245,37 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
     if (k.has_alt_min) z.alt_min = k.alt_min;
     if (k.has_alt_max) z.alt_max = k.alt_max;
     z.window = fromMsg(k.window);
+    if (k.motion.size() != k.motion_t.size()) {
+      throw scenario::ConfigError("mission message: keep_out_zones[" + std::to_string(i) +
+                                  "]: " + std::to_string(k.motion.size()) + " motion points but " +
+                                  std::to_string(k.motion_t.size()) + " motion_t stamps");
+    }
+    for (std::size_t j = 0; j < k.motion.size(); ++j) {
+      z.motion.push_back({k.motion_t[j], k.motion[j].x, k.motion[j].y, 0.0, 0.0});
+    }
     mission.kozs.push_back(z);
+  }
+  for (std::size_t i = 0; i < m.phases.size(); ++i) {
+    const auto& x = m.phases[i];
+    scenario::MissionPhase p;
+    p.id = x.id;
+    if (!scenario::parsePhaseType(x.type, &p.type)) {
+      throw scenario::ConfigError("mission message: phases[" + std::to_string(i) +
+                                  "].type: unknown phase type '" + x.type +
+                                  "' (search, follow, track or avoid)");
+    }
+    p.targets = x.targets;
+    if (x.has_duration) p.duration = x.duration;
+    p.follow = {x.follow_distance,         x.follow_distance_tolerance,  x.follow_height,
+                x.follow_height_tolerance, x.follow_min_inside_fraction, x.follow_max_outside_s};
+    p.track = {x.track_min_visible_fraction, x.track_min_box_area, x.track_min_tracked_fraction,
+               x.track_max_reacquire_s};
+    p.avoid.goal = geometry::Vec3(x.avoid_goal.x, x.avoid_goal.y, x.avoid_goal.z);
+    p.avoid.goal_radius = x.avoid_goal_radius;
+    p.avoid.shortest_path_m = x.avoid_shortest_path_m;
+    p.avoid.min_horizontal_separation = x.avoid_min_horizontal_separation;
+    p.avoid.min_vertical_separation = x.avoid_min_vertical_separation;
+    mission.phases.push_back(p);
   }
   for (const auto& p : m.area_priors) {
     scenario::AreaPrior prior;
