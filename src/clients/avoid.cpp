@@ -42,6 +42,13 @@ constexpr double kSpeeds[] = {1.0, 0.7, 0.45, 0.2, 0.0, -0.5};
 constexpr double kOffsets[] = {0.0, 6.0, -6.0, 12.0, -12.0, 18.0};
 // Metres before the goal over which the vertical offset fades out.
 constexpr double kTaper = 20.0;
+// Metres kept from the static obstacles when planning (the generator's shortest path keeps 1).
+constexpr double kClearance = 2.5;
+// A turn sharper than this (rad) is a corner, taken at no more than kCornerSpeed (m/s) from
+// kCornerSlowdown metres before it until the reference has passed it.
+constexpr double kCornerAngle = 0.35;
+constexpr double kCornerSpeed = 3.0;
+constexpr double kCornerSlowdown = 10.0;
 
 }  // namespace
 
@@ -66,14 +73,18 @@ AvoidPilot::AvoidPilot(const scenario::World& world, const scenario::Mission& mi
       settings_(settings),
       static_kozs_(zones(mission, false)),
       moving_kozs_(zones(mission, true)),
-      band_(world, static_kozs_, planning::validitySettingsFor(uav)) {
+      band_(world, static_kozs_, planning::validitySettingsFor(uav, kClearance)),
+      tight_(world, static_kozs_, planning::validitySettingsFor(uav)) {
   settings_.validate();
 }
 
 bool AvoidPilot::plan(const Vec3& start) {
   path_.clear();
   cumulative_.clear();
-  const scenario::ReferenceFlight f = scenario::shortestFlight(band_, start, spec_.goal);
+  // Planned with kClearance from the obstacles (the autopilot cuts corners); where that finds
+  // no flight (a narrow gap), with the generator's 1 m.
+  scenario::ReferenceFlight f = scenario::shortestFlight(band_, start, spec_.goal);
+  if (!f.ok) f = scenario::shortestFlight(tight_, start, spec_.goal);
   if (!f.ok) {
     why_ = f.why;
     return false;
@@ -82,6 +93,14 @@ bool AvoidPilot::plan(const Vec3& start) {
   cumulative_.assign(path_.size(), 0.0);
   for (std::size_t i = 1; i < path_.size(); ++i) {
     cumulative_[i] = cumulative_[i - 1] + (path_[i] - path_[i - 1]).norm();
+  }
+  // Corners: where the path turns by more than kCornerAngle.
+  corners_.clear();
+  for (std::size_t i = 1; i + 1 < path_.size(); ++i) {
+    const Vec3 a = path_[i] - path_[i - 1], b = path_[i + 1] - path_[i];
+    if (a.norm() < 1e-6 || b.norm() < 1e-6) continue;
+    const double c = std::clamp(a.dot(b) / (a.norm() * b.norm()), -1.0, 1.0);
+    if (std::acos(c) > kCornerAngle) corners_.push_back(cumulative_[i]);
   }
   s_ = 0.0;
   offset_ = 0.0;
@@ -196,7 +215,10 @@ AvoidCommand AvoidPilot::step(double t, const Vec3& uav) {
     it = t - it->second.t > settings_.stale_after ? traffic_.erase(it) : std::next(it);
   }
 
-  const double cruise = settings_.speed_fraction * uav_.max_speed;
+  double cruise = settings_.speed_fraction * uav_.max_speed;
+  for (double c : corners_) {
+    if (s_ > c - kCornerSlowdown && s_ < c + 1.0) cruise = std::min(cruise, kCornerSpeed);
+  }
   const double len = cumulative_.back();
   // The candidate moves in the order of preference; the first that keeps the buffer wins.
   std::optional<Candidate> best, fallback;

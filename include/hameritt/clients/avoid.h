@@ -1,7 +1,8 @@
 #pragma once
 // The avoid baseline's pilot: flies an avoid mission's goal along the shortest flight clear of
-// the static obstacles and the static keep-out zones (scenario::shortestFlight, the generator's
-// own planner), and deconflicts from the other aircraft and the moving keep-out zones by
+// the static obstacles (by 2.5 m where it can, else the generator's 1 m) and the static
+// keep-out zones (scenario::shortestFlight, the generator's own planner), slowing to 3 m/s for
+// its corners, and deconflicts from the other aircraft and the moving keep-out zones by
 // choosing, every tick, how fast to go along that path (full, slower, wait, back off) and how
 // far above or below it to fly. The choice predicts every reported aircraft at constant
 // velocity and every moving zone along its published motion over a horizon, and takes the
@@ -100,8 +101,9 @@ class AvoidPilot {
   scenario::UavSpec uav_;
   AvoidSettings settings_;
   std::vector<scenario::KeepOutZone> static_kozs_, moving_kozs_;
-  planning::WorldValidity band_;
+  planning::WorldValidity band_, tight_;
   std::vector<geometry::Vec3> path_;
+  std::vector<double> corners_;  // arc lengths of the path's corners
   std::vector<double> cumulative_;
   std::string why_;
   std::map<std::string, TrafficReport> traffic_;
