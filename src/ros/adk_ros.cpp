@@ -174,6 +174,18 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   state_pub_ = gate_->advertise<hameritt::MissionState>(nh, "adk/state", 10, true);
   metrics_pub_ = gate_->advertise<hameritt::MissionMetrics>(nh, "adk/metrics", 1, true);
   if (avoid_) avoid_pub_ = gate_->advertise<hameritt::AvoidStatus>(nh, "adk/avoid", 10, true);
+  // The ADS-B-like traffic reports of an avoid mission's aircraft.
+  double traffic_rate = 2.0;
+  pnh.param("traffic_rate_hz", traffic_rate, traffic_rate);
+  if (!(traffic_rate >= 0.0 && traffic_rate <= 100.0)) {
+    throw scenario::ConfigError(
+        "~traffic_rate_hz: expected [0, 100] (0: no traffic reports), got " +
+        std::to_string(traffic_rate));
+  }
+  traffic_period_ = traffic_rate > 0.0 ? 1.0 / traffic_rate : 0.0;
+  if (avoid_ && traffic_period_ > 0.0) {
+    traffic_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "adk/traffic", 10);
+  }
   if (follow_) follow_pub_ = gate_->advertise<hameritt::FollowStatus>(nh, "adk/follow", 10, true);
   if (!mission_.phases.empty()) {
     phase_pub_ = gate_->advertise<hameritt::PhaseState>(nh, "adk/phase", 10, true);
@@ -298,7 +310,14 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   try {
     for (const auto& e : monitor_->add(t, p)) gate_->publish(events_pub_, toMsg(e));
     metrics_->addState(t, p, v);
-    if (avoid_) avoid_->add(avoidSample(t, p, v));
+    if (avoid_) {
+      const adk::TrafficSample sample = avoidSample(t, p, v);
+      avoid_->add(sample);
+      if (traffic_period_ > 0.0 && t >= next_traffic_t_) {
+        publishTraffic(t, sample);
+        next_traffic_t_ = t + traffic_period_;
+      }
+    }
     if (follow_ && follow_->started()) {
       const adk::EntityTruth target = adk::scenarioEntityAt(*follow_target_, t);
       adk::FollowSample f;
@@ -470,6 +489,36 @@ adk::TrafficSample AdkRos::avoidSample(double t, const Eigen::Vector3d& p,
     s.aircraft.push_back(st);
   }
   return s;
+}
+
+void AdkRos::publishTraffic(double t, const adk::TrafficSample& s) {
+  hameritt::EntityStateArray m;
+  m.header.stamp = stampOf(t);
+  m.header.frame_id = "map";
+  for (std::size_t i = 0; i < s.aircraft.size(); ++i) {
+    const auto& a = s.aircraft[i];
+    const auto& spec = sim_config_.aircraft[i];
+    hameritt::EntityState e;
+    e.header = m.header;
+    e.id = a.id;
+    e.entity_class = "aircraft";
+    e.role = "aircraft";
+    // The message's pose is the bottom of the box; the report's position is the body centre.
+    e.pose.position.x = a.position.x();
+    e.pose.position.y = a.position.y();
+    e.pose.position.z = a.position.z() - 0.5 * spec.size.z();
+    const double yaw = std::atan2(a.velocity.y(), a.velocity.x());
+    e.pose.orientation.z = std::sin(0.5 * yaw);
+    e.pose.orientation.w = std::cos(0.5 * yaw);
+    e.velocity.linear.x = a.velocity.x();
+    e.velocity.linear.y = a.velocity.y();
+    e.velocity.linear.z = a.velocity.z();
+    e.size.x = spec.size.x();
+    e.size.y = spec.size.y();
+    e.size.z = spec.size.z();
+    m.entities.push_back(e);
+  }
+  gate_->publish(traffic_pub_, m);
 }
 
 void AdkRos::publishAvoid(double t, const adk::AvoidScore& a) {

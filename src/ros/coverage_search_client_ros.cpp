@@ -88,6 +88,19 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
     throw scenario::ConfigError("~pursuit_rate_hz: expected (0, 100]");
   }
   pursuit_.validate();
+  double avoid_rate = 10.0;
+  pnh.param("avoid", avoid_enabled_, avoid_enabled_);
+  pnh.param("avoid_rate_hz", avoid_rate, avoid_rate);
+  pnh.param("avoid_speed_fraction", avoid_settings_.speed_fraction, avoid_settings_.speed_fraction);
+  pnh.param("avoid_horizontal_buffer", avoid_settings_.horizontal_buffer,
+            avoid_settings_.horizontal_buffer);
+  pnh.param("avoid_vertical_buffer", avoid_settings_.vertical_buffer,
+            avoid_settings_.vertical_buffer);
+  pnh.param("avoid_horizon", avoid_settings_.horizon, avoid_settings_.horizon);
+  if (!(avoid_rate > 0 && avoid_rate <= 100)) {
+    throw scenario::ConfigError("~avoid_rate_hz: expected (0, 100]");
+  }
+  avoid_settings_.validate();
 
   // The honesty rule: the map and the UAV's own specification, never the scenario's entities.
   sim_ = clients::loadPublicSimConfig(sim_path);
@@ -99,7 +112,7 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   settings_.validate();
   claims_ = clients::ClaimLedger(claim_radius, claim_hold);
   detections_ = clients::ClaimLedger(claim_radius, 0.0);
-  if ((claim_ && use_context_) || pursue_) {
+  if ((claim_ && use_context_) || pursue_ || avoid_enabled_) {
     world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
   }
 
@@ -124,6 +137,12 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
     pose_pub_ = gate_->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
     predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
     gate_->every(nh, 1.0 / pursuit_rate, [this] { onPursuitTick(); });
+  }
+  if (avoid_enabled_) {
+    if (!pose_pub_)
+      pose_pub_ = gate_->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
+    traffic_sub_ = gate_->subscribe(nh, "adk/traffic", 20, &Self::onTraffic, this);
+    gate_->every(nh, 1.0 / avoid_rate, [this] { onAvoidTick(); });
   }
   gate_->every(nh, 1.0 / rate, [this] { onTick(); });
   ROS_INFO("%s: %s camera, altitude %.1f m, swath %.1f m, lines %.1f m apart%s", kClientName,
@@ -157,8 +176,24 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   }
   covered_.clear();
   planned_ = stopped_ = exhausted_ = pursuing_ = false;
+  avoid_.reset();
+  avoid_planned_ = avoid_arrived_ = false;
   ROS_INFO("%s: mission %s: %s", kClientName, mission_->scenario_id.c_str(),
            mission_->objective.text.c_str());
+  const bool avoid_phase = std::any_of(
+      mission_->phases.begin(), mission_->phases.end(),
+      [](const scenario::MissionPhase& p) { return p.type == scenario::PhaseType::kAvoid; });
+  if (avoid_enabled_ && avoid_phase) {
+    try {
+      avoid_ = std::make_unique<clients::AvoidPilot>(*world_, *mission_, sim_.uav, avoid_settings_);
+    } catch (const std::exception& e) {
+      ROS_ERROR("%s: avoid: %s", kClientName, e.what());
+      stop("the avoid mission cannot be flown");
+      return;
+    }
+    planned_ = true;  // no search: the pilot flies it
+    return;
+  }
   if (odom_) replan("mission received");
 }
 
@@ -190,7 +225,7 @@ void CoverageSearchClientRos::replan(const std::string& why) {
 }
 
 void CoverageSearchClientRos::sendIfDue() {
-  if (stopped_ || pursuing_ || !planned_ || sent_ || !mission_) return;
+  if (stopped_ || pursuing_ || !planned_ || sent_ || !mission_ || avoid_) return;
   if (leg_ >= plan_.legs.size()) {
     if (exhausted_) return;
     if (repeat_ && !covered_.empty()) {
@@ -443,6 +478,56 @@ void CoverageSearchClientRos::onPursuitTick() {
     planner_flying_ = true;
     planner_sent_at_ = t;
   }
+}
+
+void CoverageSearchClientRos::onTraffic(const hameritt::EntityStateArray::ConstPtr& msg) {
+  if (!avoid_) return;
+  const double t = msg->header.stamp.toSec() - mission_start_;
+  for (const auto& e : msg->entities) {
+    clients::TrafficReport r;
+    r.id = e.id;
+    r.t = t;
+    // The message gives the bottom of the box; the pilot predicts body centres.
+    r.position =
+        geometry::Vec3(e.pose.position.x, e.pose.position.y, e.pose.position.z + 0.5 * e.size.z);
+    r.velocity = geometry::Vec3(e.velocity.linear.x, e.velocity.linear.y, e.velocity.linear.z);
+    avoid_->observe(r);
+  }
+}
+
+void CoverageSearchClientRos::onAvoidTick() {
+  if (!avoid_ || stopped_ || !odom_) return;
+  const auto& o = odom_->pose.pose.position;
+  const geometry::Vec3 uav(o.x, o.y, o.z);
+  const ros::Time now = ros::Time::now();
+  if (!avoid_planned_) {
+    avoid_planned_ = true;
+    if (!avoid_->plan(uav)) {
+      ROS_ERROR("%s: avoid: no flight to the goal: %s", kClientName, avoid_->why().c_str());
+      avoid_.reset();
+      stop("no flight to the goal");
+      return;
+    }
+    nav_msgs::Path stop_planner;  // empty: the planner stops following
+    stop_planner.header.stamp = now;
+    stop_planner.header.frame_id = "map";
+    gate_->publish(waypoints_pub_, stop_planner);
+    ROS_INFO("%s: avoid: flying a %.1f m path of %zu points to the goal", kClientName,
+             avoid_->pathLength(), avoid_->path().size());
+  }
+  const clients::AvoidCommand c = avoid_->step(missionTime(), uav);
+  if (c.at_goal && !avoid_arrived_) {
+    avoid_arrived_ = true;
+    ROS_INFO("%s: avoid: the reference is at the goal", kClientName);
+  }
+  if (c.conflict) {
+    ROS_INFO_THROTTLE(2.0, "%s: avoid t %.1f: %s", kClientName, missionTime(), c.reason.c_str());
+  } else {
+    ROS_INFO_THROTTLE(10.0, "%s: avoid t %.1f: UAV (%.1f, %.1f, %.1f), %zu aircraft reported, %s",
+                      kClientName, missionTime(), uav.x(), uav.y(), uav.z(), avoid_->tracked(),
+                      c.reason.c_str());
+  }
+  gate_->publish(pose_pub_, poseAt(c.setpoint, c.yaw, now));
 }
 
 void CoverageSearchClientRos::stop(const std::string& why) {

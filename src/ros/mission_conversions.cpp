@@ -125,6 +125,13 @@ hameritt::Mission toMsg(const scenario::Mission& mission) {
     x.has_alt_max = k.alt_max.has_value();
     x.alt_max = k.alt_max.value_or(0.0);
     x.window = toMsg(k.window);
+    for (const auto& q : k.motion) {
+      x.motion_t.push_back(q.t);
+      geometry_msgs::Point pt;
+      pt.x = q.x;
+      pt.y = q.y;
+      x.motion.push_back(pt);
+    }
     m.keep_out_zones.push_back(x);
   }
   for (const auto& p : mission.priors) {
@@ -237,6 +244,14 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
     if (k.has_alt_min) z.alt_min = k.alt_min;
     if (k.has_alt_max) z.alt_max = k.alt_max;
     z.window = fromMsg(k.window);
+    if (k.motion.size() != k.motion_t.size()) {
+      throw scenario::ConfigError("mission message: keep_out_zones[" + std::to_string(i) +
+                                  "]: " + std::to_string(k.motion.size()) + " motion points but " +
+                                  std::to_string(k.motion_t.size()) + " motion_t stamps");
+    }
+    for (std::size_t j = 0; j < k.motion.size(); ++j) {
+      z.motion.push_back({k.motion_t[j], k.motion[j].x, k.motion[j].y, 0.0, 0.0});
+    }
     mission.kozs.push_back(z);
   }
   for (const auto& p : m.area_priors) {

@@ -18,7 +18,9 @@ namespace hameritt::ros_wrappers {
 namespace {
 
 TEST(MissionConversions, RoundTripKeepsEveryField) {
-  for (const char* file : {"scenarios/default/mission.json", "test/data/replan_mission.json"}) {
+  // The avoid mission has phases and a moving keep-out zone.
+  for (const char* file : {"scenarios/default/mission.json", "test/data/replan_mission.json",
+                           "test/data/avoid_mission.json"}) {
     const scenario::Mission m = scenario::loadMission(file);
     const hameritt::Mission msg = toMsg(m);
     EXPECT_EQ(msg.scenario_class, scenario::toString(m.cls));
@@ -121,6 +123,21 @@ TEST(MissionConversions, UavSpecRoundTripAndBadMessages) {
 }
 
 TEST(MissionConversions, BadMessagesAreConfigErrors) {
+  {
+    hameritt::Mission avoid = toMsg(scenario::loadMission("test/data/avoid_mission.json"));
+    ASSERT_EQ(avoid.phases.size(), 1u);
+    avoid.phases[0].type = "hover";
+    EXPECT_THROW(fromMsg(avoid), scenario::ConfigError);
+    avoid = toMsg(scenario::loadMission("test/data/avoid_mission.json"));
+    bool moving = false;
+    for (auto& k : avoid.keep_out_zones) {
+      if (k.motion.empty()) continue;
+      moving = true;
+      k.motion_t.pop_back();  // a stamp short
+    }
+    ASSERT_TRUE(moving);
+    EXPECT_THROW(fromMsg(avoid), scenario::ConfigError);
+  }
   hameritt::Mission msg = toMsg(scenario::loadMission("scenarios/default/mission.json"));
   msg.relations[1].op = "EVENTUALLY_ON_TOP_OF";  // the prefixed spelling is understood
   EXPECT_TRUE(fromMsg(msg).relations[1].eventually);

@@ -87,14 +87,17 @@ def generate_one(tmp, cls, seed):
     return os.path.join(out, dirs[0])
 
 
-def launch_mission(args, out, log, label, check, guard):
+def launch_mission(args, out, log, label, check, guard, master_uri=None):
     """Runs `roslaunch hameritt mission.launch ARGS output_dir:=OUT` (its output in LOG) until it
     ends by itself; after `guard` wall seconds (a hang, not a timing) it is stopped and that is a
-    failed check. Returns (exit code, log text, metrics.json or None: a failed check)."""
+    failed check. `master_uri`: another master than ROS_MASTER_URI's (two missions at once).
+    Returns (exit code, log text, metrics.json or None: a failed check)."""
+    env = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
+    if master_uri:
+        env["ROS_MASTER_URI"] = master_uri
     launch = subprocess.Popen(
         ["roslaunch", "hameritt", "mission.launch"] + list(args) + ["output_dir:=" + out],
-        stdout=open(log, "w"), stderr=subprocess.STDOUT,
-        env=dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED="1"))
+        stdout=open(log, "w"), stderr=subprocess.STDOUT, env=env)
     try:
         rc = launch.wait(guard)
     except subprocess.TimeoutExpired:

@@ -42,7 +42,10 @@ namespace hameritt::ros_wrappers {
 //   ~found_by_sighting (default: mode == maneuver_only), ~track_fraction (0.5),
 //   ~coverage_cell_size (2), ~coverage_max_range (150),
 //   ~recorder_min_space_mb (0 = no recorder; else the recorder's --min-space in MB: a mission
-//   cut short while ~output_dir's disk has less free names the recorder's stop as the cause).
+//   cut short while ~output_dir's disk has less free names the recorder's stop as the cause),
+//   ~traffic_rate_hz (2, sim time; 0 = none: an avoid mission's aircraft as ADS-B-like reports
+//   on adk/traffic, hameritt/EntityStateArray, class and role "aircraft", at the odometry after
+//   each period).
 // Topics are relative to the node's namespace (/mission, /adk/... in the root namespace).
 class AdkRos {
  public:
@@ -85,6 +88,8 @@ class AdkRos {
   void publishAvoid(double t, const adk::AvoidScore& a);
   adk::TrafficSample avoidSample(double t, const Eigen::Vector3d& p,
                                  const Eigen::Vector3d& v) const;
+  // adk/traffic: the aircraft of sample `s` as ADS-B-like reports (hameritt/EntityStateArray).
+  void publishTraffic(double t, const adk::TrafficSample& s);
   // Track objectives are judged at the time limit: at t >= the limit, success when every
   // target was in view for the track fraction of it (before the time limit's timeout).
   void judgeTrackAtLimit(double t);
@@ -138,6 +143,8 @@ class AdkRos {
   double follow_koz_start_ = 0.0;  // the monitor's violation seconds at the phase's start
   bool crashed_ = false;
   std::map<std::string, adk::PhaseState> phase_states_;  // the last published, by phase id
+  double traffic_period_ = 0.5;  // s between adk/traffic reports; 0: none
+  double next_traffic_t_ = 0.0;
   std::unique_ptr<adk::ClockWatchdog> watchdog_;
   adk::GroundTruthHistory truth_{10.0};
 
@@ -157,7 +164,8 @@ class AdkRos {
   ros::WallTime finished_at_;
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
-      perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_, follow_pub_, phase_pub_;
+      perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_, follow_pub_, phase_pub_,
+      traffic_pub_;
   ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };

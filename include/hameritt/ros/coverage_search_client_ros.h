@@ -4,8 +4,11 @@
 // leg at a time; it hovers when the ADK says the mission is over, at the mission's time limit, or
 // once the objective's targets have been detected. A track objective (pursuit) is not over at
 // the find: the client then pursues the target (clients::ViewpointChooser, StreetPredictor) until
-// the mission ends. In maneuver-only mode it also turns the ADK's perfect perception into claims
-// (the paper's maneuver-only training thread).
+// the mission ends. An avoid mission (a reach objective with an avoid phase) is flown by
+// clients::AvoidPilot instead of a search: the shortest flight to the goal, deconflicted from the
+// aircraft of the ADK's traffic reports and the moving keep-out zones. In maneuver-only mode it
+// also turns the ADK's perfect perception into claims (the paper's maneuver-only training
+// thread).
 
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
@@ -17,9 +20,11 @@
 #include <string>
 
 #include "hameritt/Detection.h"
+#include "hameritt/EntityStateArray.h"
 #include "hameritt/FollowProgress.h"
 #include "hameritt/Mission.h"
 #include "hameritt/PerceptionReport.h"
+#include "hameritt/clients/avoid.h"
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/context_filter.h"
 #include "hameritt/clients/coverage.h"
@@ -44,7 +49,10 @@ namespace hameritt::ros_wrappers {
 // must pass the context filter), ~claim_radius (4 m), ~claim_hold (30 s), ~mission_start_time
 // (0: sim time of mission time 0), ~rate_hz (2), ~pursue (true: pursue a track objective's
 // target after its find instead of hovering), ~pursuit_standoff (8 m), ~pursuit_height (20 m),
-// ~pursuit_lead (1 s), ~pursuit_rate_hz (10).
+// ~pursuit_lead (1 s), ~pursuit_rate_hz (10), ~avoid (true: fly an avoid mission with the
+// pilot), ~avoid_rate_hz (10), ~avoid_speed_fraction (0.6), ~avoid_horizontal_buffer (9 m),
+// ~avoid_vertical_buffer (6 m), ~avoid_horizon (10 s). Avoid missions: sub adk/traffic
+// (hameritt/EntityStateArray), pub uav/cmd_pose.
 class CoverageSearchClientRos {
  public:
   // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
@@ -63,6 +71,9 @@ class CoverageSearchClientRos {
   // Pursuit: starts it (after the find of a track objective's target) and flies it.
   void startPursuit(const std::string& why);
   void onPursuitTick();
+  // Avoid: traffic reports and the pilot's tick.
+  void onTraffic(const hameritt::EntityStateArray::ConstPtr& msg);
+  void onAvoidTick();
 
   double missionTime() const;
   void replan(const std::string& why);
@@ -102,8 +113,14 @@ class CoverageSearchClientRos {
   double planner_sent_at_ = -1e9;
   int losses_ = 0;
 
+  // Avoid.
+  bool avoid_enabled_ = true, avoid_planned_ = false, avoid_arrived_ = false;
+  clients::AvoidSettings avoid_settings_;
+  std::unique_ptr<clients::AvoidPilot> avoid_;
+
   ros::Publisher waypoints_pub_, plan_pub_, detection_pub_, pose_pub_;
-  ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_;
+  ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_,
+      traffic_sub_;
 };
 
 }  // namespace hameritt::ros_wrappers
