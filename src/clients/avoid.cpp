@@ -49,6 +49,9 @@ constexpr double kClearance = 2.5;
 constexpr double kCornerAngle = 0.35;
 constexpr double kCornerSpeed = 3.0;
 constexpr double kCornerSlowdown = 10.0;
+// Seconds held before the path is planned again, and how many times.
+constexpr double kStallReplan = 8.0;
+constexpr int kMaxReplans = 3;
 
 }  // namespace
 
@@ -78,13 +81,33 @@ AvoidPilot::AvoidPilot(const scenario::World& world, const scenario::Mission& mi
   settings_.validate();
 }
 
-bool AvoidPilot::plan(const Vec3& start) {
+bool AvoidPilot::plan(const Vec3& start, std::optional<double> freeze_at) {
   path_.clear();
   cumulative_.clear();
   // Planned with kClearance from the obstacles (the autopilot cuts corners); where that finds
   // no flight (a narrow gap), with the generator's 1 m.
-  scenario::ReferenceFlight f = scenario::shortestFlight(band_, start, spec_.goal);
-  if (!f.ok) f = scenario::shortestFlight(tight_, start, spec_.goal);
+  scenario::ReferenceFlight f;
+  if (freeze_at && !moving_kozs_.empty()) {
+    // A replan after a stall: the moving zones where they are now, as static ones.
+    std::vector<scenario::KeepOutZone> zones = static_kozs_;
+    for (const auto& k : moving_kozs_) {
+      scenario::KeepOutZone z = k;
+      z.polygon = scenario::kozPolygonAt(k, *freeze_at);
+      z.motion.clear();
+      zones.push_back(z);
+    }
+    // Kept farther from the frozen zones than the stall margin (else the new path stalls
+    // too), then with less where that finds nothing.
+    for (double margin : {settings_.koz_margin + 0.5, kClearance, 1.0}) {
+      f = scenario::shortestFlight(
+          planning::WorldValidity(world_, zones, planning::validitySettingsFor(uav_, margin)),
+          start, spec_.goal);
+      if (f.ok) break;
+    }
+  } else {
+    f = scenario::shortestFlight(band_, start, spec_.goal);
+    if (!f.ok) f = scenario::shortestFlight(tight_, start, spec_.goal);
+  }
   if (!f.ok) {
     why_ = f.why;
     return false;
@@ -243,6 +266,32 @@ AvoidCommand AvoidPilot::step(double t, const Vec3& uav) {
     if (best) break;  // a slower candidate is never preferred to a faster one that keeps it
   }
   const Candidate chosen = best ? *best : fallback ? *fallback : Candidate{};
+  // Held (or backing off) for kStallReplan s: a zone or an aircraft sits on the path. The path
+  // is planned again from here, around the moving zones where they are now (at most
+  // kMaxReplans times); this tick holds.
+  if (chosen.speed > 0.0 || s_ >= len - 1e-6) {
+    stalled_since_.reset();
+  } else if (!stalled_since_) {
+    stalled_since_ = t;
+  } else if (t - *stalled_since_ >= kStallReplan && replans_ < kMaxReplans) {
+    const std::vector<Vec3> old_path = path_;
+    const std::vector<double> old_cumulative = cumulative_, old_corners = corners_;
+    const double old_s = s_, old_offset = offset_;
+    ++replans_;
+    stalled_since_.reset();
+    if (plan(uav, t)) {
+      cmd.setpoint = uav;
+      cmd.reason = "stalled: planned again around the moving zones";
+      last_t_ = t;
+      started_ = true;
+      return cmd;
+    }
+    path_ = old_path;  // no other way: keep waiting on the old one
+    cumulative_ = old_cumulative;
+    corners_ = old_corners;
+    s_ = old_s;
+    offset_ = old_offset;
+  }
   cmd.conflict = !best;
   cmd.speed = chosen.speed;
   // The reference advances (or backs off) at the chosen speed, but waits for a lagging UAV.

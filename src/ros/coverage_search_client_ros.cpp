@@ -515,7 +515,12 @@ void CoverageSearchClientRos::onAvoidTick() {
     ROS_INFO("%s: avoid: flying a %.1f m path of %zu points to the goal", kClientName,
              avoid_->pathLength(), avoid_->path().size());
   }
+  const int replans = avoid_->replans();
   const clients::AvoidCommand c = avoid_->step(missionTime(), uav);
+  if (avoid_->replans() > replans) {
+    ROS_INFO("%s: avoid t %.1f: %s (%.1f m, replan %d)", kClientName, missionTime(),
+             c.reason.c_str(), avoid_->pathLength(), avoid_->replans());
+  }
   if (c.at_goal && !avoid_arrived_) {
     avoid_arrived_ = true;
     ROS_INFO("%s: avoid: the reference is at the goal", kClientName);

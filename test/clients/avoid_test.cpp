@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "hameritt/generation/generator.h"
+#include "hameritt/geometry/polygon.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/world.h"
 
@@ -169,6 +170,48 @@ TEST(AvoidPilot, AHeadOnAircraftIsAvoidedOnlyWhenReported) {
   // The negative control: told nothing, the pilot flies into it.
   const Flight deaf = fly(suburb(), sc, fleet, false);
   EXPECT_TRUE(deaf.lost) << "closest " << deaf.min_separation << " m";
+}
+
+// A moving zone (a hostile vehicle's escort) that parks on the path for good: the pilot holds,
+// then plans again around the zone where it stands, reaches the goal and never enters it.
+TEST(AvoidPilot, PlansAgainAroundAMovingZoneParkedOnThePath) {
+  scenario::Scenario sc =
+      scenario::generateScenario(suburb(), config(), scenario::ScenarioClass::kAvoid, 3);
+  AvoidPilot probe(suburb(), sc.mission, sc.sim.uav);
+  ASSERT_TRUE(probe.plan(Vec3(sc.sim.uav.start.x, sc.sim.uav.start.y, 0.0)));
+  const Vec3 mid = probe.pointAt(0.5 * probe.pathLength());
+  scenario::KeepOutZone k;
+  k.id = "koz_parked";
+  k.purpose = "restricted";
+  k.polygon = geometry::orientedRectangle(mid.head<2>(), 30.0, 30.0, 0.0);
+  k.alt_min = 0.0;
+  k.alt_max = sc.sim.uav.altitude_max + 20.0;
+  k.motion = {{0.0, mid.x(), mid.y(), 0.0, 0.0}, {1000.0, mid.x(), mid.y(), 0.0, 0.0}};
+  // Only this moving zone: the generated escort is dropped.
+  std::vector<scenario::KeepOutZone> zones;
+  for (const auto& z : sc.mission.kozs) {
+    if (z.motion.empty()) zones.push_back(z);
+  }
+  zones.push_back(k);
+  sc.mission.kozs = zones;
+  AvoidPilot pilot(suburb(), sc.mission, sc.sim.uav);
+  Vec3 p(sc.sim.uav.start.x, sc.sim.uav.start.y, 0.0);
+  ASSERT_TRUE(pilot.plan(p));
+  const scenario::AvoidPhaseSpec& spec = avoidSpec(sc.mission);
+  Vec3 setpoint = p;
+  bool reached = false, entered = false;
+  for (int i = 0; i * 0.05 <= sc.mission.time_limit && !reached; ++i) {
+    if (i % 2 == 0) setpoint = pilot.step(i * 0.05, p).setpoint;
+    Vec3 v = (setpoint - p) * 1.5;
+    if (v.norm() > sc.sim.uav.max_speed) v *= sc.sim.uav.max_speed / v.norm();
+    p += v * 0.05;
+    entered |= k.polygon.contains(p.head<2>());
+    reached = (p - spec.goal).norm() <= spec.goal_radius;
+  }
+  EXPECT_TRUE(reached) << "at (" << p.transpose() << "), " << pilot.replans() << " replans, path "
+                       << pilot.pathLength() << " m: " << pilot.why();
+  EXPECT_FALSE(entered);
+  EXPECT_GE(pilot.replans(), 1);
 }
 
 TEST(AvoidPilot, AStaleReportIsDroppedAndAnOlderOneIgnored) {

@@ -64,8 +64,10 @@ class AvoidPilot {
              const scenario::UavSpec& uav, const AvoidSettings& settings = {});
 
   // Plans the path from `start` (the UAV on the ground or in the air) to the goal. False (with
-  // why()) when no flight exists.
-  bool plan(const geometry::Vec3& start);
+  // why()) when no flight exists. `freeze_at`: the moving zones count as static ones where
+  // they are at that time (step() replans so after a stall).
+  bool plan(const geometry::Vec3& start, std::optional<double> freeze_at = std::nullopt);
+  int replans() const { return replans_; }
   bool planned() const { return !path_.empty(); }
   const std::string& why() const { return why_; }
   const std::vector<geometry::Vec3>& path() const { return path_; }
@@ -110,6 +112,8 @@ class AvoidPilot {
   double s_ = 0.0;       // the reference's arc length
   double offset_ = 0.0;  // the current vertical offset command
   double last_t_ = 0.0;
+  std::optional<double> stalled_since_;
+  int replans_ = 0;
   bool started_ = false;
 };
 
