@@ -217,7 +217,8 @@ class ProcessGroupTest(unittest.TestCase):
 def mission(cls, mode, outcome, ttd, koz, **kw):
     e = {"class": cls, "mode": mode, "outcome": outcome, "time_to_first_correct_detection": ttd,
          "koz_violation_count": koz, "bag_size": 10, "shard": 0, "host": "h", "job": "",
-         "wall_time": 1.0, "finished": "t", "energy": 1.0, "path_length": 2.0, "coverage": 0.1}
+         "wall_time": 1.0, "finished": "t", "energy": 1.0, "path_length": 2.0, "coverage": 0.1,
+         "end_time": 6.0}
     e.update(kw)
     return e
 
@@ -247,7 +248,7 @@ class SummaryAndCompareTest(unittest.TestCase):
         b = json.loads(json.dumps(a))
         b["run"]["shards"] = 1
         b["missions"][0].update(shard=3, host="n2", job="7_3", wall_time=9.0, finished="u",
-                                bag_size=99, energy=1.5)
+                                bag_size=99, energy=1.5, end_time=6.4)
         b["summary"]["bag_bytes"] = 99
         self.assertEqual(hc.compare_manifests(a, b), [])
         b["missions"][0]["outcome"] = "timeout"
