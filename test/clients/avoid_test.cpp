@@ -17,23 +17,17 @@
 #include "hameritt/geometry/polygon.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/world.h"
+#include "../scenario/test_util.h"
 
 namespace hameritt::clients {
 namespace {
 
 using geometry::Vec3;
 
-const scenario::GeneratorConfig& config() {
-  static const scenario::GeneratorConfig c =
-      scenario::loadGeneratorConfig(scenario::defaultConfigDir() + "/generator.json");
-  return c;
-}
-
-const scenario::World& suburb() {
-  static const scenario::World w = scenario::generateWorld(
-      scenario::loadWorldParams(scenario::defaultConfigDir() + "/world.json"));
-  return w;
-}
+// The shipped configuration and worlds, built once (the scenario tests' fixtures).
+const scenario::GeneratorConfig& config() { return scenario::testing::shippedConfig(); }
+const scenario::World& suburb() { return scenario::testing::shippedWorld(); }
+const scenario::World& city() { return scenario::testing::shippedCityWorld(); }
 
 const scenario::AvoidPhaseSpec& avoidSpec(const scenario::Mission& m) {
   for (const auto& p : m.phases) {
@@ -120,16 +114,6 @@ scenario::Aircraft headOn(const AvoidPilot& pilot, double start_t) {
     a.trajectory.insert(a.trajectory.begin(), first);
   }
   return a;
-}
-
-const scenario::World& city() {
-  static const scenario::World w = [] {
-    scenario::WorldParams p =
-        scenario::loadWorldParams(scenario::defaultConfigDir() + "/world.json");
-    p.type = scenario::WorldType::kCity;
-    return scenario::generateWorld(p);
-  }();
-  return w;
 }
 
 void flyGenerated(const scenario::World& world, int n) {
