@@ -18,35 +18,17 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "test",
-                                "scripts"))
-from graph_util import start_master, stop_master  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mission_bench_util import fly_mission  # noqa: E402
 
 
 def fly(scenario, out, pursue, time_limit, port):
-    env = dict(os.environ, ROS_MASTER_URI="http://localhost:%d" % port,
-               ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
-    core = start_master(port)
-    t0 = time.time()
-    try:
-        with open(out + ".log", "w") as log:
-            rc = subprocess.call(
-                ["roslaunch", "-p", str(port), "hameritt", "mission.launch",
-                 "scenario:=" + scenario, "mode:=maneuver_only", "lockstep:=true",
-                 "real_time_factor:=0", "time_limit:=%g" % time_limit, "pursue:=" + pursue,
-                 "output_dir:=" + out], stdout=log, stderr=subprocess.STDOUT, env=env,
-                timeout=3600)
-    finally:
-        stop_master(core)
-    wall = time.time() - t0
-    try:
-        with open(os.path.join(out, "metrics.json")) as f:
-            m = json.load(f)
-    except (OSError, ValueError) as e:
-        return {"scenario": os.path.basename(scenario), "outcome": "no metrics: %s" % e,
-                "rc": rc, "wall_s": wall}
+    rc, wall, m = fly_mission(scenario, out, port,
+                              ["time_limit:=%g" % time_limit, "pursue:=" + pursue])
+    if isinstance(m, str):
+        return {"scenario": os.path.basename(scenario), "outcome": m, "rc": rc,
+                "wall_s": wall}
     limit = m["time_limit"]
     in_view = m["targets"][0]["in_view_time"]
     return {"scenario": os.path.basename(scenario), "outcome": m["outcome"], "rc": rc,
