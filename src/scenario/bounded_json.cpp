@@ -1,6 +1,8 @@
 #include "hameritt/scenario/bounded_json.h"
 
+#include <filesystem>
 #include <fstream>
+#include <system_error>
 
 #include "hameritt/scenario/error.h"
 
@@ -58,6 +60,11 @@ void checkJsonText(std::string_view text, const std::string& file, std::uintmax_
 }
 
 std::string readBoundedFile(const std::string& path, std::uintmax_t max_bytes) {
+  // An ifstream opens a directory and reports its size as the largest offset: say what it is.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ConfigError(path + ": is a directory, expected a JSON file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot open file");
   // A regular file's size is known before reading; a pipe or a device is read in blocks and

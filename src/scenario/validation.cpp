@@ -167,9 +167,11 @@ std::vector<ValidationIssue> validateFile(const std::string& path, const std::st
   try {
     text = readBoundedFile(path);
   } catch (const ConfigError& e) {
-    // "PATH: cannot open file", "PATH: N bytes, more than the limit ...".
+    // "PATH: cannot open file", "PATH: is a directory, ...", "PATH: N bytes, more than the
+    // limit ...".
     const std::string what = std::string(e.what()).substr(path.size() + 2);
-    return {{path, "", what.rfind("cannot", 0) == 0 ? "io" : "limit", what}};
+    const bool io = what.rfind("cannot", 0) == 0 || what.rfind("is a directory", 0) == 0;
+    return {{path, "", io ? "io" : "limit", what}};
   }
   json doc;
   ValidationIssue issue;

@@ -96,6 +96,14 @@ TEST(BoundedJsonTest, OverSizeFileIsRefusedBeforeItIsRead) {
   EXPECT_NE(issues[0].message.find(stated), std::string::npos) << issues[0].message;
   EXPECT_EQ(messageOf([&] { readBoundedFile((dir / "none.json").string()); }),
             (dir / "none.json").string() + ": cannot open file");
+  // A directory opens as a stream whose end is the largest offset: it is named for what it is,
+  // not refused as too large.
+  EXPECT_EQ(messageOf([&] { readBoundedFile(dir.string()); }),
+            dir.string() + ": is a directory, expected a JSON file");
+  const auto dir_issues = validateFile(dir.string(), "/nonexistent");
+  ASSERT_EQ(dir_issues.size(), 1u);
+  EXPECT_EQ(dir_issues[0].rule, "io");
+  EXPECT_EQ(dir_issues[0].message, "is a directory, expected a JSON file");
   fs::remove_all(dir);
 }
 
