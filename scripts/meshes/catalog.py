@@ -5,6 +5,7 @@ from .fences import make_fence_chain_link, make_fence_vinyl, make_fence_wood
 from .trees import make_tree_deciduous, make_tree_pine
 from .cars import CARS, make_car, make_pickup_bed
 from .pedestrian_uav import make_pedestrian, make_sentinel
+from .aircraft import make_fixed_wing, make_quadrotor
 
 
 # ----------------------------------------------------------------------------------------------
@@ -29,6 +30,8 @@ CLASS_MESHES = [
 ] + [(name, lambda lod, name=name: make_car_named(name, lod), (1, 2)) for name in CARS] + [
     ("pedestrian", lambda lod: make_pedestrian(), ()),
     ("sentinel", lambda lod: make_sentinel(), ()),
+    ("aircraft_fixed_wing", lambda lod: make_fixed_wing(), ()),
+    ("aircraft_quadrotor", lambda lod: make_quadrotor(), ()),
 ]
 
 

@@ -42,8 +42,9 @@ def make_pedestrian():
 # ----------------------------------------------------------------------------------------------
 # Sentinel UAV (metres, base_link FLU, origin at the centre of mass)
 # ----------------------------------------------------------------------------------------------
-def make_sentinel():
-    m = Mesh("sentinel", 1500, normalized=False, paint=(0.16, 0.16, 0.17))
+def make_sentinel(name="sentinel", normalized=False):
+    """The sentinel in metres (normalized=False), or the same parts as a class mesh."""
+    m = Mesh(name, 1500, normalized=normalized, paint=(0.16, 0.16, 0.17))
     a = 0.106066
     # central body: tapered box 0.12 x 0.08 x 0.05 and a battery/cover plate on top
     m.hexa("frame", [(-0.06, -0.04, -0.025), (0.06, -0.04, -0.025), (0.06, 0.04, -0.025),

@@ -14,12 +14,12 @@ using scenario::JsonWriter;
 std::vector<Category> entityCategories() {
   using scenario::EntityClass;
   std::vector<Category> out;
-  for (EntityClass c :
-       {EntityClass::kStreet, EntityClass::kDriveway, EntityClass::kHouse, EntityClass::kGarage,
-        EntityClass::kFence, EntityClass::kTree, EntityClass::kCar, EntityClass::kPedestrian,
-        EntityClass::kBuilding, EntityClass::kParkingGarage, EntityClass::kParkingLot,
-        EntityClass::kAlley, EntityClass::kLampPost, EntityClass::kTrafficLight,
-        EntityClass::kBusStop, EntityClass::kBench, EntityClass::kStreetTree}) {
+  for (EntityClass c : {EntityClass::kStreet, EntityClass::kDriveway, EntityClass::kHouse,
+                        EntityClass::kGarage, EntityClass::kFence, EntityClass::kTree,
+                        EntityClass::kCar, EntityClass::kPedestrian, EntityClass::kBuilding,
+                        EntityClass::kParkingGarage, EntityClass::kParkingLot, EntityClass::kAlley,
+                        EntityClass::kLampPost, EntityClass::kTrafficLight, EntityClass::kBusStop,
+                        EntityClass::kBench, EntityClass::kStreetTree, EntityClass::kAircraft}) {
     out.push_back({scenario::semanticId(c), scenario::toString(c)});
   }
   std::sort(out.begin(), out.end(),

@@ -175,6 +175,7 @@ bool hasBoundingBox(scenario::EntityClass c) {
     case EntityClass::kBusStop:
     case EntityClass::kBench:
     case EntityClass::kStreetTree:
+    case EntityClass::kAircraft:
       return true;
     default:
       return false;

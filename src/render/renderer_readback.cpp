@@ -268,9 +268,7 @@ void Renderer::Impl::boxes(Frame& f) {
     b.instance = id;
     b.entity_id = scene.entityIds()[static_cast<std::size_t>(id)];
     b.cls = si.cls;
-    b.role = si.scenario_entity >= 0
-                 ? config.entities[static_cast<std::size_t>(si.scenario_entity)].role
-                 : "world";
+    b.role = si.scenario_entity >= 0 ? scene.scenarioEntity(si.scenario_entity).role : "world";
     b.x_min = acc.x_min;
     b.y_min = acc.y_min;
     b.x_max = acc.x_max;

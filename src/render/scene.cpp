@@ -273,7 +273,7 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
        {"house_1.obj", "house_2.obj", "garage_1.obj", "garage_2.obj", "fence_wood.obj",
         "fence_vinyl.obj", "fence_chain_link.obj", "tree_deciduous.obj", "tree_pine.obj",
         "car_sedan.obj", "car_suv.obj", "car_pickup.obj", "car_hatchback.obj", "car_van.obj",
-        "pedestrian.obj", "sentinel.obj"}) {
+        "pedestrian.obj", "sentinel.obj", "aircraft_fixed_wing.obj", "aircraft_quadrotor.obj"}) {
     model(f);
   }
   loadLods(dir, file_model);
@@ -288,7 +288,9 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
 
   foliage_ = std::clamp(config.environment.foliage, 0.0, 1.0);
   const std::size_t n_world = world.entities().size();
-  const std::size_t n_total = 2 + n_world + config.entities.size();  // + none, + uav
+  aircraft_ = scenario::aircraftEntities(config);
+  // + none, + uav
+  const std::size_t n_total = 2 + n_world + config.entities.size() + aircraft_.size();
   if (n_total > 65536) {
     throw RenderError("scene: " + std::to_string(n_total - 1) +
                       " instances do not fit the 16-bit instance labels (at most 65535)");
@@ -437,6 +439,16 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
         si.model = model("pedestrian.obj");
         color_key = "clothing_color";
         break;
+      case EntityClass::kAircraft: {
+        const std::string m = e.attributes.str("model");
+        if (m != "fixed_wing" && m != "quadrotor") {
+          throw RenderError(attributeError(e, "model", "fixed_wing or quadrotor"));
+        }
+        si.model = model("aircraft_" + m + ".obj");
+        // Airplanes white, multirotors black.
+        paintColor(m == "fixed_wing" ? "white" : "black", &si.record.color);
+        break;
+      }
     }
     if (!color_key.empty() && !paintColor(e.attributes.str(color_key), &si.record.color)) {
       throw RenderError(attributeError(e, color_key,
@@ -468,6 +480,16 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     const auto& se = config.entities[j];
     add(se.entity, static_cast<int>(1 + n_world + j), static_cast<int>(j), !se.trajectory.empty());
   }
+  const std::size_t n_config = config.entities.size();
+  for (std::size_t k = 0; k < aircraft_.size(); ++k) {
+    add(aircraft_[k].entity, static_cast<int>(1 + n_world + n_config + k),
+        static_cast<int>(n_config + k), true);
+  }
+}
+
+const scenario::ScenarioEntity& Scene::scenarioEntity(int j) const {
+  const auto k = static_cast<std::size_t>(j);
+  return k < config_.entities.size() ? config_.entities[k] : aircraft_[k - config_.entities.size()];
 }
 
 void Scene::pose(std::size_t i, double time, InstanceRecord* record, Eigen::Vector3f* center,
@@ -477,7 +499,7 @@ void Scene::pose(std::size_t i, double time, InstanceRecord* record, Eigen::Vect
   *center = si.center;
   *radius = si.radius;
   if (!si.mover) return;
-  const auto& se = config_.entities[static_cast<std::size_t>(si.scenario_entity)];
+  const auto& se = scenarioEntity(si.scenario_entity);
   const geometry::OrientedBox box =
       scenario::poseBox(se.entity.box, scenario::sampleTrajectory(se.trajectory, time));
   boxRecordRows(box, 0.0, record->row);

@@ -91,6 +91,9 @@ class Scene {
   // Instance id -> entity id ("" for 0 and the UAV is "uav").
   const std::vector<std::string>& entityIds() const { return entity_ids_; }
   int uavInstanceId() const { return uav_instance_; }
+  // The scenario entity an instance stands for (SceneInstance::scenario_entity): the
+  // configuration's entities, then its aircraft (scenario::aircraftEntities).
+  const scenario::ScenarioEntity& scenarioEntity(int j) const;
   double foliage() const { return foliage_; }
   // Record and bounding sphere of instance i at `time` (movers follow their trajectories).
   void pose(std::size_t i, double time, InstanceRecord* record, Eigen::Vector3f* center,
@@ -122,6 +125,7 @@ class Scene {
   void loadLods(const std::string& dir, const std::unordered_map<std::string, int>& file_model);
 
   const scenario::SimConfig& config_;
+  std::vector<scenario::ScenarioEntity> aircraft_;
   std::vector<Mesh> models_;
   // Per model: its coarser levels, from fine to coarse.
   struct LodLevel {

@@ -651,6 +651,16 @@ void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::Const
       pe.entity_class = "car";
       pe.role = "world";
       pe.attributes = toKeyValues(we.attributes);
+    } else if (const scenario::Aircraft* a = aircraftById(box.entity_id)) {
+      // Another aircraft of an avoid mission: its body centre on its scripted trajectory.
+      const scenario::TrajectoryPoint q = scenario::sampleTrajectory(a->trajectory, stamp);
+      where.position = geometry::Vec3(q.x, q.y, q.z);
+      where.yaw = q.yaw;
+      pe.entity_class = "aircraft";
+      pe.role = "aircraft";
+      scenario::Attributes model;
+      model.set("model", a->model);
+      pe.attributes = toKeyValues(model);
     } else if (box.role == "world" && box.entity_class != "car" &&
                box.entity_class != "pedestrian") {
       continue;  // the city's buildings and street furniture: scenery, not a perceived entity
@@ -670,6 +680,13 @@ void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::Const
   }
   if (perfect_perception_) gate_->publish(perception_pub_, report);
   checkObjective(std::max(now_, stamp));
+}
+
+const scenario::Aircraft* AdkRos::aircraftById(const std::string& id) const {
+  for (const auto& a : sim_config_.aircraft) {
+    if (a.id == id) return &a;
+  }
+  return nullptr;
 }
 
 void AdkRos::onDetection(const hameritt::Detection::ConstPtr& msg) {

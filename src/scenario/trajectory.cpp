@@ -236,4 +236,24 @@ std::optional<std::pair<double, double>> insideInterval(const Trajectory& traj,
   return std::make_pair(*enter, *exit);
 }
 
+std::vector<ScenarioEntity> aircraftEntities(const SimConfig& config) {
+  std::vector<ScenarioEntity> out;
+  for (const auto& a : config.aircraft) {
+    if (a.trajectory.empty()) continue;
+    ScenarioEntity se;
+    se.entity.id = a.id;
+    se.entity.cls = EntityClass::kAircraft;
+    se.entity.attributes.set("model", a.model);
+    se.role = "aircraft";
+    for (auto p : a.trajectory) {
+      p.z -= 0.5 * a.size.z();
+      se.trajectory.push_back(p);
+    }
+    const auto& p0 = se.trajectory.front();
+    se.entity.box = boxFromPose(geometry::Vec3(p0.x, p0.y, p0.z), p0.yaw, a.size);
+    out.push_back(std::move(se));
+  }
+  return out;
+}
+
 }  // namespace hameritt::scenario

@@ -96,25 +96,10 @@ void SimSettings::validate() const {
 }
 
 namespace {
-// The scenario's entities followed by its aircraft (class aircraft, role "aircraft"): an
-// aircraft's trajectory gives its body centre, an entity's the bottom of its box.
+// The scenario's entities followed by its aircraft (scenario::aircraftEntities).
 std::vector<scenario::ScenarioEntity> withAircraft(const scenario::SimConfig& c) {
   std::vector<scenario::ScenarioEntity> out = c.entities;
-  for (const auto& a : c.aircraft) {
-    if (a.trajectory.empty()) continue;
-    scenario::ScenarioEntity se;
-    se.entity.id = a.id;
-    se.entity.cls = scenario::EntityClass::kAircraft;
-    se.entity.attributes.set("model", a.model);
-    se.role = "aircraft";
-    for (auto p : a.trajectory) {
-      p.z -= 0.5 * a.size.z();
-      se.trajectory.push_back(p);
-    }
-    const auto& p0 = se.trajectory.front();
-    se.entity.box = scenario::boxFromPose(Vec3(p0.x, p0.y, p0.z), p0.yaw, a.size);
-    out.push_back(std::move(se));
-  }
+  for (auto& a : scenario::aircraftEntities(c)) out.push_back(std::move(a));
   return out;
 }
 }  // namespace

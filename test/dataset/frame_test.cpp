@@ -126,12 +126,15 @@ TEST(Coco, DocumentStructure) {
   EXPECT_EQ(next, 11);
   EXPECT_EQ(text, cocoJson({&f}, entityCategories(), {ctx}, "train", &(next = 10)));
   const auto doc = nlohmann::json::parse(text);
-  // The suburb's 8 classes and the city's 9, each with its semantic id.
-  ASSERT_EQ(doc["categories"].size(), 17u);
+  // The suburb's 8 classes, the city's 9 and the avoid missions' aircraft, each with its
+  // semantic id.
+  ASSERT_EQ(doc["categories"].size(), 18u);
   EXPECT_EQ(doc["categories"][8]["name"], "building");
   EXPECT_EQ(doc["categories"][8]["id"], 11);
   EXPECT_EQ(doc["categories"][16]["name"], "street_tree");
   EXPECT_EQ(doc["categories"][16]["id"], 19);
+  EXPECT_EQ(doc["categories"][17]["name"], "aircraft");
+  EXPECT_EQ(doc["categories"][17]["id"], 20);
   EXPECT_EQ(doc["images"][0]["extra"]["scenario_id"], "sc1");
   EXPECT_DOUBLE_EQ(doc["images"][0]["extra"]["sim_time"].get<double>(), 12.5);
   const auto& a = doc["annotations"][0];
@@ -153,7 +156,8 @@ TEST(Coco, DocumentStructure) {
   EXPECT_NE(yaml.find("  6: car\n"), std::string::npos);
   EXPECT_NE(yaml.find("  8: building\n"), std::string::npos);
   EXPECT_NE(yaml.find("  16: street_tree\n"), std::string::npos);
-  EXPECT_NE(yaml.find("nc: 17\n"), std::string::npos);
+  EXPECT_NE(yaml.find("  17: aircraft\n"), std::string::npos);
+  EXPECT_NE(yaml.find("nc: 18\n"), std::string::npos);
 }
 
 }  // namespace

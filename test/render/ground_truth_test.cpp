@@ -444,6 +444,75 @@ TEST(RenderGroundTruth, UavModelIsDrawnOnlyWhenAsked) {
   EXPECT_LT(with.depth[centre], 1.6f);
 }
 
+// An avoid scenario's other aircraft: an airplane crossing the neighbourhood at 40 m and a
+// quadrotor climbing across it, drawn at their trajectory pose with their own meshes, labelled
+// with class aircraft and boxed with role "aircraft".
+TEST(RenderGroundTruth, AircraftAreDrawnLabelledAndBoxedAtTheirTrajectoryPose) {
+  scenario::SimConfig cfg = defaultSimConfig();
+  const geometry::Aabb2 bounds = defaultWorld().bounds();
+  const geometry::Vec2 mid = 0.5 * (bounds.min + bounds.max);
+  scenario::Aircraft plane;
+  plane.id = "aircraft_1";
+  plane.model = "fixed_wing";
+  plane.size = geometry::Vec3(1.8, 2.4, 0.45);
+  plane.trajectory = {{0.0, mid.x() - 150.0, mid.y(), 40.0, 0.0},
+                      {60.0, mid.x() + 450.0, mid.y(), 40.0, 0.0}};
+  scenario::Aircraft quad;
+  quad.id = "aircraft_2";
+  quad.model = "quadrotor";
+  quad.size = geometry::Vec3(0.7, 0.7, 0.25);
+  quad.trajectory = {{0.0, mid.x(), mid.y() - 60.0, 20.0, 1.57},
+                     {60.0, mid.x(), mid.y() + 240.0, 50.0, 1.57}};
+  cfg.aircraft = {plane, quad};
+  Renderer r(defaultWorld(), cfg);
+  const int n_before = defaultRenderer().instanceCount();
+  EXPECT_EQ(r.instanceCount(), n_before + 2) << "two more instances, the UAV's id moves up";
+  EXPECT_EQ(r.instanceEntityId(r.instanceCount() - 1), "uav");
+  for (const auto& a : cfg.aircraft) {
+    const int id = r.instanceOf(a.id);
+    ASSERT_GT(id, 0) << a.id;
+    const double range = a.model == "fixed_wing" ? 9.0 : 3.0;
+    for (double t : {5.0, 25.0}) {
+      const auto p = scenario::sampleTrajectory(a.trajectory, t);
+      const Eigen::Vector3d c(p.x, p.y, p.z);  // the body centre
+      RenderRequest req = clean(RenderRequest{});
+      req.intrinsics = intrinsicsFromHfov(160, 120, 60.0);
+      req.time = t;
+      req.world_T_optical = lookAt(c + Eigen::Vector3d(0.2, 0.1, range), c);
+      const FrameSet f = r.render(req);
+      Eigen::Vector2d uv;
+      ASSERT_TRUE(projectPoint(req.intrinsics, req.world_T_optical, c, &uv));
+      const std::size_t i =
+          static_cast<std::size_t>(std::lround(uv.y())) * 160 + std::lround(uv.x());
+      EXPECT_EQ(f.instance[i], id) << a.id << " at t = " << t;
+      EXPECT_EQ(f.semantic[i], scenario::semanticId(scenario::EntityClass::kAircraft));
+      EXPECT_LT(f.depth[i], range) << "its top is nearer than its centre";
+      const BoundingBox* b = boxOf(f, id);
+      ASSERT_NE(b, nullptr) << a.id << " at t = " << t;
+      EXPECT_EQ(b->entity_id, a.id);
+      EXPECT_EQ(b->role, "aircraft");
+      EXPECT_EQ(b->cls, scenario::EntityClass::kAircraft);
+      EXPECT_GT(b->visible_pixels, 200) << "a close view";
+      EXPECT_EQ(b->occlusion, 0.0);
+      // Negative control: 20 s later the aircraft has flown on and the same view is empty of it.
+      req.time = t + 20.0;
+      const FrameSet later = r.render(req);
+      EXPECT_EQ(std::count(later.instance.begin(), later.instance.end(), id), 0)
+          << a.id << " is not drawn where it was";
+      EXPECT_EQ(boxOf(later, id), nullptr);
+    }
+  }
+  // An unknown model is refused, naming the attribute.
+  cfg.aircraft[1].model = "balloon";
+  try {
+    Renderer bad(defaultWorld(), cfg);
+    ADD_FAILURE() << "an unknown aircraft model was accepted";
+  } catch (const RenderError& e) {
+    EXPECT_NE(std::string(e.what()).find("model"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fixed_wing or quadrotor"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RenderGroundTruth, SceneTrianglesCarryValidInstances) {
   Renderer& r = defaultRenderer();
   const SceneTriangles& t = caster().triangles();

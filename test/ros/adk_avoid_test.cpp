@@ -8,6 +8,7 @@
 // lost. The judge's finding a loss on /close and none on /clean is its own negative control.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -16,8 +17,10 @@
 
 #include "adk_test_client.h"
 #include "hameritt/AvoidStatus.h"
+#include "hameritt/BoundingBoxArray.h"
 #include "hameritt/MissionMetrics.h"
 #include "hameritt/MissionState.h"
+#include "hameritt/PerceptionReport.h"
 
 using Eigen::Vector3d;
 using hameritt::testing::Collector;
@@ -26,6 +29,8 @@ using hameritt::testing::spinUntil;
 namespace {
 
 const std::string kRoot = "/tmp/hameritt_adk_avoid";
+// The last /clock the flights published: later tests keep time going forward.
+double g_clock_end = 0.0;
 
 struct Keyframes {
   std::string id;
@@ -158,6 +163,7 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
     if (i < clean.size()) fake.publishOdometry(0, t, a.p, a.v);
     if (i < close.size()) fake.publishOdometry(1, t, b.p, b.v);
     fake.clock(t);
+    g_clock_end = t;
     ros::spinOnce();
     ros::WallDuration(0.002).sleep();
   }
@@ -230,6 +236,66 @@ TEST(AdkAvoid, CleanFlightSucceedsCloseFlightFails) {
   EXPECT_EQ(std::system((check + kRoot + "/clean/metrics.json").c_str()), 0);
   EXPECT_EQ(std::system((check + kRoot + "/close/metrics.json").c_str()), 0);
   EXPECT_NE(std::system((check + kRoot + "/bad_metrics.json 2>/dev/null").c_str()), 0);
+}
+
+// Perfect perception on an avoid mission: a camera's box of another aircraft becomes a
+// perceived entity of class aircraft at the aircraft's scripted pose (its body centre) at the
+// image's stamp, with its model; a box whose id is no entity and no aircraft is left out.
+TEST(AdkAvoid, PerfectPerceptionReportsASeenAircraft) {
+  ros::NodeHandle nh;
+  std::string data;
+  ASSERT_TRUE(ros::NodeHandle("~").getParam("data_dir", data)) << "~data_dir not set";
+  const auto sim = hameritt::testing::readJsonFile(data + "/avoid_sim_config.json");
+  const auto& a0 = sim["aircraft"][0];
+  Keyframes k;
+  for (const auto& p : a0["trajectory"]) k.k.push_back({p[0], p[1], p[2], p[3]});
+  ros::Publisher boxes_pub =
+      nh.advertise<hameritt::BoundingBoxArray>("/seen/uav/camera/down/boxes", 10);
+  ros::Publisher clock_pub = nh.advertise<rosgraph_msgs::Clock>("/clock", 10, true);
+  Collector<hameritt::PerceptionReport> reports(nh, "/seen/adk/perfect_perception");
+  ASSERT_TRUE(
+      spinUntil([&] { return boxes_pub.getNumSubscribers() > 0 && reports.connected(); }, 30))
+      << "/seen adk node not connected";
+  const double t = g_clock_end + 1.0;
+  rosgraph_msgs::Clock c;
+  c.clock.fromSec(t);
+  clock_pub.publish(c);
+  spinUntil([] { return false; }, 0.3);
+  auto box = [](const std::string& id) {
+    hameritt::BoundingBox b;
+    b.entity_id = id;
+    b.entity_class = "aircraft";
+    b.role = "aircraft";
+    b.x_min = 10;
+    b.y_min = 20;
+    b.x_max = 60;
+    b.y_max = 45;
+    b.visible_pixels = 900;
+    b.total_pixels = 1000;
+    b.occlusion = 0.1f;
+    return b;
+  };
+  hameritt::BoundingBoxArray frame;
+  frame.header.stamp.fromSec(t);
+  frame.header.frame_id = "uav/camera_down_optical";
+  frame.camera = "down";
+  frame.boxes = {box(a0["id"]), box("aircraft_99")};
+  boxes_pub.publish(frame);
+  ASSERT_TRUE(reports.waitFor(1, 10)) << "no perfect perception report";
+  const auto& r = reports.all[0];
+  ASSERT_EQ(r.entities.size(), 1u) << "only the known aircraft";
+  const auto& e = r.entities[0];
+  EXPECT_EQ(e.entity_id, a0["id"].get<std::string>());
+  EXPECT_EQ(e.entity_class, "aircraft");
+  EXPECT_EQ(e.role, "aircraft");
+  ASSERT_EQ(e.attributes.size(), 1u);
+  EXPECT_EQ(e.attributes[0].key, "model");
+  EXPECT_EQ(e.attributes[0].value, a0["model"].get<std::string>());
+  const Vector3d p = k.at(t);
+  EXPECT_NEAR(e.position.x, p.x(), 1e-3);
+  EXPECT_NEAR(e.position.y, p.y(), 1e-3);
+  EXPECT_NEAR(e.position.z, p.z(), 1e-3);
+  EXPECT_EQ(e.box.visible_pixels, 900u);
 }
 
 int main(int argc, char** argv) {

@@ -136,7 +136,7 @@ def main():
         bag = os.path.join(tmp, "city.bag")
         write_bag(bag, 3)
         table = documented_categories()
-        check(len(table) == 17 and table.get("building") == (11, 8) and table.get("street_tree") == (19, 16),
+        check(len(table) == 18 and table.get("building") == (11, 8) and table.get("street_tree") == (19, 16),
               "documented table %s" % table)
         coco = os.path.join(tmp, "coco")
         export(bag, coco, "coco")

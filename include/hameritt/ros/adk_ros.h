@@ -123,6 +123,8 @@ class AdkRos {
   double recorder_min_space_mb_ = 0.0;
   std::vector<adk::CameraIntrinsics> intrinsics_;
   std::map<std::string, std::size_t> scenario_index_;  // scenario entity id -> sim_config index
+  // The avoid mission's aircraft of that id (sim_config.json aircraft), or null.
+  const scenario::Aircraft* aircraftById(const std::string& id) const;
   std::vector<adk::EntityTruth> world_cars_;
   std::map<std::string, std::size_t> world_car_index_;
 

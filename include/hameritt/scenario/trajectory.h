@@ -45,4 +45,10 @@ geometry::OrientedBox poseBox(const geometry::OrientedBox& box, const Trajectory
 std::optional<std::pair<double, double>> insideInterval(const Trajectory& traj,
                                                         const geometry::Polygon& convex);
 
+// The other aircraft of an avoid scenario (SimConfig::aircraft) as scenario entities of class
+// aircraft and role "aircraft", in their order, each with attribute "model": an aircraft's
+// trajectory gives its body centre, an entity's the bottom of its box, so each sample is
+// lowered by half the aircraft's height. Aircraft without a trajectory are left out.
+std::vector<ScenarioEntity> aircraftEntities(const SimConfig& config);
+
 }  // namespace hameritt::scenario
