@@ -22,6 +22,7 @@ constexpr double kStopBack = 1.0;     // the front waits this far short of the b
 constexpr double kMinGap = 2.0;       // standstill bumper gap behind the lead (m)
 constexpr double kScanStep = 0.1;     // s
 constexpr double kWaitStep = 0.1;     // waits are multiples of this (s)
+constexpr double kMaxSpeed = 30.0;    // no car drives faster (m/s)
 constexpr double kEntryMargin = 0.2;  // the signal must allow the entry this long around it (s)
 
 Vec2 unitOf(double a) { return {std::cos(a), std::sin(a)}; }
@@ -99,6 +100,20 @@ int entryAxis(const SignalizedIntersection& si, const SignalPlan& plan, const Ve
   return -1;
 }
 
+// The axis along which a front at `front` (heading `yaw`) enters si's box at this sample, having
+// been outside it at the previous one (*was_in), or -1; *was_in becomes whether it is inside.
+int entering(const SignalizedIntersection& si, const SignalPlan& plan, const Vec2& front,
+             double yaw, char* was_in) {
+  if ((front - si.position).squaredNorm() > kNear * kNear) {
+    *was_in = 0;
+    return -1;
+  }
+  const bool in = inEither(si, plan, front);
+  const int axis = !*was_in && in ? entryAxis(si, plan, front, yaw) : -1;
+  *was_in = in;
+  return axis;
+}
+
 TrajectoryPoint rounded(TrajectoryPoint q) {
   q.t = roundMilli(q.t);
   q.x = roundMilli(q.x);
@@ -170,25 +185,16 @@ std::vector<SignalEntry> signalEntries(const Trajectory& traj, double length,
     const Vec2 front = frontOf(q, half);
     for (std::size_t i = 0; i < plan.intersections.size(); ++i) {
       const auto& si = plan.intersections[i];
-      if ((front - si.position).squaredNorm() > kNear * kNear) {
-        was_in[i] = 0;
-        continue;
-      }
-      const bool in = inEither(si, plan, front);
-      if (!was_in[i] && in) {
-        const int axis = entryAxis(si, plan, front, q.yaw);
-        if (axis >= 0) {
-          SignalEntry e;
-          e.intersection = i;
-          e.axis = axis;
-          e.t = t;
-          e.turned = turnedAt(traj, half, si, plan, t, dt);
-          e.state = plan.state(si, axis, t);
-          e.allowed = judgedAllowed(plan, si, axis, t, e.turned);
-          out.push_back(e);
-        }
-      }
-      was_in[i] = in;
+      const int axis = entering(si, plan, front, q.yaw, &was_in[i]);
+      if (axis < 0) continue;
+      SignalEntry e;
+      e.intersection = i;
+      e.axis = axis;
+      e.t = t;
+      e.turned = turnedAt(traj, half, si, plan, t, dt);
+      e.state = plan.state(si, axis, t);
+      e.allowed = judgedAllowed(plan, si, axis, t, e.turned);
+      out.push_back(e);
     }
   }
   return out;
@@ -227,39 +233,39 @@ Trajectory obeySignals(const Trajectory& traj, double length, const SignalPlan& 
       continue;
     }
     const Vec2 front = frontOf(q, half);
+    if (!lead) {
+      // Far from every intersection: on to the first step at which the front may be near one.
+      double nearest = 1e18;
+      for (const auto& si : plan.intersections)
+        nearest = std::min(nearest, (front - si.position).squaredNorm());
+      nearest = std::sqrt(nearest);
+      if (nearest > kNear + kMaxSpeed * kScanStep) {
+        std::fill(was_in.begin(), was_in.end(), 0);
+        t += kScanStep * std::floor((nearest - kNear) / (kMaxSpeed * kScanStep));
+        continue;
+      }
+    }
     bool waited = false;
     for (std::size_t i = 0; i < plan.intersections.size() && !waited; ++i) {
       const auto& si = plan.intersections[i];
-      if ((front - si.position).squaredNorm() > kNear * kNear) {
-        was_in[i] = 0;
-        continue;
-      }
-      const bool in = inEither(si, plan, front);
-      if (!was_in[i] && in) {
-        const int axis = entryAxis(si, plan, front, q.yaw);
-        if (axis >= 0) {
-          const double turned = turnedAt(tr, half, si, plan, t, kScanStep);
-          // The front crosses into the box between t - step and t; it may go when the rule
-          // holds over that interval and a margin around it.
-          auto fine = [&](double shift) {
-            for (double u = t - kScanStep - kEntryMargin; u <= t + kEntryMargin + 1e-9; u += 0.05)
-              if (!mayGo(plan, si, axis, u + shift, turned)) return false;
-            return true;
-          };
-          if (!fine(0.0)) {
-            double wait = kWaitStep;
-            while (wait <= horizon && !fine(wait)) wait += kWaitStep;
-            if (wait <= horizon) {
-              const double at = timeBack(tr, t - kScanStep, kStopBack);
-              tr = withWait(tr, at, wait);
-              t = roundMilli(at + wait);  // rescanned from the wait's end: the front is outside
-              waited = true;
-              continue;
-            }
-          }
-        }
-      }
-      was_in[i] = in;
+      const int axis = entering(si, plan, front, q.yaw, &was_in[i]);
+      if (axis < 0) continue;
+      const double turned = turnedAt(tr, half, si, plan, t, kScanStep);
+      // The front crosses into the box between t - step and t; it may go when the rule holds
+      // over that interval and a margin around it.
+      auto fine = [&](double shift) {
+        for (double u = t - kScanStep - kEntryMargin; u <= t + kEntryMargin + 1e-9; u += 0.05)
+          if (!mayGo(plan, si, axis, u + shift, turned)) return false;
+        return true;
+      };
+      if (fine(0.0)) continue;
+      double wait = kWaitStep;
+      while (wait <= horizon && !fine(wait)) wait += kWaitStep;
+      if (wait > horizon) continue;  // no time lets it go (no arrow long enough to turn)
+      const double at = timeBack(tr, t - kScanStep, kStopBack);
+      tr = withWait(tr, at, wait);
+      t = roundMilli(at + wait);  // rescanned from the wait's end: the front is outside
+      waited = true;
     }
     if (!waited) t += kScanStep;
   }
