@@ -237,7 +237,7 @@ int main(int argc, char** argv) {
       "serialize_ms_per_scenario  %.2f (mission.json + sim_config.json as a batch writes them)\n",
       write_s * 1e3 / solo);
   std::printf(
-      "inline_sim_config_kb       %.1f (sim_config.json self-contained, as --into writes it)\n",
+      "inline_sim_config_kb       %.1f (sim_config.json self-contained, as the node's service writes it)\n",
       inline_bytes / 1e3 / solo);
   struct rusage ru {};
   ::getrusage(RUSAGE_SELF, &ru);

@@ -151,8 +151,14 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
         e.id = s.mission.scenario_id;
         if (req.check) req.check(s);
         const bool by_reference = req.share_traffic && s.sim.traffic && s.sim.traffic->text;
-        if (by_reference) writeEpisode(*s.sim.traffic);
-        writeScenarioDir(req.out_dir, s, by_reference);
+        if (by_reference && req.traffic_inside) {
+          s.sim.traffic->file = trafficEpisodeFileName(s.sim.traffic->episode);
+          const std::string dir = writeScenarioDir(req.out_dir, s, by_reference);
+          writeFileAtomic(dir + "/" + s.sim.traffic->file, *s.sim.traffic->text);
+        } else {
+          if (by_reference) writeEpisode(*s.sim.traffic);
+          writeScenarioDir(req.out_dir, s, by_reference);
+        }
         written[static_cast<std::size_t>(i)] = 1;
       } catch (...) {
         std::lock_guard<std::mutex> lock(mu);

@@ -17,6 +17,7 @@
 #include "hameritt/scenario/city_traffic.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
+#include "hameritt/scenario/signal_compliance.h"
 #include "hameritt/scenario/trajectory.h"
 
 namespace hameritt::scenario {
@@ -1104,6 +1105,10 @@ class ScenarioBuilder {
       drawTargetLook(&model, &color);
       if (i == 0 && lead_model >= 0)
         model = &catalog::carModels()[static_cast<std::size_t>(lead_model)];
+      // In the city each car waits at the signals (the second behind the first as well).
+      trajs[static_cast<std::size_t>(i)] =
+          obeyCitySignals(trajs[static_cast<std::size_t>(i)], model->length,
+                          i > 0 ? &trajs[0] : nullptr, i > 0 ? targets[0].box.size.x() : 0.0);
       const Trajectory& traj = trajs[static_cast<std::size_t>(i)];
       Entity e = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
       targets.push_back(e);
@@ -1321,6 +1326,7 @@ class ScenarioBuilder {
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
     slot_taken_[static_cast<std::size_t>(slot)] = 1;
     const Vec2 fwd(std::cos(sl.yaw), std::sin(sl.yaw));
+    traj = obeyCitySignals(traj, model->length);
     Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
     m.objective.type = "track";
     m.objective.targets.push_back(describe(target));
@@ -1559,6 +1565,12 @@ class ScenarioBuilder {
       if (nodes.size() < 2) continue;
       DriveSpec spec = driveSpec(rangeDraw(rng_, cfg_.car_speed));
       spec.depart_delay = rng_.uniform(0.0, 10.0);
+      if (world_.params().type == WorldType::kCity) {
+        // Out of the first node's intersection box (so that it meets that node's signal, if
+        // any, at its stop line like the rest).
+        const CityParams& cp = world_.params().city;
+        spec.start_offset = 0.5 * cp.arterial_width + cp.sidewalk_width + 4.0;
+      }
       Trajectory traj = planDrive(nodePositions(nodes), spec);
       bool clear = true;
       for (double t = 0.0; t <= horizon + 1.0 && clear; t += 1.0) {
@@ -1578,6 +1590,7 @@ class ScenarioBuilder {
     if (chosen.empty())
       throw GenerationError("no route for the hostile vehicle clear of the start and goal");
     const auto& model = catalog::pickModel(rng_);
+    chosen = obeyCitySignals(chosen, model.length);
     Entity e = makeCar(model, catalog::pick(rng_, catalog::carColors()),
                        Vec3(chosen[0].x, chosen[0].y, chosen[0].z), chosen[0].yaw);
     KeepOutZone k = makeKoz(
@@ -1856,13 +1869,43 @@ class ScenarioBuilder {
     sc_.mission.kozs.push_back(k);
   }
 
+  static bool sameSignalPlan(const SignalPlan& a, const SignalPlan& b) {
+    if (a.cycle() != b.cycle() || a.left != b.left ||
+        a.intersections.size() != b.intersections.size())
+      return false;
+    for (std::size_t i = 0; i < a.intersections.size(); ++i) {
+      if (a.intersections[i].offset != b.intersections[i].offset) return false;
+    }
+    return true;
+  }
+
+  std::uint64_t citySeed() const { return deriveSeed(seed_, 0x4349545954524146ULL); }
+
+  // A mission vehicle's trajectory (car length `length`), in the city retimed to wait at the stop
+  // lines of the signal plan that the scenario's traffic carries (drawn before the traffic is
+  // added), behind `lead` when it follows one; in the suburb unchanged.
+  Trajectory obeyCitySignals(const Trajectory& traj, double length,
+                             const Trajectory* lead = nullptr, double lead_length = 0.0) {
+    if (world_.params().type != WorldType::kCity) return traj;
+    if (!city_signals_) {
+      city_signals_ = drawCityTraffic(world_, citySeed(), sc_.mission.time_limit).plan;
+    }
+    return obeySignals(traj, length, *city_signals_, lead, lead_length);
+  }
+
   // The city's signalised ambient traffic and crowd (scenario/city_traffic.h), drawn from a
   // stream of its own over the mission's time limit. The crowd and the cars come last: when they
   // are a window of a shared traffic episode, a batch writes them as a reference
   // (SimConfig::traffic) and a reader appends them again, pedestrians first.
   void addCityTraffic() {
-    CityTraffic traffic = simulateCityTraffic(world_, deriveSeed(seed_, 0x4349545954524146ULL),
-                                              sc_.mission.time_limit, {}, traffic_by_reference_);
+    CityTraffic traffic =
+        simulateCityTraffic(world_, citySeed(), sc_.mission.time_limit, {}, traffic_by_reference_);
+    if (city_signals_ && !sameSignalPlan(*city_signals_, traffic.plan)) {
+      // The mission's vehicles were retimed for a plan drawn with a time limit on the other side
+      // of half an episode's length.
+      throw GenerationError(
+          "the city's signal plan changed after the mission's vehicles obeyed it");
+    }
     TrafficEpisodeRef ref;
     for (auto& ped : traffic.pedestrians) {
       ScenarioEntity se = cityPedestrianEntity(ped, std::move(ped.trajectory), nextPedId());
@@ -1988,6 +2031,7 @@ class ScenarioBuilder {
   std::vector<Group> extra_groups_;
   const ScenarioPlan* plan_;
   bool traffic_by_reference_ = false;
+  std::optional<SignalPlan> city_signals_;  // the plan the city traffic will carry, once drawn
 };
 
 }  // namespace

@@ -148,7 +148,8 @@ bool paintColor(const std::string& name, std::uint32_t* srgb8);
 // InstanceRecord::color of a traffic-light mast: bits 0-1 the lamp lit towards axis 0's
 // traffic, 2-3 towards axis 1's (0 red, 1 yellow, 2 green, 3 none), bit 4 (5) set while axis 0
 // (1) shows its protected left arrow (a green arrow in the green lamp's place, beside the red
-// lamp), 8-15 axis 0's heading in 256ths of a turn.
+// lamp; the other axis' faces show a right arrow then, as its right turns go), 8-15 axis 0's
+// heading in 256ths of a turn.
 constexpr std::uint32_t kSignalDark = 3u | (3u << 2);
 std::uint32_t signalLamps(scenario::SignalState axis0, scenario::SignalState axis1,
                           double heading0);

@@ -109,9 +109,12 @@ void main() {
     bool along0 = abs(dot(n.xy, vec2(cos(h0), sin(h0)))) > 0.7;
     uint lit = along0 ? (i_ids.x & 3u) : ((i_ids.x >> 2) & 3u);
     uint arrow = along0 ? ((i_ids.x >> 4) & 1u) : ((i_ids.x >> 5) & 1u);
+    // The cross street's protected left arrow lets this street's right turns go.
+    uint right = along0 ? ((i_ids.x >> 5) & 1u) : ((i_ids.x >> 4) & 1u);
     v_frame = vec4(i_row0.w, i_row1.w, i_row2.w, wall ? -2.0 : 0.0);
-    // x: the lit lamp, plus 4 with the arrow; zw: the face's horizontal, to the viewer's right.
-    v_layout = vec4(float(lit + 4u * arrow), i_row2.z, -n.y, n.x);
+    // x: the lit lamp, plus 4 with the left arrow, plus 8 with the right arrow; zw: the face's
+    // horizontal, to the viewer's right.
+    v_layout = vec4(float(lit + 4u * arrow + 8u * right), i_row2.z, -n.y, n.x);
   } else if (roof) {
     // The roof: membrane, a parapet cap in the wall colour, a rooftop unit and a water tank.
     v_layout = vec4(vec2(i_row0.x, i_row1.x) / max(i_normal1.w, 1e-6), i_normal1.w, i_normal2.w);
@@ -253,8 +256,10 @@ void main() {
       float lit = mod(v_layout.x, 4.0);
       bool on = abs(band - lit) < 0.5;
       if (v_layout.x > 3.5 && band > 1.5) {
-        // The protected left arrow in the green lamp's place: a shaft and a head pointing left.
+        // A protected arrow in the green lamp's place: a shaft and a head pointing left (this
+        // street's left arrow) or right (the cross street's arrow, when right turns go).
         vec2 p = vec2(dot(w.xy - v_frame.xy, v_layout.zw), below - 1.0) / 0.2;
+        if (v_layout.x > 7.5) p.x = -p.x;
         on = (p.x > -0.2 && p.x < 0.8 && abs(p.y) < 0.18) ||
              (p.x > -0.8 && p.x <= -0.2 && abs(p.y) < p.x + 0.8);
       }

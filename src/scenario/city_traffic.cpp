@@ -1226,6 +1226,14 @@ SignalPlan shiftedSignalPlan(const SignalPlan& plan, double offset) {
   return out;
 }
 
+namespace {
+
+std::uint64_t episodeSeed(const World& world, int index) {
+  return deriveSeed(world.params().seed, 0x43415252554EULL + static_cast<std::uint64_t>(index));
+}
+
+}  // namespace
+
 std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
                                                                const IdmParams& idm) {
   static EpisodeCache cache;
@@ -1248,8 +1256,7 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
   }
   // Each episode is simulated once, outside the cache's lock (others are simulated meanwhile).
   std::call_once(slot->once, [&] {
-    const std::uint64_t seed =
-        deriveSeed(world.params().seed, 0x43415252554EULL + static_cast<std::uint64_t>(index));
+    const std::uint64_t seed = episodeSeed(world, index);
     TrafficEpisode e = runCars(world, seed, kTrafficEpisodeLength, idm);
     e.pedestrians = runPedestrians(world, e.plan, seed, kTrafficEpisodeLength);
     e.index = index;
@@ -1263,22 +1270,35 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
   return slot->value;
 }
 
-CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
-                                const IdmParams& idm, bool first_pose_only) {
+CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double duration,
+                                const IdmParams& idm) {
   if (world.params().type != WorldType::kCity) {
     throw GenerationError("city traffic needs a city world");
   }
   if (!(duration > 0)) throw GenerationError("city traffic needs a positive duration");
   const CityParams& cp = world.params().city;
-  Rng rng(deriveSeed(seed, 0x5045444553ULL));
-  CityTraffic out;
+  CityTrafficDraw d;
   if (duration <= 0.5 * kTrafficEpisodeLength) {
-    // A window of one of the world's episodes, starting at a time drawn for this scenario; the
-    // signal offsets move with it.
-    const int k = static_cast<int>(rng.uniformInt(0, static_cast<long>(cp.traffic_episodes) - 1));
-    out.episode = cityTrafficEpisode(world, k, idm);
-    out.offset = roundMilli(
-        idm.step * std::floor(rng.uniform(0.0, kTrafficEpisodeLength - duration) / idm.step));
+    // A window of one of the world's episodes, starting at a time drawn for this scenario (in
+    // the first half of the episode, whatever the duration); the signal offsets move with it.
+    Rng rng(deriveSeed(seed, 0x5045444553ULL));
+    d.episode = static_cast<int>(rng.uniformInt(0, static_cast<long>(cp.traffic_episodes) - 1));
+    d.offset =
+        roundMilli(idm.step * std::floor(rng.uniform(0.0, 0.5 * kTrafficEpisodeLength) / idm.step));
+    d.plan = shiftedSignalPlan(citySignalPlan(world, episodeSeed(world, d.episode)), d.offset);
+  } else {
+    d.plan = citySignalPlan(world, seed);
+  }
+  return d;
+}
+
+CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
+                                const IdmParams& idm, bool first_pose_only) {
+  const CityTrafficDraw draw = drawCityTraffic(world, seed, duration, idm);
+  CityTraffic out;
+  if (draw.episode >= 0) {
+    out.episode = cityTrafficEpisode(world, draw.episode, idm);
+    out.offset = draw.offset;
     out.plan = shiftedSignalPlan(out.episode->episode.plan, out.offset);
     out.cars.reserve(out.episode->trajectories.size());
     for (const auto& tr : out.episode->trajectories) {

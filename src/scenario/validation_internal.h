@@ -189,6 +189,10 @@ class Semantics {
   // sim_config.json's "traffic": its car ids, and the episode file it names (present, its
   // SHA-256, the window within the episode, the signal plan shifted with the offset).
   void trafficReference(IdSet& ids);
+  // In a city with a signal plan: every car of the mission (any role but "traffic") enters the
+  // signalised intersections only when its signal lets it (rule "signal";
+  // scenario/signal_compliance.h).
+  void signalCompliance(const json& ents);
 
   // Samples [t, x, y, z, yaw] of a timed path at `pointer`: t >= 0 and strictly increasing
   // (malformed samples are the schema's to report).

@@ -1,4 +1,7 @@
 // Semantic checks of sim_config.json, world.json and manifest.json.
+#include <map>
+
+#include "hameritt/scenario/signal_compliance.h"
 #include "hameritt/scenario/sim_config_io.h"
 #include "validation_internal.h"
 
@@ -18,6 +21,7 @@ void Semantics::simConfig() {
     trajectoryOrder(arrayOrEmpty(ents[i], "trajectory"), p + "/trajectory");
   }
   if (exists("/traffic")) trafficReference(ids);
+  if (exists("/signals")) signalCompliance(ents);
   const bool avoid = stringAt(doc_, "class") == std::optional<std::string>("avoid");
   if (!ents.empty() && !has_target && !avoid) {
     add("/entities", "role_target", "no entity has role 'target'");
@@ -69,6 +73,31 @@ void Semantics::trafficReference(IdSet& ids) {
     const std::string m = e.what();
     if (m.find(": traffic") != std::string::npos || m.find(": signals") != std::string::npos) {
       add("/traffic", "traffic_episode", m);
+    }
+  }
+}
+
+void Semantics::signalCompliance(const json& ents) {
+  SimConfig sc;
+  try {
+    sc = simConfigFromJson(doc_, file_);
+  } catch (const ConfigError&) {
+    return;  // reported by the schema, the reader's other checks or trafficReference()
+  }
+  if (!sc.signals) return;
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < ents.size(); ++i) {
+    if (const auto id = stringAt(ents[i], "id")) index.emplace(*id, i);
+  }
+  for (const auto& se : sc.entities) {
+    if (se.entity.cls != EntityClass::kCar || se.role == "traffic" || se.trajectory.size() < 2)
+      continue;
+    const auto it = index.find(se.entity.id);
+    if (it == index.end()) continue;
+    for (const SignalEntry& e : signalEntries(se.trajectory, se.entity.box.size.x(), *sc.signals)) {
+      if (e.allowed) continue;
+      add(jsonPointerAppend("/entities", it->second) + "/trajectory", "signal",
+          se.entity.id + " (" + se.role + ") " + describeEntry(e, *sc.signals));
     }
   }
 }

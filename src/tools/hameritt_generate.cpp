@@ -224,7 +224,10 @@ int main(int argc, char** argv) {
       };
     }
     if (!into.empty()) req.write_world = false;
-    req.share_traffic = into.empty();  // a single scenario stays self-contained
+    // A city scenario's traffic is a reference to an episode file; a single scenario's file lies
+    // in its own directory, so that the directory stands alone.
+    req.share_traffic = true;
+    req.traffic_inside = !into.empty();
     std::vector<hameritt::scenario::ManifestEntry> entries;
     try {
       entries = generateBatch(world, gc, req);
@@ -242,7 +245,15 @@ int main(int argc, char** argv) {
         fs::remove_all(out, ec);
         throw OutputError(into + ": cannot create directory");
       }
-      for (const char* f : {"sim_config.json", "mission.json"}) {
+      // The episode file first: sim_config.json never names a file that is not there.
+      std::vector<std::string> files;
+      for (const auto& entry : fs::directory_iterator(from, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name.rfind("traffic_episode_", 0) == 0) files.push_back(name);
+      }
+      files.push_back("sim_config.json");
+      files.push_back("mission.json");
+      for (const std::string& f : files) {
         fs::rename(from + "/" + f, into + "/" + f, ec);
         if (ec) {
           const std::string why = ec.message();

@@ -376,10 +376,10 @@ struct MastCloseUp {
     id = renderer->instanceOf(mast.id);
     top = mast.box.maxZ();
   }
-  // The first time (on a 0.5 s grid) at which axis 0 shows `state`, or -1.
-  double firstTime(scenario::SignalState state) const {
+  // The first time (on a 0.5 s grid) at which `axis` shows `state`, or -1.
+  double firstTime(scenario::SignalState state, int axis = 0) const {
     for (double t = 0.25; t < plan.cycle(); t += 0.5) {
-      if (plan.state(is, 0, t) == state) return t;
+      if (plan.state(is, axis, t) == state) return t;
     }
     return -1.0;
   }
@@ -478,6 +478,48 @@ TEST(CityRender, ProtectedLeftArrowShowsAGreenArrowBesideTheRedLamp) {
   EXPECT_GT(arrow.left, 1.3 * arrow.right);
   EXPECT_LT(green.left, 1.3 * green.right);  // the same criterion fails the round lamp
   EXPECT_GT(arrow.right, 0.05);              // the shaft
+}
+
+TEST(CityRender, CrossStreetArrowShowsAGreenRightArrowBesideTheRedLamp) {
+  MastCloseUp m;
+  // While axis 1 shows its protected left arrow, axis 0 is red and its right turns go.
+  const double t_cross = m.firstTime(scenario::SignalState::kLeftArrow, 1);
+  const double t_left = m.firstTime(scenario::SignalState::kLeftArrow);
+  const double t_red = m.firstTime(scenario::SignalState::kRed);
+  ASSERT_GE(t_cross, 0.0);
+  ASSERT_GE(t_left, 0.0);
+  ASSERT_GE(t_red, 0.0);
+  ASSERT_EQ(m.plan.state(m.is, 0, t_cross), scenario::SignalState::kRed);
+  auto lamps = [&](double t) {
+    const FrameSet f = m.frameAt(t);
+    return std::array<double, 3>{meanColour(f, m.r, m.id, m.top - 0.35, m.top - 0.05).x(),
+                                 greenShare(f, m.r, m.id, m.top - 1.15, m.top - 0.85, -1),
+                                 greenShare(f, m.r, m.id, m.top - 1.15, m.top - 0.85, 1)};
+  };
+  // A red time while neither axis shows an arrow: the negative control (no arrow).
+  double t_plain = -1.0;
+  for (double t = 0.25; t < m.plan.cycle() && t_plain < 0; t += 0.5) {
+    if (m.plan.state(m.is, 0, t) == scenario::SignalState::kRed &&
+        m.plan.state(m.is, 1, t) != scenario::SignalState::kLeftArrow)
+      t_plain = t;
+  }
+  ASSERT_GE(t_plain, 0.0);
+  const auto cross = lamps(t_cross), left = lamps(t_left), plain = lamps(t_plain);
+  std::printf(
+      "red lamp R: cross arrow %.0f, plain red %.0f; green share of the green lamp's left and "
+      "right halves: cross arrow %.2f %.2f, own left arrow %.2f %.2f, plain red %.2f %.2f\n",
+      cross[0], plain[0], cross[1], cross[2], left[1], left[2], plain[1], plain[2]);
+  // The red lamp is lit, as on plain red.
+  EXPECT_GT(cross[0], 0.5 * plain[0]);
+  // Green light in the green lamp's place, none on plain red (the negative control).
+  EXPECT_GT(cross[2], 0.15);
+  EXPECT_LT(plain[1] + plain[2], 0.02);
+  // An arrow pointing right: its head makes more of the right half green than of the left; the
+  // own left arrow (the negative control) the other way round.
+  EXPECT_LT(cross[2], 0.6);
+  EXPECT_GT(cross[2], 1.3 * cross[1]);
+  EXPECT_GT(cross[1], 0.05);  // the shaft
+  EXPECT_GT(left[1], 1.3 * left[2]);
 }
 
 }  // namespace

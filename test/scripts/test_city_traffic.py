@@ -13,7 +13,9 @@ hameritt_generate --world city writes (numpy; nothing of hameritt's own readers)
     queue at the bus stops of the written world.json;
   * >= 100 moving cars and >= 300 pedestrians per km^2 inside the tile at every sample;
   * a cycle set in world.json is the one written; a signal key out of its range exits 2 naming
-    the key and the range, with nothing written.
+    the key and the range, with nothing written;
+  * the mission's own moving cars (the route search's targets) enter the boxes only on their
+    signal, as the traffic does.
 Each check runs first on a doctored copy (a car made late, the plan shifted by half a cycle, a
 doubled probability, a follower moved closer) and must flag it: the negative controls.
 Prints one line per failure and a "N passed, N failed" summary; exits 1 on any failure.
@@ -126,6 +128,8 @@ def red_entries(cars, plan, times, states, judge_turns=True):
             cross = phase(plan, inter, 1 - axis, times[k + 1])
             for i, kk, s, c in zip(car_i, k + 1, st, cross):
                 out = np.nonzero(~anywhere[i, kk:])[0]
+                if not len(out) and cars[i]["trajectory"][-1][0] >= times[-1] - 1e-6:
+                    continue  # still moving in the box when the span ends: the turn is unknown
                 end = kk + out[0] if len(out) else len(times) - 1
                 turned = yaws[i, end] - yaws[i, kk]
                 turning = judge_turns and abs(turned) > 0.25 * math.pi
@@ -343,6 +347,31 @@ def entities(sim, role):
     return res
 
 
+def judge_mission_cars(sim, name, controls):
+    """(cars, entries, entries against the signal) of the mission's own moving cars (every role
+    but traffic: the targets, a hostile vehicle), judged like the traffic over the time limit;
+    the control: the plan shifted by half a cycle flags some of their entries."""
+    cars = [{"id": e["id"], "size": e["size"], "trajectory": e["trajectory"]}
+            for e in sim["entities"]
+            if e["class"] == "car" and e["role"] != "traffic" and e.get("trajectory")]
+    if not cars:
+        return 0, 0, 0
+    plan = sim["signals"]
+    times = np.arange(0.0, sim["duration"] + 1e-9, DT)
+    states = car_states(cars, times)
+    entries, _, bad = red_entries(cars, plan, times, states)
+    check(bad == 0, name + ": the mission's cars enter only on their signal",
+          "%d entries, %d against the signal" % (entries, bad))
+    if controls and entries > 0:
+        cyc = 2 * (plan["left"] + plan["green"] + plan["yellow"] + plan["all_red"])
+        shifted = dict(plan)
+        shifted["intersections"] = [dict(i, offset=(i["offset"] + 0.5 * cyc) % cyc)
+                                    for i in plan["intersections"]]
+        e2, _, bad2 = red_entries(cars, shifted, times, states)
+        check(bad2 > 0, "control: shifted plan flags a mission car", "%d of %d" % (bad2, e2))
+    return len(cars), entries, bad
+
+
 def judge_scenario(sim, world, name, controls):
     plan = sim["signals"]
     dur = sim["duration"]
@@ -486,8 +515,12 @@ def main():
         crossers = jay = queuing = far = 0
         stops = [(e["pose"]["x"], e["pose"]["y"]) for e in world["entities"]
                  if e["class"] == "bus_stop"]
+        mission_cars = mission_entries = 0
         for i, sim in enumerate(sims):
             check(sim["world"]["params"].get("type") == "city", "scenario %d is a city scenario" % i)
+            n_own, e_own, _ = judge_mission_cars(sim, "scenario %d" % i, controls=True)
+            mission_cars += n_own
+            mission_entries += e_own
             figures = judge_scenario(sim, world, "scenario %d" % i, controls=(i == 0))
             print("scenario %d: %d cars, %d pedestrians, %d box entries (%d turning), %d follower samples "
                   "(smallest gap %.3f m, time gap %.3f s), %d crosswalk samples, %.1f moving "
@@ -502,6 +535,10 @@ def main():
                     check(not p["trajectory"], "a queuing pedestrian stands")
                     best = min(math.hypot(p["pose"]["x"] - x, p["pose"]["y"] - y) for x, y in stops)
                     far += best > 8.5
+        check(mission_cars > 0 and mission_entries > 0, "the route search's targets are judged",
+              "%d cars, %d entries" % (mission_cars, mission_entries))
+        print("mission cars %d, box entries %d, all on their signal" % (mission_cars,
+                                                                      mission_entries))
         share = jay / max(crossers, 1)
         sigma = math.sqrt(pj * (1 - pj) / max(crossers, 1))
         check(crossers > 100, "crossers", str(crossers))

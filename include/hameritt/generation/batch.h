@@ -25,6 +25,10 @@ struct BatchRequest {
   // City: write each traffic episode that a scenario uses once, as DIR/traffic_episode_NN.json,
   // and a reference to it in each sim_config.json (off: every scenario self-contained).
   bool share_traffic = false;
+  // With share_traffic: each scenario's episode file goes into its own directory
+  // (DIR/<id>/traffic_episode_NN.json) and its reference names it there, so that the directory
+  // stands alone (hameritt_generate --into).
+  bool traffic_inside = false;
   // Use `seed` itself as the scenario seed (count must be 1): regenerates a scenario from the
   // class and seed written in its files.
   bool exact_seed = false;

@@ -122,6 +122,18 @@ struct SharedTrafficEpisode {
 std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
                                                                const IdmParams& idm = {});
 
+// The draw of a city scenario's traffic: the episode it is a window of (-1: a scenario longer
+// than half an episode simulates its own cars), the window's start and the signal plan it sees.
+// A function of the world, the seed and whether the duration exceeds half an episode, so that
+// the generator knows the plan before it plans the mission's own vehicles.
+struct CityTrafficDraw {
+  int episode = -1;
+  double offset = 0.0;
+  SignalPlan plan;
+};
+CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double duration,
+                                const IdmParams& idm = {});
+
 struct CityTraffic {
   SignalPlan plan;
   std::vector<CityCar> cars;
