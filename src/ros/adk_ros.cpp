@@ -199,7 +199,12 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     if (sim_config_.uav.cameras.empty()) {
       throw ConfigError(sim_config_path + ": uav.cameras: a track mission needs a camera");
     }
+    // By default the camera that looks down: the one under a UAV that keeps a car in view from
+    // above and behind it (the baseline's pursuit standoff).
     std::string camera = sim_config_.uav.cameras.front().name;
+    for (const auto& c : sim_config_.uav.cameras) {
+      if (c.name == "down") camera = c.name;
+    }
     pnh.param<std::string>("track_camera", camera, camera);
     track_camera_ = sim_config_.uav.cameras.size();
     for (std::size_t i = 0; i < sim_config_.uav.cameras.size(); ++i) {

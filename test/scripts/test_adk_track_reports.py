@@ -149,7 +149,8 @@ def main():
     with open(os.path.join(scenario, "mission.json")) as f:
         mission = json.load(f)
     with open(os.path.join(scenario, "sim_config.json")) as f:
-        camera = json.load(f)["uav"]["payload"]["cameras"][0]["name"]
+        names = [c["name"] for c in json.load(f)["uav"]["payload"]["cameras"]]
+    camera = "down" if "down" in names else names[0]  # the ADK's default ~track_camera
     phase = mission["phases"][1]
     targets, duration = phase["targets"], phase["duration"]
     limit = phase["criteria"]["max_reacquire_s"]

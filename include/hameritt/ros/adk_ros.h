@@ -48,7 +48,8 @@ namespace hameritt::ros_wrappers {
 //   ~traffic_rate_hz (2, sim time; 0 = none: an avoid mission's aircraft as ADS-B-like reports
 //   on adk/traffic, hameritt/EntityStateArray, class and role "aircraft", at the odometry after
 //   each period),
-//   ~track_camera (the first camera's name: the camera whose frames score a track phase).
+//   ~track_camera (the camera whose frames score a track phase: "down" when the UAV has it, else
+//   the first camera).
 // Topics are relative to the node's namespace (/mission, /adk/... in the root namespace).
 class AdkRos {
  public:
