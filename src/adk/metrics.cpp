@@ -225,6 +225,84 @@ MissionMetrics MetricsAccumulator::finish(Outcome outcome, const std::string& re
   return m;
 }
 
+namespace {
+
+// The "track" block: the phase, its state and every tracking score.
+nlohmann::ordered_json trackJson(const TrackPhaseScore& t) {
+  using nlohmann::ordered_json;
+  ordered_json o;
+  o["phase"] = t.phase;
+  o["targets"] = t.targets;
+  o["state"] = toString(t.state);
+  o["success"] = t.success;
+  o["failure"] = t.failure;
+  o["start_time"] = t.start_time ? ordered_json(*t.start_time) : ordered_json(nullptr);
+  o["duration"] = t.duration;
+  o["elapsed"] = t.elapsed;
+  o["frames"] = t.frames;
+  o["reports"] = t.reports;
+  o["tracked_fraction"] = t.tracked_fraction;
+  ordered_json errors;
+  errors["unknown_id"] = t.errors.unknown_id;
+  errors["bad_box"] = t.errors.bad_box;
+  errors["duplicate_id"] = t.errors.duplicate_id;
+  errors["out_of_order"] = t.errors.out_of_order;
+  errors["unmatched_stamp"] = t.errors.unmatched_stamp;
+  errors["total"] = t.errors.total();
+  o["report_errors"] = errors;
+  ordered_json targets = ordered_json::array();
+  for (const auto& s : t.tracking.targets) {
+    ordered_json g;
+    g["id"] = s.id;
+    g["frames"] = s.frames;
+    g["in_view_frames"] = s.in_view_frames;
+    g["tracked_frames"] = s.tracked_frames;
+    g["tracked_fraction"] = s.tracked_fraction;
+    ordered_json levels;
+    for (std::size_t l = 0; l < kOcclusionLevels; ++l) {
+      const auto& lv = s.by_occlusion[l];
+      levels[occlusionLevelName(static_cast<OcclusionLevel>(l))] = {
+          {"frames", lv.frames},
+          {"tracked_fraction", lv.tracked_fraction},
+          {"held_fraction", lv.held_fraction}};
+    }
+    g["by_occlusion"] = levels;
+    g["scored_frames"] = s.scored_frames;
+    g["precision"] = s.precision;
+    g["success"] = s.success;
+    g["breaks"] = s.breaks;
+    g["reacquired"] = s.reacquired;
+    g["reacquire_median"] = s.reacquire_median_s;
+    g["reacquire_max"] = s.reacquire_max_s;
+    g["open_break"] = s.open_break_s;
+    g["id_switches"] = s.id_switches;
+    targets.push_back(g);
+  }
+  o["per_target"] = targets;
+  // The multi-object scores, meaningful with several targets (computed for one too).
+  const auto& c = t.tracking.clear;
+  o["clear_mot"] = {{"mota", c.mota},
+                    {"motp", c.motp},
+                    {"tp", c.tp},
+                    {"fn", c.fn},
+                    {"fp", c.fp},
+                    {"id_switches", c.id_switches},
+                    {"mostly_tracked", c.mostly_tracked},
+                    {"partly_tracked", c.partly_tracked},
+                    {"mostly_lost", c.mostly_lost},
+                    {"fragmentations", c.fragmentations}};
+  const auto& id = t.tracking.identity;
+  o["identity"] = {{"idf1", id.idf1}, {"idr", id.idr},   {"idp", id.idp},
+                   {"idtp", id.idtp}, {"idfn", id.idfn}, {"idfp", id.idfp}};
+  const auto& h = t.tracking.hota;
+  o["hota"] = {{"hota", h.mean_hota},     {"det_a", h.mean_det_a},   {"ass_a", h.mean_ass_a},
+               {"det_re", h.mean_det_re}, {"det_pr", h.mean_det_pr}, {"ass_re", h.mean_ass_re},
+               {"ass_pr", h.mean_ass_pr}, {"loc_a", h.mean_loc_a}};
+  return o;
+}
+
+}  // namespace
+
 std::string metricsJson(const MissionMetrics& m) {
   using nlohmann::ordered_json;
   auto opt = [](const std::optional<double>& v) -> ordered_json {
@@ -363,6 +441,7 @@ std::string metricsJson(const MissionMetrics& m) {
     o["collision"] = f.collision;
     j["follow"] = o;
   }
+  if (m.track) j["track"] = trackJson(*m.track);
   return j.dump(2) + "\n";
 }
 

@@ -617,3 +617,70 @@ TrackingScore scoreTracking(const std::vector<TrackingFrame>& frames,
 }
 
 }  // namespace hameritt::adk
+
+namespace hameritt::adk {
+
+TrackingRecorder::TrackingRecorder(std::vector<std::string> target_ids, TrackingSettings settings)
+    : target_ids_(std::move(target_ids)), settings_(settings) {
+  settings_.validate();
+}
+
+void TrackingRecorder::addFrame(double t, std::vector<TargetTruth> targets) {
+  if (!std::isfinite(t)) throw InputError("tracking frame: t is not finite");
+  if (!frames_.empty() && !(t > frames_.back().t)) {
+    frames_.clear();
+    have_report_ = false;
+  }
+  TrackingFrame f;
+  f.t = t;
+  f.targets = std::move(targets);
+  frames_.push_back(std::move(f));
+}
+
+void TrackingRecorder::addReport(double stamp, const std::vector<ReportedTrack>& tracks) {
+  ++reports_;
+  if (!std::isfinite(stamp) || (have_report_ && !(stamp > last_report_))) {
+    ++errors_.out_of_order;
+    return;
+  }
+  have_report_ = true;
+  last_report_ = stamp;
+  // Frames arrive in time order: search from the newest.
+  TrackingFrame* frame = nullptr;
+  for (auto it = frames_.rbegin(); it != frames_.rend(); ++it) {
+    if (std::fabs(it->t - stamp) <= 1e-3) {
+      frame = &*it;
+      break;
+    }
+    if (it->t < stamp - 1e-3) break;
+  }
+  if (!frame) {
+    ++errors_.unmatched_stamp;
+    return;
+  }
+  frame->tracks.clear();
+  std::set<std::string> seen;
+  for (const auto& r : tracks) {
+    if (std::find(target_ids_.begin(), target_ids_.end(), r.id) == target_ids_.end()) {
+      ++errors_.unknown_id;
+      continue;
+    }
+    const PixelBox& b = r.box;
+    if (!std::isfinite(b.x) || !std::isfinite(b.y) || !std::isfinite(b.w) || !std::isfinite(b.h) ||
+        b.w < 0.0 || b.h < 0.0) {
+      ++errors_.bad_box;
+      continue;
+    }
+    if (!seen.insert(r.id).second) {
+      ++errors_.duplicate_id;
+      continue;
+    }
+    frame->tracks.push_back(r);
+  }
+}
+
+TrackingScore TrackingRecorder::score() const {
+  return scoreTracking(frames_, target_ids_, settings_);
+}
+
+}  // namespace hameritt::adk

@@ -140,7 +140,8 @@ ContextVerdict ContextFilter::check(const CandidatePose& c, double t,
   // moving target's later position.
   bool static_target = mission_.cls == scenario::ScenarioClass::kAreaSearch;
   if (mission_.cls == scenario::ScenarioClass::kPursuit ||
-      mission_.cls == scenario::ScenarioClass::kFollow) {
+      mission_.cls == scenario::ScenarioClass::kFollow ||
+      mission_.cls == scenario::ScenarioClass::kTrack) {
     for (const auto& a : mission_.aois) static_target |= a.id == v.region_id;
   }
   // The mission's targets with this description: the candidate may be any of them.

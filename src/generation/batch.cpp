@@ -35,7 +35,7 @@ std::vector<ScenarioClass> parseClassList(const std::string& s) {
     ScenarioClass c;
     if (!parseScenarioClass(name, &c)) {
       throw ConfigError(
-          "--class: expected area_search, route_search, pursuit, avoid, follow, all or a "
+          "--class: expected area_search, route_search, pursuit, avoid, follow, track, all or a "
           "comma-separated list of them, got '" +
           name + "'");
     }

@@ -126,6 +126,9 @@ class ScenarioBuilder {
       case ScenarioClass::kFollow:
         buildFollow();
         break;
+      case ScenarioClass::kTrack:
+        buildTrack();
+        break;
     }
     if (plan_ && !plan_->kozs.empty()) addSpecKozs();
     if (cls_ != ScenarioClass::kAvoid) placeUavStart();
@@ -1239,42 +1242,42 @@ class ScenarioBuilder {
     }
   }
 
-  void buildPursuit() {
-    Mission& m = sc_.mission;
-    m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_pursuit));
-    const catalog::CarModel* model;
-    std::string color;
-    drawTargetLook(&model, &color);
-    // The target waits at the kerb, the pedestrians run at it, and it drives off: it pulls out
-    // into its lane ahead of the slot, then follows a planned route (planVehicleRoute) to a
-    // node 6-12 street edges away.
-    const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
+  // A car parked at a kerb slot that drives off at `depart`: it waits, pulls out into its lane
+  // ahead of the slot, then follows a planned route (planVehicleRoute) to a node 6-12 street
+  // edges away. Takes the slot (*slot); with use_spec, a spec's placements choose the slot and
+  // *model. *route (optional) receives the route's nodes and what planned it.
+  struct DriveOffRoute {
+    std::vector<int> nodes;  // street nodes passed, the goal node last
+    std::uint64_t seed = 0;
+    planning::SpeedProfile speed;
+  };
+  Trajectory driveOff(double depart, bool use_spec, const catalog::CarModel** model, int* slot,
+                      DriveOffRoute* route_out = nullptr) {
     const planning::RouteSettings rs = routeSettings();
     const planning::SpeedProfile speed = speedProfile(rangeDraw(rng_, cfg_.car_speed));
     constexpr double kPullOutTime = 6.0;  // seconds, from rest to rest
-    int slot = -1;
     Trajectory traj;
     std::vector<int> tried;  // slots without a route, skipped on later attempts
     std::vector<std::size_t> order;
     int attempts = 20;
-    if (plan_ && plan_->placements) {
+    if (use_spec && plan_ && plan_->placements) {
       for (std::size_t i = 0; i < plan_->placements->size(); ++i) order.push_back(i);
       rng_.shuffle(order);
       attempts = static_cast<int>(std::min<std::size_t>(order.size(), 60));
     }
     for (int attempt = 0; attempt < attempts && traj.empty(); ++attempt) {
-      if (plan_ && plan_->placements) {
+      if (use_spec && plan_ && plan_->placements) {
         // Constructive: the next of the spec's feasible placements, in a seeded order.
         if (attempt >= static_cast<int>(order.size())) break;
         const auto& pl = (*plan_->placements)[order[static_cast<std::size_t>(attempt)]];
-        slot = pl.first;
-        model = &catalog::carModels()[static_cast<std::size_t>(pl.second)];
+        *slot = pl.first;
+        *model = &catalog::carModels()[static_cast<std::size_t>(pl.second)];
       } else {
-        slot = pickSlot([&](const ParkingSlot& s) { return pursuitSlotFits(world_, s); }, true);
+        *slot = pickSlot([&](const ParkingSlot& s) { return pursuitSlotFits(world_, s); }, true);
       }
-      if (slot < 0) break;
-      slot_taken_[static_cast<std::size_t>(slot)] = 1;
-      const ParkingSlot& s = world_.slots()[static_cast<std::size_t>(slot)];
+      if (*slot < 0) break;
+      slot_taken_[static_cast<std::size_t>(*slot)] = 1;
+      const ParkingSlot& s = world_.slots()[static_cast<std::size_t>(*slot)];
       const auto& e = world_.edges()[static_cast<std::size_t>(s.edge)];
       const Vec2 pa = world_.nodes()[e.a].position, pb = world_.nodes()[e.b].position;
       const Vec2 fwd(std::cos(s.yaw), std::sin(s.yaw));
@@ -1305,7 +1308,7 @@ class ScenarioBuilder {
       const int goal = nodeAtHops(second, first, static_cast<int>(rng_.uniformInt(6, 12)) - 1);
       const std::uint64_t route_seed = rng_.next();
       if (goal < 0) {
-        tried.push_back(slot);
+        tried.push_back(*slot);
         continue;
       }
       planning::RouteGoal g;
@@ -1313,16 +1316,32 @@ class ScenarioBuilder {
       const planning::RouteResult route =
           planning::planVehicleRoute(world_, prefix.back(), g, route_seed, speed, rs);
       if (!route.ok() || route.trajectory.size() < 2) {
-        tried.push_back(slot);
+        tried.push_back(*slot);
         continue;
       }
       traj = prefix;
       traj.insert(traj.end(), route.trajectory.begin() + 1, route.trajectory.end());
+      if (route_out) *route_out = DriveOffRoute{route.nodes, route_seed, speed};
     }
     for (int t : tried) slot_taken_[static_cast<std::size_t>(t)] = 0;
     if (traj.empty()) {
       throw GenerationError("no free kerb slot with a route for the pursuit target");
     }
+    return traj;
+  }
+
+  void buildPursuit() {
+    Mission& m = sc_.mission;
+    m.time_limit = std::round(rangeDraw(rng_, cfg_.time_limit_pursuit));
+    const catalog::CarModel* model;
+    std::string color;
+    drawTargetLook(&model, &color);
+    // The target waits at the kerb, the pedestrians run at it, and it drives off: it pulls out
+    // into its lane ahead of the slot, then follows a planned route (planVehicleRoute) to a
+    // node 6-12 street edges away.
+    const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
+    int slot = -1;
+    const Trajectory traj = driveOff(depart, true, &model, &slot, &pursuit_route_);
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
     slot_taken_[static_cast<std::size_t>(slot)] = 1;
     const Vec2 fwd(std::cos(sl.yaw), std::sin(sl.yaw));
@@ -1457,6 +1476,93 @@ class ScenarioBuilder {
                   duration, f.distance, f.distance_tolerance, f.height, f.height_tolerance);
     m.objective.text =
         "Find the " + lookText(m.objective.targets.front()) + " that pedestrians chase." + text;
+  }
+
+  // ------------------------------------------------------------------ track
+  // The track class: pursuit's scene with one or two moving targets (the second, drawn from
+  // track_targets_min/max, waits in the lane 12 m behind the first one's kerb slot and drives
+  // the same streets 2.5 s after it, as route search's convoy: when no such route exists the
+  // scenario keeps one target), in two phases: find them, then keep them in a camera's view for
+  // a drawn duration. Look-alike parked cars (addConfusers) stand along the streets, and the
+  // routes pass the street trees and buildings that occlude the targets. The time limit is
+  // pursuit's plus the duration.
+  void buildTrack() {
+    buildPursuit();
+    Mission& m = sc_.mission;
+    const int n_targets =
+        static_cast<int>(rng_.uniformInt(cfg_.track_targets_min, cfg_.track_targets_max));
+    if (n_targets == 2) addConvoyTarget();
+    std::vector<std::string> ids;
+    for (const auto& t : m.objective.targets) ids.push_back(t.id);
+    MissionPhase search;
+    search.id = "search_1";
+    search.type = PhaseType::kSearch;
+    search.targets = ids;
+    MissionPhase track;
+    track.id = "track_1";
+    track.type = PhaseType::kTrack;
+    track.targets = ids;
+    TrackPhaseSpec& c = track.track;
+    c.min_visible_fraction = cfg_.track_min_visible_fraction;
+    c.min_box_area = cfg_.track_min_box_area;
+    c.min_tracked_fraction = cfg_.track_min_tracked_fraction;
+    c.max_reacquire_s = cfg_.track_max_reacquire_s;
+    const double duration = std::round(rangeDraw(rng_, cfg_.track_duration));
+    track.duration = duration;
+    m.phases = {search, track};
+    m.time_limit += duration;
+    const bool two = m.objective.targets.size() == 2;
+    char text[256];
+    std::snprintf(text, sizeof(text),
+                  " Then keep %s in a camera's view for %.0f s (tracked: at least %.0f %% of it "
+                  "visible and a box of at least %.0f px; tracked %.0f %% of the time, every loss "
+                  "reacquired within %.0f s).",
+                  two ? "both" : "it", duration, 100.0 * c.min_visible_fraction, c.min_box_area,
+                  100.0 * c.min_tracked_fraction, c.max_reacquire_s);
+    m.objective.text =
+        "Find the " + lookText(m.objective.targets.front()) + " that pedestrians chase" +
+        (two ? " and the " + lookText(m.objective.targets[1]) + " behind it" : std::string()) +
+        "." + text;
+  }
+
+  // The track class's second target: a car of its own look that waits in the lane 12 m behind
+  // the first target's kerb slot, departs 2.5 s after the first target has pulled out into the
+  // lane and stops 12 m short of the first target's stop, on the same streets (checked: else
+  // none).
+  void addConvoyTarget() {
+    Mission& m = sc_.mission;
+    const catalog::CarModel* model;
+    std::string color;
+    drawTargetLook(&model, &color);
+    const ScenarioEntity* lead = nullptr;
+    for (const auto& se : sc_.sim.entities) {
+      if (se.role == "target") lead = &se;
+    }
+    if (!lead || lead->trajectory.size() < 13 || pursuit_route_.nodes.empty()) return;
+    // The end of the pull-out (kSteps = 10), kPullOut ahead of the kerb slot: the second car
+    // waits 12 m behind the slot, in the lane.
+    const TrajectoryPoint& p = lead->trajectory[11];
+    const double back = kPullOut + 12.0;
+    TrajectoryPoint start = p;
+    start.x = roundMilli(p.x - back * std::cos(p.yaw));
+    start.y = roundMilli(p.y - back * std::sin(p.yaw));
+    start.t = roundMilli(p.t + 2.5);
+    const TrajectoryPoint& le = lead->trajectory.back();
+    planning::RouteGoal g;
+    g.pose = TrajectoryPoint{0.0, roundMilli(le.x - 12.0 * std::cos(le.yaw)),
+                             roundMilli(le.y - 12.0 * std::sin(le.yaw)), 0.0, le.yaw};
+    const planning::RouteResult follow = planning::planVehicleRoute(
+        world_, start, g, pursuit_route_.seed, pursuit_route_.speed, routeSettings());
+    std::vector<int> fnodes = follow.nodes;
+    fnodes.push_back(pursuit_route_.nodes.back());
+    if (!follow.ok() || follow.trajectory.size() < 2 || fnodes != pursuit_route_.nodes) return;
+    Trajectory traj = follow.trajectory;
+    TrajectoryPoint wait = start;
+    wait.t = 0.0;
+    traj.insert(traj.begin(), wait);  // waits in its lane until it departs
+    Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
+    m.objective.targets.push_back(describe(target));
+    add(target, "target", traj);
   }
 
   // ------------------------------------------------------------------ avoid
@@ -2027,6 +2133,7 @@ class ScenarioBuilder {
   Scenario sc_;
   UavSpec uav_;
   std::vector<char> slot_taken_;
+  DriveOffRoute pursuit_route_;  // the pursuit target's route (track: the convoy follows it)
   std::vector<int> car_ids_, ped_ids_;
   std::vector<Group> extra_groups_;
   const ScenarioPlan* plan_;

@@ -541,10 +541,10 @@ class Parser {
     const Token c =
         expectIdent("a mission class after 'scenario' (area_search, route_search, pursuit)");
     scenario::ScenarioClass cls;
-    // Specs describe the three search classes; avoid and follow are classes without spec
-    // statements.
+    // Specs describe the three search classes; avoid, follow and track are classes without
+    // spec statements.
     if (!scenario::parseScenarioClass(c.text, &cls) || cls == scenario::ScenarioClass::kAvoid ||
-        cls == scenario::ScenarioClass::kFollow) {
+        cls == scenario::ScenarioClass::kFollow || cls == scenario::ScenarioClass::kTrack) {
       const std::vector<std::string> all = {"area_search", "route_search", "pursuit"};
       error("unknown mission class '" + c.text + "'" + nearestHint(c.text, all) +
                 "; classes: " + joinList(all),

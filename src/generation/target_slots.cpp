@@ -92,6 +92,7 @@ bool targetSlotAllowed(const World& world, int slot, ScenarioClass cls) {
       return insideBy20(world, s.position);
     case ScenarioClass::kPursuit:
     case ScenarioClass::kFollow:
+    case ScenarioClass::kTrack:
       return !s.driveway && pursuitSlotFits(world, s);
     case ScenarioClass::kRouteSearch:
       return false;

@@ -159,6 +159,14 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
                           phase.targets.front() + "' is not an entity of " + sim_config_path);
       }
       follow_target_ = &sim_config_.entities[it->second];
+    } else if (phase.type == scenario::PhaseType::kTrack && !track_) {
+      track_ = std::make_unique<adk::TrackScorer>(phase);
+      for (const auto& id : phase.targets) {
+        if (scenario_index_.count(id) == 0) {
+          throw ConfigError(mission_path + ": phase '" + phase.id + "': target '" + id +
+                            "' is not an entity of " + sim_config_path);
+        }
+      }
     } else if (phase.type == scenario::PhaseType::kSearch && !search_phase_) {
       search_phase_ = &phase;
     }
@@ -187,6 +195,27 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     traffic_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "adk/traffic", 10);
   }
   if (follow_) follow_pub_ = gate_->advertise<hameritt::FollowStatus>(nh, "adk/follow", 10, true);
+  if (track_) {
+    if (sim_config_.uav.cameras.empty()) {
+      throw ConfigError(sim_config_path + ": uav.cameras: a track mission needs a camera");
+    }
+    // By default the camera that looks down: the one under a UAV that keeps a car in view from
+    // above and behind it (the baseline's pursuit standoff).
+    std::string camera = sim_config_.uav.cameras.front().name;
+    for (const auto& c : sim_config_.uav.cameras) {
+      if (c.name == "down") camera = c.name;
+    }
+    pnh.param<std::string>("track_camera", camera, camera);
+    track_camera_ = sim_config_.uav.cameras.size();
+    for (std::size_t i = 0; i < sim_config_.uav.cameras.size(); ++i) {
+      if (sim_config_.uav.cameras[i].name == camera) track_camera_ = i;
+    }
+    if (track_camera_ == sim_config_.uav.cameras.size()) {
+      throw ConfigError("~track_camera: expected a camera of " + sim_config_path + ", got '" +
+                        camera + "'");
+    }
+    track_pub_ = gate_->advertise<hameritt::TrackStatus>(nh, "adk/track", 10, true);
+  }
   if (!mission_.phases.empty()) {
     phase_pub_ = gate_->advertise<hameritt::PhaseState>(nh, "adk/phase", 10, true);
   }
@@ -205,6 +234,7 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   truth_sub_ = gate_->subscribe(nh, "ground_truth/entities", 100, &AdkRos::onTruth, this);
   crash_sub_ = gate_->subscribe(nh, "uav/crash", 10, &AdkRos::onCrash, this);
   detection_sub_ = gate_->subscribe(nh, "perception/detections", 100, &AdkRos::onDetection, this);
+  if (track_) tracks_sub_ = gate_->subscribe(nh, "perception/tracks", 100, &AdkRos::onTracks, this);
   for (std::size_t i = 0; i < sim_config_.uav.cameras.size(); ++i) {
     const std::string topic = "uav/camera/" + sim_config_.uav.cameras[i].name + "/boxes";
     box_subs_.push_back(gate_->subscribe<hameritt::BoundingBoxArray>(
@@ -349,6 +379,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     publishConstraints(t);
     if (avoid_) publishAvoid(t, avoid_->score(monitor_->violationDuration()));
     if (follow_ && follow_->started()) publishFollow(t, followScore(false));
+    if (track_ && track_->started()) publishTrack(t, track_->score(false));
     next_status_t_ = t + status_period_;
   }
   judgeTrackAtLimit(t);
@@ -360,6 +391,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   checkObjective(t);
   checkAvoid(t);
   checkFollow(t);
+  checkTrack(t);
   endAtSimulationEnd(false);
 }
 
@@ -429,8 +461,9 @@ void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {
 }
 
 void AdkRos::judgeTrackAtLimit(double t) {
-  if (lifecycle_->state() != adk::MissionState::kRunning || !metrics_->isTrack() || follow_) {
-    return;  // a follow mission is judged by its phases (checkFollow)
+  if (lifecycle_->state() != adk::MissionState::kRunning || !metrics_->isTrack() || follow_ ||
+      track_) {
+    return;  // follow and track missions are judged by their phases (checkFollow, checkTrack)
   }
   const double limit = lifecycle_->timeLimit();
   if (t < limit || !metrics_->objectiveMet(limit)) return;  // else the time limit: timeout
@@ -442,6 +475,21 @@ void AdkRos::judgeTrackAtLimit(double t) {
 }
 
 void AdkRos::checkObjective(double t) {
+  if (track_) {
+    // The search phase ends at the find: the track phase starts.
+    if (lifecycle_->state() != adk::MissionState::kRunning || track_->started()) return;
+    const auto& targets = metrics_->targets();
+    if (!std::all_of(targets.begin(), targets.end(), [](const auto& tm) { return tm.found; })) {
+      return;
+    }
+    track_->start(t);
+    const std::string how = found_by_sighting_ ? "targets sighted" : "targets claimed";
+    if (search_phase_) publishPhase(t, *search_phase_, adk::PhaseState::kSucceeded, how);
+    publishPhase(t, track_->phase(), adk::PhaseState::kActive, how);
+    ROS_INFO("adk: %s at t = %.3f s: the track phase '%s' starts (%.0f s)", how.c_str(), t,
+             track_->phase().id.c_str(), *track_->phase().duration);
+    return;
+  }
   if (follow_) {
     // The search phase ends at the find: the follow phase starts.
     if (lifecycle_->state() != adk::MissionState::kRunning || follow_->started()) return;
@@ -615,8 +663,81 @@ void AdkRos::checkFollow(double t) {
   }
 }
 
+void AdkRos::publishTrack(double t, const adk::TrackPhaseScore& s) {
+  hameritt::TrackStatus m;
+  m.header.stamp = stampOf(t);
+  m.phase = s.phase;
+  m.targets = s.targets;
+  m.state = adk::toString(s.state);
+  m.start_time = s.start_time ? *s.start_time : std::nan("");
+  m.duration = s.duration;
+  m.elapsed = s.elapsed;
+  m.frames = static_cast<std::uint32_t>(s.frames);
+  m.reports = static_cast<std::uint32_t>(s.reports);
+  m.tracked_fraction = s.tracked_fraction;
+  m.current_break = s.current_break_s;
+  m.errors_unknown_id = static_cast<std::uint32_t>(s.errors.unknown_id);
+  m.errors_bad_box = static_cast<std::uint32_t>(s.errors.bad_box);
+  m.errors_duplicate_id = static_cast<std::uint32_t>(s.errors.duplicate_id);
+  m.errors_out_of_order = static_cast<std::uint32_t>(s.errors.out_of_order);
+  m.errors_unmatched_stamp = static_cast<std::uint32_t>(s.errors.unmatched_stamp);
+  m.failure = s.failure;
+  gate_->publish(track_pub_, m);
+}
+
+void AdkRos::checkTrack(double t) {
+  if (!track_ || !track_->started() || lifecycle_->state() != adk::MissionState::kRunning) {
+    return;
+  }
+  if (!track_->complete() && !track_->failedEarly()) return;
+  const adk::TrackPhaseScore s = track_->score(true);
+  publishPhase(t, track_->phase(), s.state, s.success ? "criteria met" : s.failure);
+  if (s.success ? lifecycle_->succeed(t, "the track phase '" + s.phase + "' succeeded")
+                : lifecycle_->fail(t, "the track phase '" + s.phase + "' failed: " + s.failure)) {
+    publishState();
+    finish();
+  }
+}
+
+void AdkRos::addTrackFrame(const hameritt::BoundingBoxArray& msg) {
+  std::vector<adk::TargetTruth> targets;
+  for (const auto& b : msg.boxes) {
+    const auto& ids = track_->phase().targets;
+    if (std::find(ids.begin(), ids.end(), b.entity_id) == ids.end() || b.total_pixels == 0) {
+      continue;
+    }
+    adk::TargetTruth g;
+    g.id = b.entity_id;
+    // The bounds of the visible pixels (the renderer's box; x_max, y_max inclusive).
+    g.box = adk::PixelBox{static_cast<double>(b.x_min), static_cast<double>(b.y_min),
+                          static_cast<double>(b.x_max - b.x_min + 1),
+                          static_cast<double>(b.y_max - b.y_min + 1)};
+    g.visible_fraction =
+        std::clamp(static_cast<double>(b.visible_pixels) / b.total_pixels, 0.0, 1.0);
+    g.occlusion = std::clamp(static_cast<double>(b.occlusion), 0.0, 1.0);
+    targets.push_back(g);
+  }
+  try {
+    track_->addFrame(msg.header.stamp.toSec(), targets);
+  } catch (const adk::InputError& e) {
+    HAMERITT_ERROR_THROTTLE(5.0, "adk: camera %s: %s; ignored", msg.camera.c_str(), e.what());
+  }
+}
+
+void AdkRos::onTracks(const hameritt::TrackReport::ConstPtr& msg) {
+  if (finished_ || !track_) return;
+  const auto& cam = sim_config_.uav.cameras[track_camera_];
+  std::vector<adk::ReportedTrack> tracks;
+  for (const auto& b : msg->tracks)
+    tracks.push_back({b.target_id, adk::PixelBox{b.x, b.y, b.w, b.h}});
+  // Reports of the other cameras are not scored (nor errors): the phase is one camera's.
+  if (msg->camera != cam.name) return;
+  track_->addReport(msg->header.stamp.toSec(), tracks);
+}
+
 void AdkRos::onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg) {
   if (finished_) return;
+  if (track_ && camera == track_camera_ && track_->started()) addTrackFrame(*msg);
   const auto& cam = sim_config_.uav.cameras[camera];
   const double stamp = msg->header.stamp.toSec();
   hameritt::PerceptionReport report;
@@ -738,13 +859,20 @@ void AdkRos::finish() {
     m.follow = followScore(true);
     publishFollow(lifecycle_->endTime(), *m.follow);
   }
+  if (track_) {
+    m.track = track_->score(true);
+    publishTrack(lifecycle_->endTime(), *m.track);
+  }
   // A phase still active when the mission ends has failed.
   for (const auto& phase : mission_.phases) {
     const auto it = phase_states_.find(phase.id);
     if (it != phase_states_.end() && it->second == adk::PhaseState::kActive) {
       const bool follow = follow_ && phase.id == follow_->phase().id;
+      const bool track = track_ && phase.id == track_->phase().id;
       publishPhase(lifecycle_->endTime(), phase, adk::PhaseState::kFailed,
-                   follow && !m.follow->failure.empty() ? m.follow->failure : reason);
+                   follow && !m.follow->failure.empty() ? m.follow->failure
+                   : track && !m.track->failure.empty() ? m.track->failure
+                                                        : reason);
     }
   }
   std::string file;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "hameritt/clients/public_config.h"
 #include "hameritt/ros/client_conversions.h"
@@ -80,6 +81,7 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   if (!(rate > 0 && rate <= 100)) throw scenario::ConfigError("~rate_hz: expected (0, 100]");
   double pursuit_rate = 10.0;
   pnh.param("pursue", pursue_, pursue_);
+  pnh.param("publish_tracks", publish_tracks_, publish_tracks_);
   pnh.param("pursuit_standoff", pursuit_.standoff, pursuit_.standoff);
   pnh.param("pursuit_height", pursuit_.height, pursuit_.height);
   pnh.param("pursuit_lead", pursuit_.lead, pursuit_.lead);
@@ -128,6 +130,9 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
     detection_pub_ = gate_->advertise<hameritt::Detection>(nh, "perception/detections", 50);
     perfect_sub_ =
         gate_->subscribe(nh, "adk/perfect_perception", 20, &Self::onPerfectPerception, this);
+    if (publish_tracks_) {
+      tracks_pub_ = gate_->advertise<hameritt::TrackReport>(nh, "perception/tracks", 50);
+    }
   }
   if (pursue_) {
     // The parked cars of the public map: a sighting at one's place is that car.
@@ -161,6 +166,8 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   if (mission_ && mission_->scenario_id == m->scenario_id) return;  // the same, again
   mission_ = std::move(*m);
   filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get());
+  track_phase_ = std::any_of(mission_->phases.begin(), mission_->phases.end(),
+                             [](const auto& p) { return p.type == scenario::PhaseType::kTrack; });
   // A follow phase states where to be: its envelope's d* behind and h* above the target.
   for (const auto& phase : mission_->phases) {
     if (phase.type != scenario::PhaseType::kFollow) continue;
@@ -367,9 +374,7 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     if (targets.empty()) continue;
     const scenario::TargetDescription& target = *targets.front();
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
-    const bool parked = std::any_of(parked_.begin(), parked_.end(), [&](const geometry::Vec2& c) {
-      return (c - p.head<2>()).norm() < kParkedRadius;
-    });
+    const bool parked = parkedAt(p);
     for (const auto& h : parked ? std::vector<clients::VehicleState>{} : predicted) {
       const double d = (p - h.position).head<2>().norm();
       if (d < nearest) {
@@ -406,6 +411,44 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
   }
   if (associated) predictor_->observe(t, associated->first, associated->second);
+  if (track_phase_ && pursuing_ && tracks_pub_) {
+    publishTracks(*msg,
+                  associated ? std::optional<geometry::Vec3>(associated->first) : std::nullopt);
+  }
+}
+
+bool CoverageSearchClientRos::parkedAt(const geometry::Vec3& p) const {
+  return std::any_of(parked_.begin(), parked_.end(), [&](const geometry::Vec2& c) {
+    return (c - p.head<2>()).norm() < kParkedRadius;
+  });
+}
+
+void CoverageSearchClientRos::publishTracks(const hameritt::PerceptionReport& msg,
+                                            const std::optional<geometry::Vec3>& near) {
+  hameritt::TrackReport report;
+  report.header.stamp = msg.header.stamp;  // the image's
+  report.header.frame_id = msg.header.frame_id;
+  report.camera = msg.camera;
+  std::map<std::string, std::pair<double, hameritt::TrackedBox>> best;  // target id -> box
+  for (const auto& e : msg.entities) {
+    const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
+    const bool parked = parkedAt(p);
+    if (parked) continue;
+    for (const auto* target : filter_->targetsMatching(toObservation(e))) {
+      const double d = near ? (p - *near).head<2>().norm() : 0.0;
+      const auto it = best.find(target->id);
+      if (it != best.end() && it->second.first <= d) continue;
+      hameritt::TrackedBox b;
+      b.target_id = target->id;
+      b.x = e.box.x_min;
+      b.y = e.box.y_min;
+      b.w = e.box.x_max - e.box.x_min + 1;
+      b.h = e.box.y_max - e.box.y_min + 1;
+      best[target->id] = {d, b};
+    }
+  }
+  for (const auto& kv : best) report.tracks.push_back(kv.second.second);
+  gate_->publish(tracks_pub_, report);
 }
 
 void CoverageSearchClientRos::onTick() {

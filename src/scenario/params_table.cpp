@@ -75,6 +75,7 @@ constexpr RangeField kRangeFields[] = {
     {"follow_height", &GeneratorConfig::follow_height},
     {"follow_height_tolerance", &GeneratorConfig::follow_height_tolerance},
     {"follow_duration", &GeneratorConfig::follow_duration},
+    {"track_duration", &GeneratorConfig::track_duration},
 };
 
 struct IntField {
@@ -98,6 +99,8 @@ constexpr IntField kIntFields[] = {
     {"route_edges_max", &GeneratorConfig::route_edges_max},
     {"camera_width", &GeneratorConfig::camera_width},
     {"camera_height", &GeneratorConfig::camera_height},
+    {"track_targets_min", &GeneratorConfig::track_targets_min},
+    {"track_targets_max", &GeneratorConfig::track_targets_max},
 };
 
 struct DoubleField {
@@ -109,6 +112,10 @@ constexpr DoubleField kDoubleFields[] = {
     {"uav_max_speed", &GeneratorConfig::uav_max_speed},
     {"weather_probability", &GeneratorConfig::weather_probability},
     {"camera_rate_hz", &GeneratorConfig::camera_rate_hz},
+    {"track_min_visible_fraction", &GeneratorConfig::track_min_visible_fraction},
+    {"track_min_box_area", &GeneratorConfig::track_min_box_area},
+    {"track_min_tracked_fraction", &GeneratorConfig::track_min_tracked_fraction},
+    {"track_max_reacquire_s", &GeneratorConfig::track_max_reacquire_s},
 };
 
 struct RelationField {
@@ -353,6 +360,21 @@ void GeneratorConfig::validate() const {
     throw ConfigError(
         "generator.follow_height_tolerance: expected twice the largest tolerance to fit the "
         "narrowest altitude band (uav_altitude_max.min - uav_altitude_min.max)");
+  }
+  if (track_targets_min < 1 || track_targets_max > 2 || track_targets_min > track_targets_max) {
+    throw ConfigError(
+        "generator.track_targets_min/track_targets_max: expected 1 <= min <= max <= 2, got " +
+        std::to_string(track_targets_min) + " and " + std::to_string(track_targets_max));
+  }
+  if (track_duration.min < 10) {
+    throw ConfigError("generator.track_duration: expected a duration of at least 10 s");
+  }
+  if (!(track_min_visible_fraction >= 0 && track_min_visible_fraction <= 1) ||
+      !(track_min_tracked_fraction >= 0 && track_min_tracked_fraction <= 1) ||
+      !(track_min_box_area >= 0) || !(track_max_reacquire_s >= 0)) {
+    throw ConfigError(
+        "generator.track_min_visible_fraction/track_min_tracked_fraction: expected fractions in "
+        "[0, 1]; track_min_box_area/track_max_reacquire_s: expected numbers >= 0");
   }
   if (depart_time.min < 10 || depart_time.max > time_limit_pursuit.min - 30) {
     throw ConfigError("generator.depart_time: expected 10 s to time_limit_pursuit.min - 30 s");

@@ -9,11 +9,10 @@ struct ClassName {
   ScenarioClass cls;
   const char* name;
 };
-constexpr ClassName kClasses[] = {{ScenarioClass::kAreaSearch, "area_search"},
-                                  {ScenarioClass::kRouteSearch, "route_search"},
-                                  {ScenarioClass::kPursuit, "pursuit"},
-                                  {ScenarioClass::kAvoid, "avoid"},
-                                  {ScenarioClass::kFollow, "follow"}};
+constexpr ClassName kClasses[] = {
+    {ScenarioClass::kAreaSearch, "area_search"}, {ScenarioClass::kRouteSearch, "route_search"},
+    {ScenarioClass::kPursuit, "pursuit"},        {ScenarioClass::kAvoid, "avoid"},
+    {ScenarioClass::kFollow, "follow"},          {ScenarioClass::kTrack, "track"}};
 struct OpName {
   RelationOp op;
   const char* name;

@@ -82,24 +82,27 @@ void Semantics::mission() {
     }
     if (!has_avoid) add("/phases", "avoid_phase", "an avoid mission needs an avoid phase");
   }
-  // A follow mission finds its target, then follows it: phases search and follow of the same
-  // target, the follow phase shorter than the time limit.
-  if (stringAt(doc_, "class") == std::optional<std::string>("follow")) {
+  // A follow mission finds its target, then follows it; a track mission finds its targets, then
+  // keeps them in view: phases search and then follow (track) of the same targets, the second
+  // phase shorter than the time limit.
+  for (const std::string cls : {"follow", "track"}) {
+    if (stringAt(doc_, "class") != std::optional<std::string>(cls)) continue;
+    const std::string rule = cls + "_phase";
     const auto type = [&](std::size_t i) { return stringAt(phases[i], "type"); };
     if (phases.size() != 2 || type(0) != std::optional<std::string>("search") ||
-        type(1) != std::optional<std::string>("follow")) {
-      add("/phases", "follow_phase", "a follow mission needs two phases: search, then follow");
-    } else {
-      if (phases[0].contains("targets") && phases[1].contains("targets") &&
-          phases[0]["targets"] != phases[1]["targets"]) {
-        add("/phases/1/targets", "follow_phase", "expected the search phase's target");
-      }
-      const json* d = member(phases[1], "duration");
-      const json* limit = member(doc_, "time_limit");
-      if (d && limit && d->is_number() && limit->is_number() &&
-          !(d->get<double>() < limit->get<double>())) {
-        add("/phases/1/duration", "follow_phase", "expected less than the mission's time_limit");
-      }
+        type(1) != std::optional<std::string>(cls)) {
+      add("/phases", rule, "a " + cls + " mission needs two phases: search, then " + cls);
+      continue;
+    }
+    if (phases[0].contains("targets") && phases[1].contains("targets") &&
+        phases[0]["targets"] != phases[1]["targets"]) {
+      add("/phases/1/targets", rule, "expected the search phase's targets");
+    }
+    const json* d = member(phases[1], "duration");
+    const json* limit = member(doc_, "time_limit");
+    if (d && limit && d->is_number() && limit->is_number() &&
+        !(d->get<double>() < limit->get<double>())) {
+      add("/phases/1/duration", rule, "expected less than the mission's time_limit");
     }
   }
 }

@@ -35,7 +35,7 @@ import time
 SCHEMA_PLAN = "hameritt/campaign_plan"
 SCHEMA_MANIFEST = "hameritt/campaign_manifest"
 SCHEMA_VERSION = 1
-CLASSES = ("area_search", "route_search", "pursuit", "follow")
+CLASSES = ("area_search", "route_search", "pursuit", "follow", "track")
 # What "all" means, as for hameritt_generate --class all: the three search classes.
 ALL_CLASSES = CLASSES[:3]
 MODES = ("maneuver_only", "perception_only", "end_to_end")

@@ -1,5 +1,6 @@
 // hameritt_generate: random scenarios as mission.json + sim_config.json, with a manifest.
-//   hameritt_generate --class area_search|route_search|pursuit|avoid|follow|all --count N --seed S
+//   hameritt_generate --class area_search|route_search|pursuit|avoid|follow|track|all
+//                     --count N --seed S
 //                     --out DIR
 //                     [--first K] [--jobs J] [--world-config FILE] [--world suburb|city]
 //                     [--generator-config FILE]
@@ -49,8 +50,8 @@ const char* kUsage =
     "       hameritt_generate (--class CLASS | --spec FILE ...) --seed S --into DIR\n"
     "  --into DIR: scenario 0 of the batch, its mission.json and sim_config.json written into\n"
     "  DIR itself (replacing those files; no manifest), e.g. for mission.launch spec:=FILE.\n"
-    "  CLASS: area_search, route_search, pursuit, avoid, follow, all (the three search\n"
-    "  classes), or a comma-separated list\n"
+    "  CLASS: area_search, route_search, pursuit, avoid, follow, track, all (the three\n"
+    "  search classes), or a comma-separated list\n"
     "  Scenario i of a batch has class CLASS[i mod k] and a seed derived from S and i.\n"
     "  --first K: write only indices K..K+N-1 of the batch (a shard), byte-identical to them.\n"
     "  --world: the world type, overriding the world config's \"type\" (default suburb).\n"

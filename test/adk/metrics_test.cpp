@@ -251,5 +251,47 @@ TEST(MetricsJson, AvoidBlock) {
   EXPECT_TRUE(k["avoid"]["reach_time"].is_null());
 }
 
+TEST(MetricsJson, TrackBlock) {
+  scenario::MissionPhase phase;
+  phase.id = "track_1";
+  phase.type = scenario::PhaseType::kTrack;
+  phase.targets = {"car_1"};
+  phase.duration = 2.0;
+  TrackScorer scorer(phase);
+  scorer.start(0.0);
+  for (int i = 1; i <= 20; ++i) {
+    const double t = 0.1 * i;
+    scorer.addFrame(t, {{"car_1", PixelBox{10, 10, 40, 30}, 0.9, 0.1}});
+    scorer.addReport(t, {{"car_1", PixelBox{10, 10, 40, 30}}, {"car_9", PixelBox{0, 0, 1, 1}}});
+  }
+  MetricsAccumulator acc(shippedMission());
+  ConstraintMonitor mon(shippedMission());
+  CoverageGrid cov(shippedMission());
+  MissionMetrics m =
+      acc.finish(Outcome::kSuccess, "tracked", 0.0, 2.0, 60.0, "maneuver_only", mon, cov);
+  m.track = scorer.score(true);
+  const auto j = nlohmann::ordered_json::parse(metricsJson(m));
+  std::vector<std::string> keys;
+  for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
+  ASSERT_EQ(keys.back(), "track");
+  const auto& t = j["track"];
+  EXPECT_TRUE(t["success"].get<bool>()) << t["failure"];
+  EXPECT_EQ(t["state"], "succeeded");
+  EXPECT_EQ(t["frames"], 20);
+  EXPECT_EQ(t["reports"], 20);
+  EXPECT_EQ(t["report_errors"]["unknown_id"], 20);
+  EXPECT_EQ(t["report_errors"]["total"], 20);
+  EXPECT_EQ(t["tracked_fraction"], 1.0);
+  ASSERT_EQ(t["per_target"].size(), 1u);
+  EXPECT_EQ(t["per_target"][0]["precision"], 1.0);
+  EXPECT_EQ(t["per_target"][0]["by_occlusion"]["partial"]["frames"], 20);
+  EXPECT_EQ(t["clear_mot"]["mota"], 1.0);
+  EXPECT_EQ(t["identity"]["idf1"], 1.0);
+  EXPECT_GT(t["hota"]["hota"].get<double>(), 0.9);
+  // Control: without a track phase there is no block.
+  m.track.reset();
+  EXPECT_FALSE(nlohmann::ordered_json::parse(metricsJson(m)).contains("track"));
+}
+
 }  // namespace
 }  // namespace hameritt::adk

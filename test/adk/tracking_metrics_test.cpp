@@ -440,5 +440,59 @@ TEST(ScoreTracking, MatchesIndependentReferenceOnRandomSequences) {
   EXPECT_GE(sequences_off, 55);
 }
 
+TEST(TrackingRecorder, ScoresLikeTheBatchAndCountsMalformedReports) {
+  const auto seq = handSequence();
+  TrackingRecorder clean({"car"}, {});
+  TrackingRecorder noisy({"car"}, {});
+  std::size_t bad_sent = 0;
+  for (const auto& f : seq) {
+    clean.addFrame(f.t, f.targets);
+    noisy.addFrame(f.t, f.targets);
+    if (!f.tracks.empty()) clean.addReport(f.t, f.tracks);
+    // The noisy client sends the same tracks plus one malformed track of each kind...
+    auto tracks = f.tracks;
+    tracks.push_back({"car_unknown", PixelBox{0, 0, 10, 10}});
+    tracks.push_back({"car", PixelBox{0, 0, NAN, 10}});
+    tracks.push_back({"car", PixelBox{0, 0, 10, -1}});
+    if (!f.tracks.empty()) tracks.push_back(f.tracks[0]);  // a repeated id
+    bad_sent += 3 + !f.tracks.empty();
+    noisy.addReport(f.t, tracks);
+    // ...a report stamped between frames, and one re-sent after it (out of order).
+    noisy.addReport(f.t + 0.5, f.tracks);
+    noisy.addReport(f.t + 0.25, f.tracks);
+  }
+  EXPECT_EQ(clean.errors().total(), 0u);
+  const auto& e = noisy.errors();
+  EXPECT_EQ(e.unknown_id, 6u);
+  EXPECT_EQ(e.bad_box, 12u);
+  EXPECT_EQ(e.duplicate_id, 4u);  // the four frames with a box
+  EXPECT_EQ(e.unmatched_stamp, 6u);
+  EXPECT_EQ(e.out_of_order, 6u);
+  EXPECT_EQ(e.unknown_id + e.bad_box + e.duplicate_id, bad_sent);
+  EXPECT_EQ(noisy.reports(), 18u);
+  EXPECT_EQ(noisy.frames(), 6u);
+  // Dropped tracks cost nothing else: both score as the batch function does.
+  const auto batch = scoreTracking(seq, {"car"});
+  for (const auto* r : {&clean, &noisy}) {
+    const auto s = r->score();
+    EXPECT_DOUBLE_EQ(s.targets[0].precision, batch.targets[0].precision);
+    EXPECT_DOUBLE_EQ(s.targets[0].success, batch.targets[0].success);
+    EXPECT_DOUBLE_EQ(s.clear.mota, batch.clear.mota);
+    EXPECT_DOUBLE_EQ(s.hota.mean_hota, batch.hota.mean_hota);
+  }
+  // Negative control: a client whose reports all miss their frames scores no precision.
+  TrackingRecorder late({"car"}, {});
+  for (const auto& f : seq) {
+    late.addFrame(f.t, f.targets);
+    late.addReport(f.t + 0.5, f.tracks);
+  }
+  EXPECT_EQ(late.errors().unmatched_stamp, 6u);
+  EXPECT_DOUBLE_EQ(late.score().targets[0].precision, 0.0);
+  // A clock restart (simulator reset) starts a new recording.
+  late.addFrame(0.0, {});
+  EXPECT_EQ(late.frames(), 1u);
+  EXPECT_THROW(late.addFrame(NAN, {}), InputError);
+}
+
 }  // namespace
 }  // namespace hameritt::adk

@@ -64,6 +64,11 @@ class ConfigTest(unittest.TestCase):
         self.assertEqual([hc.class_of(c, i) for i in range(3)], ["follow", "pursuit", "follow"])
         self.assertNotIn("follow", cfg_of("seed: 1\ncount: 2\nclasses: all\n")["classes"])
 
+    def test_track_class_is_accepted_but_not_part_of_all(self):
+        c = cfg_of("seed: 1\ncount: 2\nclasses: [track]\n")
+        self.assertEqual(c["classes"], ["track"])
+        self.assertNotIn("track", cfg_of("seed: 1\ncount: 2\nclasses: all\n")["classes"])
+
     def test_errors_name_the_file_and_the_field(self):
         cases = [
             ("seed: -1", "field 'seed'"),

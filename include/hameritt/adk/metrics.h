@@ -13,6 +13,7 @@
 #include "hameritt/adk/detection_scoring.h"
 #include "hameritt/adk/follow_score.h"
 #include "hameritt/adk/intervals.h"
+#include "hameritt/adk/track_score.h"
 #include "hameritt/geometry/types.h"
 #include "hameritt/scenario/scenario.h"
 
@@ -115,6 +116,7 @@ struct MissionMetrics {
   double prior_weighted_coverage = 0.0;
   std::optional<AvoidScore> avoid;  // missions with an avoid phase
   std::optional<FollowPhaseScore> follow;  // missions with a follow phase
+  std::optional<TrackPhaseScore> track;    // missions with a track phase
 };
 
 // Collects the figures of one run.

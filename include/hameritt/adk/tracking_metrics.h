@@ -178,3 +178,52 @@ TrackingScore scoreTracking(const std::vector<TrackingFrame>& frames,
 std::vector<int> minCostAssignment(const std::vector<std::vector<double>>& cost);
 
 }  // namespace hameritt::adk
+
+namespace hameritt::adk {
+
+// Kinds of malformed client track reports: counted, never fatal.
+struct TrackReportErrors {
+  std::size_t unknown_id = 0;       // an id that is not a mission target's
+  std::size_t bad_box = 0;          // non-finite, or negative width or height
+  std::size_t duplicate_id = 0;     // the same id twice in one report
+  std::size_t out_of_order = 0;     // a stamp not after the previous report's
+  std::size_t unmatched_stamp = 0;  // no camera frame with that stamp
+  std::size_t total() const {
+    return unknown_id + bad_box + duplicate_id + out_of_order + unmatched_stamp;
+  }
+};
+
+// Collects a track mission's frames as they happen: the ADK node adds each camera frame's
+// ground truth, and each report the client publishes (the image stamp it refers to and its
+// boxes). A report is matched to the frame with the same stamp (within 1 ms); malformed
+// reports and tracks are dropped and counted, so that a client's bad output costs it score but
+// never stops the scoring. ROS-free.
+class TrackingRecorder {
+ public:
+  TrackingRecorder(std::vector<std::string> target_ids, TrackingSettings settings);
+
+  // A camera frame's ground truth at sim time t. A t not after the previous frame's restarts
+  // the recording (a simulator reset). Non-finite t: InputError.
+  void addFrame(double t, std::vector<TargetTruth> targets);
+  // A client report for the frame stamped `stamp`: bad tracks are dropped one by one (an
+  // unknown id, a bad box, a repeated id), a whole report with an out-of-order or unmatched
+  // stamp is dropped. A second report for a frame replaces the first.
+  void addReport(double stamp, const std::vector<ReportedTrack>& tracks);
+
+  const TrackReportErrors& errors() const { return errors_; }
+  std::size_t frames() const { return frames_.size(); }
+  std::size_t reports() const { return reports_; }
+  // Every score over the frames so far.
+  TrackingScore score() const;
+
+ private:
+  std::vector<std::string> target_ids_;
+  TrackingSettings settings_;
+  std::vector<TrackingFrame> frames_;
+  TrackReportErrors errors_;
+  std::size_t reports_ = 0;
+  bool have_report_ = false;
+  double last_report_ = 0.0;
+};
+
+}  // namespace hameritt::adk

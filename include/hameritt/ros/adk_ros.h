@@ -22,6 +22,8 @@
 #include "hameritt/FollowStatus.h"
 #include "hameritt/PhaseState.h"
 #include "hameritt/SimulationEnd.h"
+#include "hameritt/TrackReport.h"
+#include "hameritt/TrackStatus.h"
 #include "hameritt/adk/clock_watchdog.h"
 #include "hameritt/adk/constraint_monitor.h"
 #include "hameritt/adk/coverage.h"
@@ -45,7 +47,9 @@ namespace hameritt::ros_wrappers {
 //   cut short while ~output_dir's disk has less free names the recorder's stop as the cause),
 //   ~traffic_rate_hz (2, sim time; 0 = none: an avoid mission's aircraft as ADS-B-like reports
 //   on adk/traffic, hameritt/EntityStateArray, class and role "aircraft", at the odometry after
-//   each period).
+//   each period),
+//   ~track_camera (the camera whose frames score a track phase: "down" when the UAV has it, else
+//   the first camera).
 // Topics are relative to the node's namespace (/mission, /adk/... in the root namespace).
 class AdkRos {
  public:
@@ -68,6 +72,11 @@ class AdkRos {
   void onCrash(const hameritt::CrashEvent::ConstPtr& msg);
   void onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
+  // A client's track report (perception/tracks): fed to the track phase's scorer.
+  void onTracks(const hameritt::TrackReport::ConstPtr& msg);
+  // The track phase's frame of camera `camera`: the targets' boxes, visible fractions and
+  // occlusion from the instance mask (targets without a visible pixel are absent).
+  void addTrackFrame(const hameritt::BoundingBoxArray& msg);
   // The simulator stopped at its duration: the mission ends (outcome ended) once the odometry
   // up to that time has been handled (at once in lock-step; free running, within a wall second).
   void onSimulationEnd(const hameritt::SimulationEnd::ConstPtr& msg);
@@ -103,6 +112,12 @@ class AdkRos {
   void publishPhase(double t, const scenario::MissionPhase& phase, adk::PhaseState state,
                     const std::string& reason);
   adk::FollowPhaseScore followScore(bool ended) const;
+  // Track missions: the search phase ends at the find, which starts the track phase; the
+  // mission ends when the track phase has run its duration (succeeded when its criteria hold,
+  // adk/track_score.h) or a target has been lost too long (failed).
+  void checkTrack(double t);
+  // adk/track: the track phase's score `s` at sim time t.
+  void publishTrack(double t, const adk::TrackPhaseScore& s);
   // Ends the mission (lifecycle already ended): metrics.json, /adk/metrics, /adk/state.
   void finish();
 
@@ -143,6 +158,10 @@ class AdkRos {
   const scenario::MissionPhase* search_phase_ = nullptr;
   const scenario::ScenarioEntity* follow_target_ = nullptr;
   double follow_koz_start_ = 0.0;  // the monitor's violation seconds at the phase's start
+  // The track phase of a track mission (after its search phase): scored from the frames of
+  // camera track_camera_ and the client's reports.
+  std::unique_ptr<adk::TrackScorer> track_;
+  std::size_t track_camera_ = 0;
   bool crashed_ = false;
   std::map<std::string, adk::PhaseState> phase_states_;  // the last published, by phase id
   double traffic_period_ = 0.5;  // s between adk/traffic reports; 0: none
@@ -167,8 +186,9 @@ class AdkRos {
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
       perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_, follow_pub_, phase_pub_,
-      traffic_pub_;
-  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_;
+      traffic_pub_, track_pub_;
+  ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_,
+      tracks_sub_;
   std::vector<ros::Subscriber> box_subs_;
 };
 

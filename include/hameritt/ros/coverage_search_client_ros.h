@@ -24,6 +24,7 @@
 #include "hameritt/FollowProgress.h"
 #include "hameritt/Mission.h"
 #include "hameritt/PerceptionReport.h"
+#include "hameritt/TrackReport.h"
 #include "hameritt/clients/avoid.h"
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/context_filter.h"
@@ -66,6 +67,13 @@ class CoverageSearchClientRos {
   void onProgress(const hameritt::FollowProgress::ConstPtr& msg);
   void onState(const topic_tools::ShapeShifter::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
+  // A sighting at p is a parked car of the public map.
+  bool parkedAt(const geometry::Vec3& p) const;
+  // perception/tracks: for each mission target, the box of the sighting in `msg` that matches
+  // its description, is not a parked car of the public map, and lies nearest `near` (the
+  // pursued vehicle) when there is one.
+  void publishTracks(const hameritt::PerceptionReport& msg,
+                     const std::optional<geometry::Vec3>& near);
   void onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg);
   void onTick();
   // Pursuit: starts it (after the find of a track objective's target) and flies it.
@@ -118,7 +126,10 @@ class CoverageSearchClientRos {
   clients::AvoidSettings avoid_settings_;
   std::unique_ptr<clients::AvoidPilot> avoid_;
 
-  ros::Publisher waypoints_pub_, plan_pub_, detection_pub_, pose_pub_;
+  ros::Publisher waypoints_pub_, plan_pub_, detection_pub_, pose_pub_, tracks_pub_;
+  // A track phase: while pursuing, the boxes of the targets it sees go out on perception/tracks.
+  bool publish_tracks_ = true;
+  bool track_phase_ = false;
   ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_,
       traffic_sub_;
 };

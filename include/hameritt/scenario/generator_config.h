@@ -71,6 +71,15 @@ struct GeneratorConfig {
   Range follow_height{20, 35};
   Range follow_height_tolerance{5, 7};
   Range follow_duration{60, 120};
+  // Track: 1-2 moving targets (a second one drives the first one's route as a convoy), the
+  // track phase's duration and its criteria (TrackPhaseSpec), written into mission.json.
+  int track_targets_min = 1;
+  int track_targets_max = 2;
+  Range track_duration{60, 120};
+  double track_min_visible_fraction = 0.5;
+  double track_min_box_area = 400.0;  // px^2
+  double track_min_tracked_fraction = 0.7;
+  double track_max_reacquire_s = 10.0;
   // Plan a perception-only UAV flight over the targets (sim_config uav.perception_path); the
   // most expensive step of generation, so it can be switched off.
   bool perception_paths = true;

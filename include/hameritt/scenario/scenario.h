@@ -20,8 +20,9 @@ namespace hameritt::scenario {
 constexpr int kSchemaVersion = 1;
 
 // follow: pursuit's moving target, found, then followed inside an envelope (phases search ->
-// follow).
-enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit, kAvoid, kFollow };
+// follow). track: pursuit's scene with 1-2 moving targets, found, then kept in a camera's view
+// (phases search -> track).
+enum class ScenarioClass { kAreaSearch, kRouteSearch, kPursuit, kAvoid, kFollow, kTrack };
 const char* toString(ScenarioClass c);
 bool parseScenarioClass(const std::string& s, ScenarioClass* out);
 

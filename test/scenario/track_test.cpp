@@ -1,0 +1,183 @@
+// The track class: pursuit's scene with one or two moving targets in two phases (search, then
+// track) whose criteria and duration come from config/generator.json; the files validate (schema
+// and semantic rules), round-trip, are deterministic; the second target drives the first one's
+// streets without touching it; the routes pass occluders; the pursuit class is unchanged by it;
+// and the track_phase rule catches doctored missions (the negative controls).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "hameritt/scenario/mission_io.h"
+#include "hameritt/scenario/scenario_io.h"
+#include "hameritt/scenario/sim_config_io.h"
+#include "hameritt/scenario/validation.h"
+#include "test_util.h"
+#include "validation_test_util.h"
+
+using namespace hameritt::scenario;
+using namespace hameritt::scenario::testing;
+
+namespace {
+
+const ScenarioEntity* entity(const Scenario& s, const std::string& id) {
+  for (const auto& e : s.sim.entities) {
+    if (e.entity.id == id) return &e;
+  }
+  return nullptr;
+}
+
+// Occluders (street trees, buildings, houses, garages) whose centre comes within `radius` m of
+// the target's driven path (sampled every second after it starts moving).
+int occludersPassed(const World& w, const Trajectory& traj, double radius) {
+  int n = 0;
+  for (const auto& e : w.entities()) {
+    if (e.cls != EntityClass::kStreetTree && e.cls != EntityClass::kBuilding &&
+        e.cls != EntityClass::kHouse && e.cls != EntityClass::kGarage) {
+      continue;
+    }
+    for (double t = traj[1].t; t <= traj.back().t; t += 1.0) {
+      const TrajectoryPoint p = sampleTrajectory(traj, t);
+      if ((e.box.center2() - hameritt::geometry::Vec2(p.x, p.y)).norm() < radius) {
+        ++n;
+        break;
+      }
+    }
+  }
+  return n;
+}
+
+// Checks one track scenario; returns its number of targets.
+std::size_t expectWellPosed(const World& w, const Scenario& s) {
+  SCOPED_TRACE(s.mission.scenario_id);
+  const GeneratorConfig& c = shippedConfig();
+  EXPECT_EQ(s.mission.scenario_id.rfind("track-", 0), 0u);
+  EXPECT_EQ(s.mission.objective.type, "track");
+  const auto& targets = s.mission.objective.targets;
+  EXPECT_GE(targets.size(), 1u);
+  EXPECT_LE(targets.size(), 2u);
+  std::vector<std::string> ids;
+  for (const auto& t : targets) ids.push_back(t.id);
+  EXPECT_EQ(s.mission.phases.size(), 2u);
+  if (s.mission.phases.size() != 2) return 0;
+  const MissionPhase& search = s.mission.phases[0];
+  const MissionPhase& track = s.mission.phases[1];
+  EXPECT_EQ(search.type, PhaseType::kSearch);
+  EXPECT_EQ(track.type, PhaseType::kTrack);
+  EXPECT_EQ(search.targets, ids);
+  EXPECT_EQ(track.targets, ids);
+  EXPECT_TRUE(track.duration.has_value());
+  const double duration = track.duration.value_or(0.0);
+  EXPECT_GE(duration, std::round(c.track_duration.min));
+  EXPECT_LE(duration, std::round(c.track_duration.max));
+  EXPECT_DOUBLE_EQ(track.track.min_visible_fraction, 0.5);
+  EXPECT_DOUBLE_EQ(track.track.min_box_area, 400.0);
+  EXPECT_DOUBLE_EQ(track.track.min_tracked_fraction, 0.7);
+  EXPECT_DOUBLE_EQ(track.track.max_reacquire_s, 10.0);
+  EXPECT_GE(s.mission.time_limit, c.time_limit_pursuit.min + duration - 1.0);
+  // Every target drives, past occluders; two targets never come within 4 m of each other.
+  std::vector<const Trajectory*> trajs;
+  for (const auto& id : ids) {
+    const ScenarioEntity* e = entity(s, id);
+    EXPECT_NE(e, nullptr) << id;
+    if (!e) return 0;
+    EXPECT_EQ(e->role, "target");
+    EXPECT_GT(e->trajectory.size(), 2u) << id;
+    if (e->trajectory.size() <= 2) return 0;
+    EXPECT_GE(occludersPassed(w, e->trajectory, 15.0), 1) << id;
+    trajs.push_back(&e->trajectory);
+  }
+  if (trajs.size() == 2) {
+    double closest = 1e9;
+    for (double t = 0; t <= trajs[0]->back().t; t += 0.25) {
+      const TrajectoryPoint a = sampleTrajectory(*trajs[0], t), b = sampleTrajectory(*trajs[1], t);
+      closest = std::min(closest, std::hypot(a.x - b.x, a.y - b.y));
+    }
+    EXPECT_GT(closest, 4.0);
+    // Both stop where their routes end, 12 m apart on the same street.
+    const auto &ea = trajs[0]->back(), &eb = trajs[1]->back();
+    EXPECT_NEAR(std::hypot(ea.x - eb.x, ea.y - eb.y), 12.0, 1.0);
+  }
+  // Look-alike confusers of the first target: parked cars of its model and colour.
+  int confusers = 0;
+  for (const auto& e : s.sim.entities) {
+    if (e.role == "confuser" && e.entity.cls == EntityClass::kCar &&
+        e.entity.attributes.str("color") == targets[0].color &&
+        e.entity.attributes.str("model") == targets[0].model) {
+      ++confusers;
+    }
+  }
+  EXPECT_GE(confusers, 1);
+  expectValidAndRoundTrips(s);
+  return targets.size();
+}
+
+TEST(TrackGeneratorTest, ScenariosAreWellPosedWithOneOrTwoTargets) {
+  std::map<std::size_t, int> by_count;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    ++by_count[expectWellPosed(shippedWorld(), generateScenario(shippedWorld(), shippedConfig(),
+                                                                ScenarioClass::kTrack, seed))];
+  }
+  EXPECT_GE(by_count[1], 1);
+  EXPECT_GE(by_count[2], 1);
+  EXPECT_EQ(by_count[1] + by_count[2], 6);
+  // Two targets asked for: every scenario whose convoy route exists has them.
+  GeneratorConfig two = shippedConfig();
+  two.track_targets_min = 2;
+  int with_two = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    with_two += expectWellPosed(shippedWorld(), generateScenario(shippedWorld(), two,
+                                                                 ScenarioClass::kTrack, seed)) == 2;
+  }
+  EXPECT_GE(with_two, 3);
+  expectWellPosed(shippedCityWorld(),
+                  generateScenario(shippedCityWorld(), shippedConfig(), ScenarioClass::kTrack, 1));
+}
+
+TEST(TrackGeneratorTest, DeterministicAndPursuitUnchanged) {
+  // The track scene is pursuit's with the same seed: the first target, its look and its route.
+  const auto [a, p] = expectDeterministicOverPursuit(ScenarioClass::kTrack, 7);
+  ASSERT_FALSE(p.mission.objective.targets.empty());
+  const ScenarioEntity* pt = entity(p, p.mission.objective.targets[0].id);
+  const ScenarioEntity* at = entity(a, a.mission.objective.targets[0].id);
+  ASSERT_TRUE(pt && at);
+  EXPECT_EQ(pt->trajectory.size(), at->trajectory.size());
+  EXPECT_DOUBLE_EQ(a.mission.time_limit, p.mission.time_limit + *a.mission.phases[1].duration);
+}
+
+TEST(TrackGeneratorTest, TrackPhaseRuleCatchesDoctoredMissions) {
+  const Scenario s = generateScenario(shippedWorld(), shippedConfig(), ScenarioClass::kTrack, 4);
+  const nlohmann::json good = nlohmann::json::parse(missionJson(s.mission));
+  ASSERT_TRUE(issues(good).empty()) << rules(issues(good));
+  nlohmann::json m = good;
+  m["phases"].erase(1);  // the track phase gone
+  EXPECT_NE(rules(issues(m)).find("track_phase /phases"), std::string::npos) << rules(issues(m));
+  m = good;
+  m["phases"][1]["targets"] = nlohmann::json::array({m["phases"][0]["targets"][0]});
+  m["phases"][0]["targets"].push_back("car_9999");  // the search looks for another target
+  EXPECT_NE(rules(issues(m)).find("track_phase /phases/1/targets"), std::string::npos)
+      << rules(issues(m));
+  m = good;
+  m["phases"][1]["duration"] = m["time_limit"].get<double>() + 1.0;
+  EXPECT_NE(rules(issues(m)).find("track_phase /phases/1/duration"), std::string::npos)
+      << rules(issues(m));
+  m = good;
+  m["phases"][1]["type"] = "follow";  // a follow phase in a track mission
+  EXPECT_NE(rules(issues(m)).find("track_phase /phases"), std::string::npos) << rules(issues(m));
+}
+
+TEST(TrackGeneratorTest, ConfigRangesAreChecked) {
+  GeneratorConfig c = shippedConfig();
+  c.track_targets_max = 3;
+  EXPECT_NE(messageOf([&] { c.validate(); }).find("generator.track_targets_min/track_targets_max"),
+            std::string::npos);
+  c = shippedConfig();
+  c.track_duration = {5, 60};
+  EXPECT_NE(messageOf([&] { c.validate(); }).find("generator.track_duration"), std::string::npos);
+  c = shippedConfig();
+  c.track_min_visible_fraction = 1.5;
+  EXPECT_NE(messageOf([&] { c.validate(); }).find("track_min_visible_fraction"), std::string::npos);
+  c = shippedConfig();
+  EXPECT_EQ(messageOf([&] { c.validate(); }), "(no error)");
+}
+
+}  // namespace
