@@ -83,7 +83,7 @@ void Semantics::mission() {
     if (!has_avoid) add("/phases", "avoid_phase", "an avoid mission needs an avoid phase");
   }
   // A follow mission finds its target, then follows it: phases search and follow of the same
-  // target, the follow phase shorter than the time limit.
+  // target, the follow phase with its approach allowance shorter than the time limit.
   if (stringAt(doc_, "class") == std::optional<std::string>("follow")) {
     const auto type = [&](std::size_t i) { return stringAt(phases[i], "type"); };
     if (phases.size() != 2 || type(0) != std::optional<std::string>("search") ||
@@ -96,9 +96,13 @@ void Semantics::mission() {
       }
       const json* d = member(phases[1], "duration");
       const json* limit = member(doc_, "time_limit");
+      const json* c = member(phases[1], "criteria");
+      const json* a = c ? member(*c, "approach_s") : nullptr;
+      const double approach = a && a->is_number() ? a->get<double>() : 0.0;
       if (d && limit && d->is_number() && limit->is_number() &&
-          !(d->get<double>() < limit->get<double>())) {
-        add("/phases/1/duration", "follow_phase", "expected less than the mission's time_limit");
+          !(d->get<double>() + approach < limit->get<double>())) {
+        add("/phases/1/duration", "follow_phase",
+            "expected duration + criteria.approach_s less than the mission's time_limit");
       }
     }
   }
