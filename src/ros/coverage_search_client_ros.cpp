@@ -166,8 +166,13 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
     if (phase.type != scenario::PhaseType::kFollow) continue;
     pursuit_.standoff = phase.follow.distance;  // >= 0 (mission.json)
     if (phase.follow.height > 0) pursuit_.height = phase.follow.height;
-    ROS_INFO("%s: follow phase '%s': standoff %.1f m behind, %.1f m above the target", kClientName,
-             phase.id.c_str(), pursuit_.standoff, pursuit_.height);
+    pursuit_.envelope_radius = phase.follow.distance_tolerance;  // > 0 (mission.json)
+    pursuit_.envelope_height = phase.follow.height_tolerance;
+    ROS_INFO(
+        "%s: follow phase '%s': standoff %.1f m behind, %.1f m above the target, within "
+        "%.1f m and %.1f m",
+        kClientName, phase.id.c_str(), pursuit_.standoff, pursuit_.height, pursuit_.envelope_radius,
+        pursuit_.envelope_height);
   }
   if (pursue_) {
     chooser_ =
