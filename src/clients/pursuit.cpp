@@ -241,6 +241,22 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
   }
   std::optional<PursuitView> seen, fallback;
   double seen_cost = std::numeric_limits<double>::infinity(), fallback_cost = seen_cost;
+  // A candidate outside the keep-out zones, kept when it is the cheapest that sees the vehicle
+  // (or, while none does, the cheapest): close to the preferred viewpoint, then to the UAV.
+  auto consider = [&](PursuitView v) {
+    if (inKoz(v.position, t)) return;
+    const double cost = (v.position - preferred.position).norm() + 0.5 * (v.position - uav).norm();
+    if (cost >= seen_cost) return;
+    if (const auto cam = seenBy(v.position, v.yaw, target)) {
+      seen_cost = cost;
+      v.visible = true;
+      v.camera = *cam;
+      seen = v;
+    } else if (cost < fallback_cost) {
+      fallback_cost = cost;
+      fallback = v;
+    }
+  };
   if (settings_.envelope_radius > 0.0) {
     // Inside the envelope: the score is the envelope's, the sight line keeps the track.
     const Vec2 centre = preferred.position.head<2>();
@@ -248,20 +264,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
     for (double h : {h0, h0 + dh, h0 - dh}) {
       for (int k = -1; k < 8; ++k) {
         const double a = k * geometry::kPi / 4.0;
-        PursuitView v = at(k < 0 ? centre : centre + r * Vec2(std::cos(a), std::sin(a)), h);
-        if (inKoz(v.position, t)) continue;
-        const double cost =
-            (v.position - preferred.position).norm() + 0.5 * (v.position - uav).norm();
-        if (cost >= seen_cost) continue;
-        if (const auto cam = seenBy(v.position, v.yaw, target)) {
-          seen_cost = cost;
-          v.visible = true;
-          v.camera = *cam;
-          seen = v;
-        } else if (cost < fallback_cost) {
-          fallback_cost = cost;
-          fallback = v;
-        }
+        consider(at(k < 0 ? centre : centre + r * Vec2(std::cos(a), std::sin(a)), h));
       }
     }
     if (seen) return *seen;
@@ -275,22 +278,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
     for (double r : ranges) {
       for (int k = 0; k < 12; ++k) {
         if (r == 0.0 && k > 0) break;
-        PursuitView v = candidate(k * geometry::kPi / 6.0, r, h);
-        if (inKoz(v.position, t)) continue;
-        // Close to the preferred viewpoint and to the UAV, in that order.
-        const double cost =
-            (v.position - preferred.position).norm() + 0.5 * (v.position - uav).norm();
-        if (const auto cam = seenBy(v.position, v.yaw, target)) {
-          if (cost < seen_cost) {
-            seen_cost = cost;
-            v.visible = true;
-            v.camera = *cam;
-            seen = v;
-          }
-        } else if (cost < fallback_cost) {
-          fallback_cost = cost;
-          fallback = v;
-        }
+        consider(candidate(k * geometry::kPi / 6.0, r, h));
       }
     }
   }

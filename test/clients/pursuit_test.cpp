@@ -209,14 +209,10 @@ TEST(Pursuit, ViewpointSeesTheVehiclePastOccluders) {
   EXPECT_GT(preferred_used, tested / 2);
 }
 
-TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
-  // A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its
-  // edge: the preferred viewpoint (8 m behind, 20 m above) often looks through the occluder.
-  const auto& w = world();
-  PursuitSettings settings;
-  const ViewpointChooser chooser(w, sim().uav, {}, settings);
-  const auto& occ = w.occluders();
-  int hidden = 0, recovered = 0;
+// A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its edge.
+std::vector<VehicleState> pastTallOccluders() {
+  std::vector<VehicleState> out;
+  const auto& occ = world().occluders();
   for (std::size_t i = 0; i < occ.size(); ++i) {
     const auto& box = occ.box(static_cast<int>(i));
     if (box.maxZ() < 5.0) continue;
@@ -225,6 +221,20 @@ TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
     VehicleState v;
     v.position = Vec3(p.x(), p.y(), 0.0);
     v.yaw = std::atan2(u.y(), u.x());
+    out.push_back(v);
+  }
+  return out;
+}
+
+TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
+  // A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its
+  // edge: the preferred viewpoint (8 m behind, 20 m above) often looks through the occluder.
+  const auto& w = world();
+  PursuitSettings settings;
+  const ViewpointChooser chooser(w, sim().uav, {}, settings);
+  int hidden = 0, recovered = 0;
+  for (const VehicleState& v : pastTallOccluders()) {
+    const Vec2 p = v.position.head<2>(), u(std::cos(v.yaw), std::sin(v.yaw));
     const Vec3 centre = v.position + Vec3(0, 0, 0.8);
     const Vec2 behind = p - u * settings.standoff;
     const PursuitView view = chooser.choose(v, v.position + Vec3(0, 0, 30), 0.0);
@@ -255,16 +265,9 @@ TEST(Pursuit, ViewpointStaysInsideTheEnvelopeWhenFollowing) {
   follow_settings.envelope_height = 5.0;
   const ViewpointChooser free_chooser(w, sim().uav, {}, free_settings);
   const ViewpointChooser follow_chooser(w, sim().uav, {}, follow_settings);
-  const auto& occ = w.occluders();
   int hidden = 0, seen_inside = 0, free_outside = 0;
-  for (std::size_t i = 0; i < occ.size(); ++i) {
-    const auto& box = occ.box(static_cast<int>(i));
-    if (box.maxZ() < 5.0) continue;
-    const Vec2 u(std::cos(box.yaw), std::sin(box.yaw));
-    const Vec2 p = box.center2() + u * (0.5 * box.size.x() + 2.5);
-    VehicleState v;
-    v.position = Vec3(p.x(), p.y(), 0.0);
-    v.yaw = std::atan2(u.y(), u.x());
+  for (const VehicleState& v : pastTallOccluders()) {
+    const Vec2 p = v.position.head<2>(), u(std::cos(v.yaw), std::sin(v.yaw));
     const Vec3 centre = v.position + Vec3(0, 0, 0.8);
     const Vec2 behind = p - u * follow_settings.standoff;
     const Vec3 uav = v.position + Vec3(0, 0, 30);
