@@ -212,6 +212,18 @@ void CoverageSearchClientRos::replan(const std::string& why) {
   clients::SearchProgress progress{geometry::Vec3(p.x, p.y, p.z), missionTime(), covered_};
   try {
     plan_ = clients::planSearch(*mission_, settings_, progress);
+    // A target that drives off (pursuit, follow) leaves from its area of interest: when no cell
+    // can be reached before the windows close, the areas are searched past their windows.
+    const bool windows = std::any_of(mission_->aois.begin(), mission_->aois.end(),
+                                     [](const auto& a) { return a.window.nlt.has_value(); });
+    if (plan_.legs.empty() && !plan_.skipped.empty() && mission_->objective.type == "track" &&
+        windows) {
+      scenario::Mission open = *mission_;
+      for (auto& a : open.aois) a.window.nlt.reset();
+      plan_ = clients::planSearch(open, settings_, progress);
+      ROS_INFO("%s: no cell can be reached inside the windows: searching the areas past them",
+               kClientName);
+    }
   } catch (const std::exception& e) {
     ROS_ERROR("%s: planning the search failed: %s", kClientName, e.what());
     plan_ = {};
