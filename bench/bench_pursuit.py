@@ -11,16 +11,14 @@ fraction (from metrics.json, the ADK's ground truth) and the wall time, and the 
 
 --jobs runs that many missions at once, each on its own ROS master.
 """
-import argparse
-import concurrent.futures
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mission_bench_util import fly_mission  # noqa: E402
+from mission_bench_util import (fly_all, fly_mission, generate,  # noqa: E402
+                                pursuit_arguments)
 
 
 def fly(scenario, out, pursue, time_limit, port):
@@ -38,34 +36,20 @@ def fly(scenario, out, pursue, time_limit, port):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--count", type=int, default=10)
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--pursue", default="true", choices=["true", "false"])
+    ap = pursuit_arguments()
     ap.add_argument("--time-limit", type=float, default=0.0, help="0: the mission's")
-    ap.add_argument("--jobs", type=int, default=1)
-    ap.add_argument("--out", default=None)
     a = ap.parse_args()
     out = a.out or tempfile.mkdtemp(prefix="hameritt_bench_pursuit.")
-    scen = os.path.join(out, "scenarios")
-    subprocess.run(["rosrun", "hameritt", "hameritt_generate", "--class", "pursuit", "--count",
-                    str(a.count), "--seed", str(a.seed), "--out", scen], check=True,
-                   stdout=subprocess.DEVNULL)
-    with open(os.path.join(scen, "manifest.json")) as f:
-        manifest = json.load(f)
-    dirs = [os.path.join(scen, s["path"]) for s in manifest["scenarios"]]
-    results = []
-    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = [pool.submit(fly, d, os.path.join(out, "run_%02d" % i), a.pursue, a.time_limit,
-                               21000 + 17 * i + os.getpid() % 1000)
-                   for i, d in enumerate(dirs)]
-        for fut in futures:
-            r = fut.result()
-            results.append(r)
-            print("%-26s %-8s in view %6.1f s of %4.0f s (%3.0f %%), first seen %s, wall %.0f s"
-                  % (r["scenario"], r["outcome"], r.get("in_view_time", 0),
-                     r.get("time_limit", 0), 100 * r.get("in_view_fraction", 0),
-                     r.get("first_seen"), r["wall_s"]), flush=True)
+    dirs = generate("pursuit", a.count, a.seed, out)
+
+    def report(r):
+        print("%-26s %-8s in view %6.1f s of %4.0f s (%3.0f %%), first seen %s, wall %.0f s"
+              % (r["scenario"], r["outcome"], r.get("in_view_time", 0), r.get("time_limit", 0),
+                 100 * r.get("in_view_fraction", 0), r.get("first_seen"), r["wall_s"]),
+              flush=True)
+
+    results = fly_all(dirs, out, a.jobs,
+                      lambda d, o, port: fly(d, o, a.pursue, a.time_limit, port), report)
     ok = sum(r["outcome"] == "success" for r in results)
     print("pursue %s, seed %d: %d of %d succeeded" % (a.pursue, a.seed, ok, len(results)))
     with open(os.path.join(out, "summary.json"), "w") as f:

@@ -1,5 +1,6 @@
-"""Shared by the seeded-mission benchmarks (bench_pursuit.py, bench_avoid.py): one mission flown
-in mission.launch (maneuver_only, lock-step, as fast as it goes) on its own ROS master."""
+"""Shared by the seeded-mission benchmarks (bench_pursuit.py, bench_follow.py, bench_avoid.py):
+the seeded scenarios generated, and each mission flown in mission.launch (maneuver_only,
+lock-step, as fast as it goes) on its own ROS master."""
 import json
 import os
 import subprocess
@@ -33,3 +34,44 @@ def fly_mission(scenario, out, port, args):
             return rc, wall, json.load(f)
     except (OSError, ValueError) as e:
         return rc, wall, "no metrics: %s" % e
+
+
+def generate(cls, count, seed, out, extra=()):
+    """`hameritt_generate --class CLS --count COUNT --seed SEED` into OUT/scenarios: the
+    scenario directories, in the manifest's order."""
+    scen = os.path.join(out, "scenarios")
+    subprocess.run(["rosrun", "hameritt", "hameritt_generate", "--class", cls, "--count",
+                    str(count), "--seed", str(seed), "--out", scen] + list(extra), check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(os.path.join(scen, "manifest.json")) as f:
+        manifest = json.load(f)
+    return [os.path.join(scen, s["path"]) for s in manifest["scenarios"]]
+
+
+def fly_all(dirs, out, jobs, fly, report):
+    """fly(scenario, out_prefix, port) for each scenario, `jobs` at once, each on its own ROS
+    master; report(result) prints each result in order. Returns the results."""
+    import concurrent.futures
+    results = []
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(fly, d, os.path.join(out, "run_%02d" % i),
+                               21000 + 17 * i + os.getpid() % 1000)
+                   for i, d in enumerate(dirs)]
+        for fut in futures:
+            r = fut.result()
+            results.append(r)
+            report(r)
+    return results
+
+
+def pursuit_arguments():
+    """The options bench_pursuit.py and bench_follow.py share: --count, --seed, --pursue,
+    --jobs, --out."""
+    import argparse
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--count", type=int, default=10)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--pursue", default="true", choices=["true", "false"])
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--out", default=None)
+    return ap

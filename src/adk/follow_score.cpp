@@ -48,6 +48,10 @@ FollowScorer::FollowScorer(const scenario::MissionPhase& phase)
   }
   criteria_.min_inside_fraction = phase.follow.min_inside_fraction;
   criteria_.max_outside_s = phase.follow.max_outside_s;
+  if (!(phase.follow.approach_s >= 0.0 && std::isfinite(phase.follow.approach_s))) {
+    throw scenario::ConfigError(where + "follow.approach_s: expected a finite number >= 0, got " +
+                                scenario::formatNumber(phase.follow.approach_s));
+  }
   if (!(criteria_.min_inside_fraction >= 0.0 && criteria_.min_inside_fraction <= 1.0)) {
     throw scenario::ConfigError(where + "follow.min_inside_fraction: expected [0, 1], got " +
                                 scenario::formatNumber(criteria_.min_inside_fraction));
@@ -64,12 +68,12 @@ void FollowScorer::start(double t) {
 }
 
 bool FollowScorer::complete() const {
-  return start_ && !samples_.empty() && samples_.back().t >= *start_ + *phase_.duration;
+  return scored_from_ && !samples_.empty() && samples_.back().t >= *scored_from_ + *phase_.duration;
 }
 
 bool FollowScorer::add(const FollowSample& s) {
   if (!start_ || s.t < *start_ || complete()) return false;
-  if (!std::isfinite(s.t) || (!samples_.empty() && !(s.t > samples_.back().t))) {
+  if (!std::isfinite(s.t) || (last_t_ && !(s.t > *last_t_))) {
     throw InputError("follow sample: t = " + scenario::formatNumber(s.t) +
                      " does not come after the previous sample");
   }
@@ -77,8 +81,15 @@ bool FollowScorer::add(const FollowSample& s) {
     throw InputError("follow sample at t = " + scenario::formatNumber(s.t) +
                      ": expected finite positions and yaw");
   }
+  last_t_ = s.t;
+  const bool inside = insideEnvelope(s, envelope_);
+  if (!scored_from_) {
+    // The approach: nothing is scored until the first entry or the end of the allowance.
+    if (!inside && s.t < *start_ + phase_.follow.approach_s) return true;
+    scored_from_ = s.t;
+  }
   samples_.push_back(s);
-  if (insideEnvelope(s, envelope_)) {
+  if (inside) {
     outside_since_.reset();
   } else if (!outside_since_) {
     outside_since_ = s.t;
@@ -98,7 +109,12 @@ FollowPhaseScore FollowScorer::score(double koz_seconds, bool collision, bool en
   r.koz_seconds = koz_seconds;
   r.collision = collision;
   r.envelope = scoreFollow(samples_, envelope_);
-  if (start_ && !samples_.empty()) r.elapsed = samples_.back().t - *start_;
+  if (scored_from_) {
+    r.approach_time = *scored_from_ - *start_;
+    r.elapsed = samples_.back().t - *scored_from_;
+  } else if (start_ && last_t_) {
+    r.approach_time = *last_t_ - *start_;
+  }
   r.outside = outside_since_.has_value();
   if (outside_since_) r.current_outside_s = samples_.back().t - *outside_since_;
   char buf[160];
@@ -112,6 +128,10 @@ FollowPhaseScore FollowScorer::score(double koz_seconds, bool collision, bool en
   } else if (r.envelope.longest_outside_s > criteria_.max_outside_s) {
     std::snprintf(buf, sizeof(buf), "outside the envelope for %.2f s at a stretch (at most %g s)",
                   r.envelope.longest_outside_s, criteria_.max_outside_s);
+    r.failure = buf;
+  } else if (!scored_from_) {
+    std::snprintf(buf, sizeof(buf), "the mission ended %.2f s into the approach (%g s allowed)",
+                  r.approach_time, phase_.follow.approach_s);
     r.failure = buf;
   } else if (!complete()) {
     std::snprintf(buf, sizeof(buf), "the mission ended %.2f s into the %g s phase", r.elapsed,

@@ -428,6 +428,7 @@ std::string metricsJson(const MissionMetrics& m) {
     o["success"] = f.success;
     o["failure"] = f.failure;
     o["start_time"] = opt(f.start_time);
+    o["approach_time"] = f.approach_time;
     o["duration"] = f.duration;
     o["elapsed"] = f.elapsed;
     o["samples"] = f.envelope.samples;

@@ -35,6 +35,8 @@ void PursuitSettings::validate() const {
   requirePositive(clearance, "clearance", true);
   requirePositive(margin_px, "margin_px", true);
   requirePositive(speed_window, "speed_window");
+  requirePositive(envelope_radius, "envelope_radius", true);
+  requirePositive(envelope_height, "envelope_height", true);
 }
 
 StreetPredictor::StreetPredictor(const scenario::World& world, const PursuitSettings& settings)
@@ -211,10 +213,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
   const Vec3 target = vehicle.position + Vec3(0, 0, kBodyHeight);
   const Vec2 g = vehicle.position.head<2>();
   const double ground = vehicle.position.z();
-  auto candidate = [&](double bearing, double range, double height) {
-    // bearing: from the vehicle's tail (0) counter-clockwise.
-    const double a = vehicle.yaw + geometry::kPi + bearing;
-    const Vec2 xy = g + range * Vec2(std::cos(a), std::sin(a));
+  auto at = [&](const Vec2& xy, double height) {
     PursuitView v;
     v.position = Vec3(xy.x(), xy.y(), safeAltitude(xy, ground + height));
     // Face the vehicle, or along its heading from straight above it.
@@ -222,7 +221,15 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
     v.yaw = to.norm() > 1.0 ? std::atan2(to.y(), to.x()) : vehicle.yaw;
     return v;
   };
-  const double h0 = settings_.height + std::max(0.0, climb);
+  auto candidate = [&](double bearing, double range, double height) {
+    // bearing: from the vehicle's tail (0) counter-clockwise.
+    const double a = vehicle.yaw + geometry::kPi + bearing;
+    return at(g + range * Vec2(std::cos(a), std::sin(a)), height);
+  };
+  // Following an envelope, the climb stops where the candidates would leave its height band.
+  const double max_climb =
+      settings_.envelope_radius > 0.0 ? 0.4 * settings_.envelope_height : climb;
+  const double h0 = settings_.height + std::clamp(climb, 0.0, std::max(0.0, max_climb));
   const PursuitView preferred = candidate(0.0, settings_.standoff, h0);
   if (!inKoz(preferred.position, t)) {
     if (auto cam = seenBy(preferred.position, preferred.yaw, target)) {
@@ -234,6 +241,36 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
   }
   std::optional<PursuitView> seen, fallback;
   double seen_cost = std::numeric_limits<double>::infinity(), fallback_cost = seen_cost;
+  // A candidate outside the keep-out zones, kept when it is the cheapest that sees the vehicle
+  // (or, while none does, the cheapest): close to the preferred viewpoint, then to the UAV.
+  auto consider = [&](PursuitView v) {
+    if (inKoz(v.position, t)) return;
+    const double cost = (v.position - preferred.position).norm() + 0.5 * (v.position - uav).norm();
+    if (cost >= seen_cost) return;
+    if (const auto cam = seenBy(v.position, v.yaw, target)) {
+      seen_cost = cost;
+      v.visible = true;
+      v.camera = *cam;
+      seen = v;
+    } else if (cost < fallback_cost) {
+      fallback_cost = cost;
+      fallback = v;
+    }
+  };
+  if (settings_.envelope_radius > 0.0) {
+    // Inside the envelope: the score is the envelope's, the sight line keeps the track.
+    const Vec2 centre = preferred.position.head<2>();
+    const double r = 0.6 * settings_.envelope_radius, dh = 0.6 * settings_.envelope_height;
+    for (double h : {h0, h0 + dh, h0 - dh}) {
+      for (int k = -1; k < 8; ++k) {
+        const double a = k * geometry::kPi / 4.0;
+        consider(at(k < 0 ? centre : centre + r * Vec2(std::cos(a), std::sin(a)), h));
+      }
+    }
+    if (seen) return *seen;
+    if (!inKoz(preferred.position, t)) return preferred;
+    if (fallback) return *fallback;
+  }
   const double s = settings_.standoff;
   const double ranges[] = {0.0, 0.5 * s, 1.5 * s + 4.0, 3.0 * s + 12.0};
   const double heights[] = {h0, h0 + 10.0};
@@ -241,22 +278,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
     for (double r : ranges) {
       for (int k = 0; k < 12; ++k) {
         if (r == 0.0 && k > 0) break;
-        PursuitView v = candidate(k * geometry::kPi / 6.0, r, h);
-        if (inKoz(v.position, t)) continue;
-        // Close to the preferred viewpoint and to the UAV, in that order.
-        const double cost =
-            (v.position - preferred.position).norm() + 0.5 * (v.position - uav).norm();
-        if (const auto cam = seenBy(v.position, v.yaw, target)) {
-          if (cost < seen_cost) {
-            seen_cost = cost;
-            v.visible = true;
-            v.camera = *cam;
-            seen = v;
-          }
-        } else if (cost < fallback_cost) {
-          fallback_cost = cost;
-          fallback = v;
-        }
+        consider(candidate(k * geometry::kPi / 6.0, r, h));
       }
     }
   }

@@ -1341,7 +1341,7 @@ class ScenarioBuilder {
     // node 6-12 street edges away.
     const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
     int slot = -1;
-    const Trajectory traj = driveOff(depart, true, &model, &slot, &pursuit_route_);
+    Trajectory traj = driveOff(depart, true, &model, &slot, &pursuit_route_);
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
     slot_taken_[static_cast<std::size_t>(slot)] = 1;
     const Vec2 fwd(std::cos(sl.yaw), std::sin(sl.yaw));
@@ -1444,7 +1444,10 @@ class ScenarioBuilder {
   // ------------------------------------------------------------------ follow
   // The follow class: pursuit's scene (a car that drives off after the pedestrians reach it),
   // in two phases: find it, then keep inside the envelope behind and above it for a drawn
-  // duration. The time limit is pursuit's plus that duration.
+  // duration. The scored duration starts at the first entry into the envelope after the find,
+  // within an approach allowance: the time to close kFindReach (the farthest a find lies from
+  // the envelope) on a target that drives away, at half the UAV's top speed, within
+  // [kMinApproach, kMaxApproach]. The time limit is pursuit's plus the allowance and duration.
   void buildFollow() {
     buildPursuit();
     Mission& m = sc_.mission;
@@ -1467,13 +1470,17 @@ class ScenarioBuilder {
                    uav_.altitude_min + f.height_tolerance, uav_.altitude_max - f.height_tolerance);
     const double duration = std::round(rangeDraw(rng_, cfg_.follow_duration));
     follow.duration = duration;
+    constexpr double kFindReach = 200.0, kMinApproach = 10.0, kMaxApproach = 60.0;  // m, s, s
+    f.approach_s =
+        std::clamp(std::ceil(kFindReach / (0.5 * uav_.max_speed)), kMinApproach, kMaxApproach);
     m.phases = {search, follow};
-    m.time_limit += duration;
+    m.time_limit += f.approach_s + duration;
     char text[256];
     std::snprintf(text, sizeof(text),
-                  " Then follow it for %.0f s: %.0f +- %.0f m behind it and %.0f +- %.0f m above "
-                  "it.",
-                  duration, f.distance, f.distance_tolerance, f.height, f.height_tolerance);
+                  " Then reach it within %.0f s and follow it for %.0f s: %.0f +- %.0f m behind it "
+                  "and %.0f +- %.0f m above it.",
+                  f.approach_s, duration, f.distance, f.distance_tolerance, f.height,
+                  f.height_tolerance);
     m.objective.text =
         "Find the " + lookText(m.objective.targets.front()) + " that pedestrians chase." + text;
   }
@@ -1560,6 +1567,8 @@ class ScenarioBuilder {
     TrajectoryPoint wait = start;
     wait.t = 0.0;
     traj.insert(traj.begin(), wait);  // waits in its lane until it departs
+    // In the city it stops at the signals, and behind the first target while that one waits.
+    traj = obeyCitySignals(traj, model->length, &lead->trajectory, lead->entity.box.size.x());
     Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
     m.objective.targets.push_back(describe(target));
     add(target, "target", traj);

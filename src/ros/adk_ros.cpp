@@ -502,8 +502,11 @@ void AdkRos::checkObjective(double t) {
     const std::string how = found_by_sighting_ ? "target sighted" : "target claimed";
     if (search_phase_) publishPhase(t, *search_phase_, adk::PhaseState::kSucceeded, how);
     publishPhase(t, follow_->phase(), adk::PhaseState::kActive, how);
-    ROS_INFO("adk: %s at t = %.3f s: the follow phase '%s' starts (%.0f s)", how.c_str(), t,
-             follow_->phase().id.c_str(), *follow_->phase().duration);
+    ROS_INFO(
+        "adk: %s at t = %.3f s: the follow phase '%s' starts (approach up to %g s, then "
+        "%.0f s scored)",
+        how.c_str(), t, follow_->phase().id.c_str(), follow_->phase().follow.approach_s,
+        *follow_->phase().duration);
     return;
   }
   if (lifecycle_->state() != adk::MissionState::kRunning || metrics_->isTrack()) return;
@@ -619,6 +622,7 @@ void AdkRos::publishFollow(double t, const adk::FollowPhaseScore& f) {
   m.target = f.target;
   m.state = adk::toString(f.state);
   m.start_time = f.start_time ? *f.start_time : std::nan("");
+  m.approach_time = f.approach_time;
   m.duration = f.duration;
   m.elapsed = f.elapsed;
   m.outside = f.outside;

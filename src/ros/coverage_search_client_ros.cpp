@@ -173,8 +173,13 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
     if (phase.type != scenario::PhaseType::kFollow) continue;
     pursuit_.standoff = phase.follow.distance;  // >= 0 (mission.json)
     if (phase.follow.height > 0) pursuit_.height = phase.follow.height;
-    ROS_INFO("%s: follow phase '%s': standoff %.1f m behind, %.1f m above the target", kClientName,
-             phase.id.c_str(), pursuit_.standoff, pursuit_.height);
+    pursuit_.envelope_radius = phase.follow.distance_tolerance;  // > 0 (mission.json)
+    pursuit_.envelope_height = phase.follow.height_tolerance;
+    ROS_INFO(
+        "%s: follow phase '%s': standoff %.1f m behind, %.1f m above the target, within "
+        "%.1f m and %.1f m",
+        kClientName, phase.id.c_str(), pursuit_.standoff, pursuit_.height, pursuit_.envelope_radius,
+        pursuit_.envelope_height);
   }
   if (pursue_) {
     chooser_ =
@@ -214,6 +219,18 @@ void CoverageSearchClientRos::replan(const std::string& why) {
   clients::SearchProgress progress{geometry::Vec3(p.x, p.y, p.z), missionTime(), covered_};
   try {
     plan_ = clients::planSearch(*mission_, settings_, progress);
+    // A target that drives off (pursuit, follow) leaves from its area of interest: when no cell
+    // can be reached before the windows close, the areas are searched past their windows.
+    const bool windows = std::any_of(mission_->aois.begin(), mission_->aois.end(),
+                                     [](const auto& a) { return a.window.nlt.has_value(); });
+    if (plan_.legs.empty() && !plan_.skipped.empty() && mission_->objective.type == "track" &&
+        windows) {
+      scenario::Mission open = *mission_;
+      for (auto& a : open.aois) a.window.nlt.reset();
+      plan_ = clients::planSearch(open, settings_, progress);
+      ROS_INFO("%s: no cell can be reached inside the windows: searching the areas past them",
+               kClientName);
+    }
   } catch (const std::exception& e) {
     ROS_ERROR("%s: planning the search failed: %s", kClientName, e.what());
     plan_ = {};

@@ -187,6 +187,7 @@ hameritt::Mission toMsg(const scenario::Mission& mission) {
     x.follow_height_tolerance = p.follow.height_tolerance;
     x.follow_min_inside_fraction = p.follow.min_inside_fraction;
     x.follow_max_outside_s = p.follow.max_outside_s;
+    x.follow_approach_s = p.follow.approach_s;
     x.track_min_visible_fraction = p.track.min_visible_fraction;
     x.track_min_box_area = p.track.min_box_area;
     x.track_min_tracked_fraction = p.track.min_tracked_fraction;
@@ -314,6 +315,7 @@ scenario::Mission fromMsg(const hameritt::Mission& m) {
     p.follow.height_tolerance = x.follow_height_tolerance;
     p.follow.min_inside_fraction = x.follow_min_inside_fraction;
     p.follow.max_outside_s = x.follow_max_outside_s;
+    p.follow.approach_s = x.follow_approach_s;
     p.track.min_visible_fraction = x.track_min_visible_fraction;
     p.track.min_box_area = x.track_min_box_area;
     p.track.min_tracked_fraction = x.track_min_tracked_fraction;

@@ -275,6 +275,7 @@ MissionPhase readPhase(const json& j, const std::string& path, const std::string
     Obj c = o.object("criteria");
     p.follow.min_inside_fraction = c.numberIn("min_inside_fraction", 0, 1);
     p.follow.max_outside_s = nonNegative(c, "max_outside_s");
+    p.follow.approach_s = nonNegative(c, "approach_s");
     c.finish();
   } else if (p.type == PhaseType::kTrack) {
     Obj c = o.object("criteria");

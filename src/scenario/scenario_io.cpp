@@ -113,6 +113,7 @@ void writePhase(JsonWriter& w, const MissionPhase& p) {
       w.key("criteria").beginObject();
       w.key("min_inside_fraction").value(p.follow.min_inside_fraction);
       w.key("max_outside_s").value(p.follow.max_outside_s);
+      w.key("approach_s").value(p.follow.approach_s);
       w.endObject();
       break;
     case PhaseType::kTrack:

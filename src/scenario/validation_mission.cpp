@@ -84,7 +84,7 @@ void Semantics::mission() {
   }
   // A follow mission finds its target, then follows it; a track mission finds its targets, then
   // keeps them in view: phases search and then follow (track) of the same targets, the second
-  // phase shorter than the time limit.
+  // phase (with a follow phase's approach allowance) shorter than the time limit.
   for (const std::string cls : {"follow", "track"}) {
     if (stringAt(doc_, "class") != std::optional<std::string>(cls)) continue;
     const std::string rule = cls + "_phase";
@@ -100,9 +100,13 @@ void Semantics::mission() {
     }
     const json* d = member(phases[1], "duration");
     const json* limit = member(doc_, "time_limit");
+    const json* c = member(phases[1], "criteria");
+    const json* a = c ? member(*c, "approach_s") : nullptr;
+    const double approach = a && a->is_number() ? a->get<double>() : 0.0;
     if (d && limit && d->is_number() && limit->is_number() &&
-        !(d->get<double>() < limit->get<double>())) {
-      add("/phases/1/duration", rule, "expected less than the mission's time_limit");
+        !(d->get<double>() + approach < limit->get<double>())) {
+      add("/phases/1/duration", rule,
+          "expected duration + criteria.approach_s less than the mission's time_limit");
     }
   }
 }

@@ -1,6 +1,8 @@
 // The follow phase's score: a vehicle that stays in the envelope behind a driving target
 // succeeds; the same flight with an 11 s excursion (the negative control) fails on the
-// 10 s rule, and one that hovers where the target was found fails on both rules.
+// 10 s rule, and one that hovers where the target was found fails on both rules. The scored
+// part starts at the first entry within the approach allowance; an approach 11 s longer than
+// the allowance fails on the 10 s rule.
 #include "hameritt/adk/follow_score.h"
 
 #include <gtest/gtest.h>
@@ -130,6 +132,88 @@ TEST(FollowScore, SearchCollisionKozAndEarlyEndFail) {
   EXPECT_NE(r.failure.find("ended 30.00 s into the 60 s phase"), std::string::npos) << r.failure;
 }
 
+// The target drives east at 8 m/s from x = 0 at t = 20 (the find) with a 30 s approach
+// allowance; the vehicle hovers 100 m behind it until `enter` and then keeps inside the
+// envelope (or at 20 m too high between `away_from` and `away_to`). Sampled every 0.1 s from
+// t = 10 to t = 150; `last` ends the mission early.
+FollowScorer approach(double enter, double last = 150.0) {
+  scenario::MissionPhase p = followPhase();
+  p.follow.approach_s = 30.0;
+  FollowScorer s(p);
+  for (int i = 100; i <= static_cast<int>(last * 10.0 + 0.5); ++i) {
+    const double t = i / 10.0;
+    if (i == 200) s.start(t);
+    FollowSample f;
+    f.t = t;
+    f.target = Vec3(std::max(0.0, 8.0 * (t - 20.0)), 0.0, 0.0);
+    f.vehicle = t < enter ? Vec3(-100.0, 0.0, 25.0) : f.target + Vec3(-15.0, 1.0, 24.0);
+    s.add(f);
+  }
+  return s;
+}
+
+TEST(FollowScore, ScoringStartsAtTheFirstEntryWithinTheAllowance) {
+  // In at t = 32.5, 12.5 s after the find: the 60 s are scored from there, all inside.
+  const FollowScorer s = approach(32.5);
+  ASSERT_TRUE(s.scoredFrom().has_value());
+  EXPECT_NEAR(*s.scoredFrom(), 32.5, 1e-9);
+  EXPECT_TRUE(s.complete());
+  const FollowPhaseScore r = s.score(0.0, false, true);
+  EXPECT_TRUE(r.success) << r.failure;
+  EXPECT_NEAR(*r.start_time, 20.0, 1e-9);
+  EXPECT_NEAR(r.approach_time, 12.5, 1e-9);
+  EXPECT_NEAR(r.elapsed, 60.0, 1e-6);
+  EXPECT_EQ(r.envelope.samples, 601u);  // t = 32.5 ... 92.5
+  EXPECT_NEAR(r.envelope.inside_fraction, 1.0, 1e-9);
+  EXPECT_DOUBLE_EQ(r.envelope.longest_outside_s, 0.0);
+  // Control: with no allowance the same flight is scored from the find and fails on the
+  // 12.5 s outside at its start.
+  scenario::MissionPhase p = followPhase();
+  FollowScorer none(p);
+  for (int i = 200; i <= 1500; ++i) {
+    const double t = i / 10.0;
+    if (i == 200) none.start(t);
+    FollowSample f;
+    f.t = t;
+    f.target = Vec3(8.0 * (t - 20.0), 0.0, 0.0);
+    f.vehicle = t < 32.5 ? Vec3(-100.0, 0.0, 25.0) : f.target + Vec3(-15.0, 1.0, 24.0);
+    none.add(f);
+  }
+  const FollowPhaseScore n = none.score(0.0, false, true);
+  EXPECT_FALSE(n.success);
+  EXPECT_DOUBLE_EQ(n.approach_time, 0.0);
+  EXPECT_NEAR(n.envelope.longest_outside_s, 12.5, 1e-6);
+}
+
+TEST(FollowScore, AnApproachLongerThanTheAllowanceCountsAsOutside) {
+  // Negative control: in at t = 61, 41 s after the find: the allowance ends at t = 50 and the
+  // 11 s after it are outside, past the 10 s rule.
+  const FollowScorer late = approach(61.0);
+  EXPECT_TRUE(late.failedEarly());
+  FollowPhaseScore r = late.score(0.0, false, true);
+  EXPECT_FALSE(r.success);
+  EXPECT_NEAR(r.approach_time, 30.0, 1e-9);
+  EXPECT_NEAR(r.envelope.longest_outside_s, 11.0, 1e-6);
+  EXPECT_NE(r.failure.find("outside the envelope for 11.00 s"), std::string::npos) << r.failure;
+  // In at t = 56, 6 s after the allowance: within the 10 s rule, and the 6 s count as outside
+  // in the fraction (54 of 60 s inside).
+  r = approach(56.0).score(0.0, false, true);
+  EXPECT_TRUE(r.success) << r.failure;
+  EXPECT_NEAR(r.approach_time, 30.0, 1e-9);
+  EXPECT_NEAR(r.envelope.longest_outside_s, 6.0, 1e-6);
+  EXPECT_NEAR(r.envelope.inside_fraction, 54.0 / 60.0, 1e-6);
+  // The mission ends during the approach: active until then, failed at the end.
+  const FollowScorer cut = approach(1000.0, 40.0);
+  EXPECT_FALSE(cut.scoredFrom().has_value());
+  EXPECT_EQ(cut.score(0.0, false, false).state, PhaseState::kActive);
+  r = cut.score(0.0, false, true);
+  EXPECT_EQ(r.state, PhaseState::kFailed);
+  EXPECT_NEAR(r.approach_time, 20.0, 1e-9);
+  EXPECT_EQ(r.envelope.samples, 0u);
+  EXPECT_NE(r.failure.find("ended 20.00 s into the approach (30 s allowed)"), std::string::npos)
+      << r.failure;
+}
+
 TEST(FollowScore, BadInputIsRefused) {
   scenario::MissionPhase p = followPhase();
   p.follow.distance_tolerance = 0.0;
@@ -140,6 +224,17 @@ TEST(FollowScore, BadInputIsRefused) {
   p = followPhase();
   p.type = scenario::PhaseType::kTrack;
   EXPECT_THROW(FollowScorer{p}, scenario::ConfigError);
+  for (double bad : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    p = followPhase();
+    p.follow.approach_s = bad;
+    std::string what;
+    try {
+      FollowScorer{p};
+    } catch (const scenario::ConfigError& e) {
+      what = e.what();
+    }
+    EXPECT_NE(what.find("follow.approach_s"), std::string::npos) << what;
+  }
 
   FollowScorer s(followPhase());
   s.start(0.0);

@@ -78,6 +78,9 @@ TEST(Pursuit, SettingsNameTheBadField) {
   s = PursuitSettings();
   s.height = std::nan("");
   EXPECT_THROW(s.validate(), scenario::ConfigError);
+  s = PursuitSettings();
+  s.envelope_radius = -1.0;
+  EXPECT_THROW(s.validate(), scenario::ConfigError);
 }
 
 TEST(Pursuit, PredictionFollowsTheStreetRoundACorner) {
@@ -206,14 +209,10 @@ TEST(Pursuit, ViewpointSeesTheVehiclePastOccluders) {
   EXPECT_GT(preferred_used, tested / 2);
 }
 
-TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
-  // A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its
-  // edge: the preferred viewpoint (8 m behind, 20 m above) often looks through the occluder.
-  const auto& w = world();
-  PursuitSettings settings;
-  const ViewpointChooser chooser(w, sim().uav, {}, settings);
-  const auto& occ = w.occluders();
-  int hidden = 0, recovered = 0;
+// A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its edge.
+std::vector<VehicleState> pastTallOccluders() {
+  std::vector<VehicleState> out;
+  const auto& occ = world().occluders();
   for (std::size_t i = 0; i < occ.size(); ++i) {
     const auto& box = occ.box(static_cast<int>(i));
     if (box.maxZ() < 5.0) continue;
@@ -222,6 +221,20 @@ TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
     VehicleState v;
     v.position = Vec3(p.x(), p.y(), 0.0);
     v.yaw = std::atan2(u.y(), u.x());
+    out.push_back(v);
+  }
+  return out;
+}
+
+TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
+  // A vehicle driving away from each tall occluder (house, garage, canopy), 2.5 m past its
+  // edge: the preferred viewpoint (8 m behind, 20 m above) often looks through the occluder.
+  const auto& w = world();
+  PursuitSettings settings;
+  const ViewpointChooser chooser(w, sim().uav, {}, settings);
+  int hidden = 0, recovered = 0;
+  for (const VehicleState& v : pastTallOccluders()) {
+    const Vec2 p = v.position.head<2>(), u(std::cos(v.yaw), std::sin(v.yaw));
     const Vec3 centre = v.position + Vec3(0, 0, 0.8);
     const Vec2 behind = p - u * settings.standoff;
     const PursuitView view = chooser.choose(v, v.position + Vec3(0, 0, 30), 0.0);
@@ -238,6 +251,50 @@ TEST(Pursuit, ViewpointMovesOffAnOccludedStandoff) {
   EXPECT_GT(hidden, 10);
   // ... and the chooser finds a viewpoint that sees nearly every one.
   EXPECT_GE(recovered, hidden * 9 / 10);
+}
+
+TEST(Pursuit, ViewpointStaysInsideTheEnvelopeWhenFollowing) {
+  // The same hidden vehicles, followed with a 10 m standoff and a 5 m envelope: every viewpoint
+  // stays within the envelope's radius of the point 10 m behind, and some of the hidden ones
+  // are still seen from inside it. Negative control: without the envelope the chooser leaves it.
+  const auto& w = world();
+  PursuitSettings free_settings;
+  free_settings.standoff = 10.0;
+  PursuitSettings follow_settings = free_settings;
+  follow_settings.envelope_radius = 5.0;
+  follow_settings.envelope_height = 5.0;
+  const ViewpointChooser free_chooser(w, sim().uav, {}, free_settings);
+  const ViewpointChooser follow_chooser(w, sim().uav, {}, follow_settings);
+  int hidden = 0, seen_inside = 0, free_outside = 0;
+  for (const VehicleState& v : pastTallOccluders()) {
+    const Vec2 p = v.position.head<2>(), u(std::cos(v.yaw), std::sin(v.yaw));
+    const Vec3 centre = v.position + Vec3(0, 0, 0.8);
+    const Vec2 behind = p - u * follow_settings.standoff;
+    const Vec3 uav = v.position + Vec3(0, 0, 30);
+    const PursuitView view = follow_chooser.choose(v, uav, 0.0);
+    EXPECT_LE((view.position.head<2>() - behind).norm(), 5.0 + 1e-9);
+    const Vec3 pref(behind.x(), behind.y(), view.position.z());
+    if (follow_chooser.seenBy(pref, v.yaw, centre)) continue;
+    ++hidden;
+    if (view.visible && follow_chooser.seenBy(view.position, view.yaw, centre)) ++seen_inside;
+    const PursuitView loose = free_chooser.choose(v, uav, 0.0);
+    free_outside += (loose.position.head<2>() - behind).norm() > 5.0;
+  }
+  std::printf(
+      "%d vehicles hidden from 10 m behind: %d seen from inside the envelope, %d "
+      "viewpoints outside it without the envelope\n",
+      hidden, seen_inside, free_outside);
+  EXPECT_GT(hidden, 10);
+  EXPECT_GT(seen_inside, 0);
+  EXPECT_GT(free_outside, 0);  // the control: the unconstrained choice leaves the envelope
+  // Lost, it climbs at most 0.4 H (2 m) above h*, where the free chooser climbs the 15 m asked.
+  VehicleState v;
+  v.position = Vec3(world().nodes()[0].position.x(), world().nodes()[0].position.y(), 0.0);
+  const Vec3 uav = v.position + Vec3(0, 0, 30);
+  const double ground = follow_chooser.choose(v, uav, 0.0).position.z();
+  EXPECT_LE(follow_chooser.choose(v, uav, 0.0, 15.0).position.z(), ground + 2.0 + 1e-9);
+  EXPECT_GT(free_chooser.choose(v, uav, 0.0, 15.0).position.z(),
+            free_chooser.choose(v, uav, 0.0).position.z() + 5.0);
 }
 
 TEST(Pursuit, ViewpointStaysOutOfActiveKeepOutZones) {

@@ -63,6 +63,7 @@ TEST(MissionConversions, PhasesRoundTrip) {
   follow.follow.distance_tolerance = 6.0;
   follow.follow.height = 31.0;
   follow.follow.height_tolerance = 7.0;
+  follow.follow.approach_s = 34.0;
   track.id = "track_1";
   track.type = scenario::PhaseType::kTrack;
   track.targets = {target};
@@ -79,6 +80,7 @@ TEST(MissionConversions, PhasesRoundTrip) {
   EXPECT_EQ(msg.phases[1].type, "follow");
   EXPECT_DOUBLE_EQ(msg.phases[1].follow_height, 31.0);
   EXPECT_EQ(scenario::missionJson(fromMsg(msg)), json);
+  EXPECT_DOUBLE_EQ(msg.phases[1].follow_approach_s, 34.0);
   msg.phases[1].follow_distance = 13.0;  // control: a changed field shows
   EXPECT_NE(scenario::missionJson(fromMsg(msg)), json);
   msg.phases[2].type = "escort";

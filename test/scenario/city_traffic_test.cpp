@@ -364,7 +364,7 @@ Trajectory withoutWaits(const Trajectory& traj) {
   return out;
 }
 
-// The mission's own cars (the targets of route searches, pursuits and follows, the avoid
+// The mission's own cars (the targets of route searches, pursuits, follows and tracks, the avoid
 // class' hostile vehicle) of city scenarios over many seeds, judged from the written files like
 // the ambient cars: none enters an intersection box against its signal. Negative controls: the
 // same cars against the plan shifted by half a cycle, and with their waits cut out (driving on
@@ -375,7 +375,7 @@ TEST(CityTraffic, MissionVehiclesObeyTheSignals) {
   int scenarios = 0, cars = 0, waiting = 0, validator_shifted = 0;
   EntryReport r, shifted, unwaited;
   for (ScenarioClass cls : {ScenarioClass::kRouteSearch, ScenarioClass::kPursuit,
-                            ScenarioClass::kFollow, ScenarioClass::kAvoid}) {
+                            ScenarioClass::kFollow, ScenarioClass::kTrack, ScenarioClass::kAvoid}) {
     for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
       SCOPED_TRACE(std::string(toString(cls)) + " seed " + std::to_string(seed));
       Scenario g = generateScenario(cityWorld(), quickConfig(), cls, seed);
@@ -430,7 +430,7 @@ TEST(CityTraffic, MissionVehiclesObeyTheSignals) {
       "%d; the validator on the shifted plans: %d\n",
       scenarios, cars, waiting, r.entries, r.turns, r.on_red, shifted.on_red, shifted.entries,
       unwaited.on_red, unwaited.entries, validator_shifted);
-  EXPECT_EQ(scenarios, 4 * kSeeds);
+  EXPECT_EQ(scenarios, 5 * kSeeds);
   EXPECT_GE(cars, scenarios);
   EXPECT_GT(waiting, cars / 4);
   EXPECT_GT(r.entries, 2 * scenarios);

@@ -4,6 +4,8 @@
 // follow_phase rule catches doctored missions (the negative controls).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "hameritt/scenario/mission_io.h"
@@ -45,8 +47,11 @@ void expectWellPosed(const Scenario& s) {
   EXPECT_LE(f.height + f.height_tolerance, s.sim.uav.altitude_max + 1e-9);
   EXPECT_DOUBLE_EQ(f.min_inside_fraction, 0.8);
   EXPECT_DOUBLE_EQ(f.max_outside_s, 10.0);
-  // The time limit leaves the search pursuit's time and the whole follow phase.
-  EXPECT_GE(s.mission.time_limit, c.time_limit_pursuit.min + *follow.duration - 1.0);
+  // The approach allowance: 200 m closed at half the UAV's top speed, within [10, 60] s.
+  EXPECT_DOUBLE_EQ(f.approach_s,
+                   std::clamp(std::ceil(200.0 / (0.5 * s.sim.uav.max_speed)), 10.0, 60.0));
+  // The time limit leaves the search pursuit's time, the approach and the whole follow phase.
+  EXPECT_GE(s.mission.time_limit, c.time_limit_pursuit.min + f.approach_s + *follow.duration - 1.0);
   // The target drives (a trajectory with more than the waiting samples).
   bool moving = false;
   for (const auto& e : s.sim.entities) {
@@ -67,7 +72,9 @@ TEST(FollowGeneratorTest, ScenariosAreWellPosedInTheSuburbAndTheCity) {
 TEST(FollowGeneratorTest, DeterministicAndPursuitUnchanged) {
   // The follow scene is pursuit's with the same seed: the target, its look and its trajectory.
   const auto [a, p] = expectDeterministicOverPursuit(ScenarioClass::kFollow, 7);
-  EXPECT_DOUBLE_EQ(a.mission.time_limit, p.mission.time_limit + *a.mission.phases[1].duration);
+  EXPECT_DOUBLE_EQ(
+      a.mission.time_limit,
+      p.mission.time_limit + a.mission.phases[1].follow.approach_s + *a.mission.phases[1].duration);
 }
 
 TEST(FollowGeneratorTest, FollowPhaseRuleCatchesDoctoredMissions) {
@@ -83,6 +90,12 @@ TEST(FollowGeneratorTest, FollowPhaseRuleCatchesDoctoredMissions) {
       << rules(issues(m));
   m = good;
   m["phases"][1]["duration"] = m["time_limit"].get<double>() + 1.0;
+  EXPECT_NE(rules(issues(m)).find("follow_phase /phases/1/duration"), std::string::npos)
+      << rules(issues(m));
+  // A duration that fits the limit only without the approach allowance.
+  m = good;
+  m["phases"][1]["duration"] = m["time_limit"].get<double>() - 1.0;
+  ASSERT_GT(m["phases"][1]["criteria"]["approach_s"].get<double>(), 1.0);
   EXPECT_NE(rules(issues(m)).find("follow_phase /phases/1/duration"), std::string::npos)
       << rules(issues(m));
   m = good;

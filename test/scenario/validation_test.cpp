@@ -591,6 +591,7 @@ std::vector<MissionPhase> everyPhase(const std::string& target) {
   ph[1].duration = 120.0;
   ph[1].follow.distance = 12.5;
   ph[1].follow.height_tolerance = 4.0;
+  ph[1].follow.approach_s = 30.0;
   ph[2].id = "watch";
   ph[2].type = PhaseType::kTrack;
   ph[2].targets = {target};
@@ -619,6 +620,7 @@ TEST_F(ValidationTest, PhasesRoundTripAndValidate) {
   EXPECT_EQ(*back.phases[1].duration, 120.0);
   EXPECT_EQ(back.phases[1].follow.distance, 12.5);
   EXPECT_EQ(back.phases[1].follow.height_tolerance, 4.0);
+  EXPECT_EQ(back.phases[1].follow.approach_s, 30.0);
   EXPECT_EQ(back.phases[2].track.min_box_area, 900.0);
   EXPECT_FALSE(back.phases[3].duration.has_value());
   EXPECT_EQ(back.phases[3].avoid.goal, geometry::Vec3(10.0, -20.5, 30.0));

@@ -9,7 +9,8 @@ mission.launch, maneuver_only, lock-step, as fast as it goes. Twice:
 
   * pursue:=true (the default): metrics.json (valid against config/schema/metrics.schema.json,
     python3-jsonschema) has a `follow` block; the phase started at the find and ran its whole
-    duration (never outside the envelope longer than max_outside_s); the outcome is "success"
+    duration after an approach within the allowance approach_s (scored from the first entry into
+    the envelope; never outside it longer than max_outside_s); the outcome is "success"
     exactly when the follow phase succeeded; the client's log says it took d* and h* from the
     mission; adk/phase (read with `rostopic echo`, not our code) carried search_1 active,
     search_1 succeeded and follow_1 active at the find, then follow_1 in the block's state;
@@ -17,10 +18,10 @@ mission.launch, maneuver_only, lock-step, as fast as it goes. Twice:
     failed on its outside rule before its end, inside the envelope at least 50 points less than
     the pursuit, and adk/phase ends with follow_1 failed.
 
-Whether the baseline meets the 80 % inside criterion is printed, not asserted: on seed 3 it
-does not (it reaches the envelope about 9 s after the find, from 115 m away, and drifts out on
-turns). The envelope figures are the ADK's (ground truth: the target's scripted trajectory),
-not the client's own account.
+Whether the baseline meets the 80 % inside criterion is printed, not asserted (on seed 3 it
+does: it reaches the envelope about 9 s after the find, within the 34 s allowance, and is
+inside 83 % of the scored 65 s). The envelope figures are the ADK's (ground truth: the
+target's scripted trajectory), not the client's own account.
 """
 import csv
 import json
@@ -72,11 +73,13 @@ def run(tmp, scenario, pursue):
     check("follow" in m, "%s: metrics.json has no follow block" % label)
     changes = phase_changes(phases)
     f = m.get("follow", {})
-    print("%s: outcome %s (%s), end_time %.1f s; follow phase %s from %s: %.1f of %.0f s, "
+    print("%s: outcome %s (%s), end_time %.1f s; follow phase %s from %s, approach %.1f s, "
+          "then %.1f of %.0f s scored, "
           "inside %.1f %%, longest outside %.1f s, RMS distance error %.2f m, p95 %.2f m, "
           "line of sight %.1f %%; adk/phase: %s" % (
               label, m["outcome"], m["reason"], m["end_time"], f.get("state"),
-              f.get("start_time"), f.get("elapsed", 0), f.get("duration", 0),
+              f.get("start_time"), f.get("approach_time", 0), f.get("elapsed", 0),
+              f.get("duration", 0),
               100 * f.get("inside_fraction", 0), f.get("longest_outside", 0),
               f.get("rms_distance_error", 0), f.get("p95_distance_error", 0),
               100 * f.get("line_of_sight_fraction", 0), changes))
@@ -92,8 +95,10 @@ def main():
             mission = json.load(fh)
         phase = mission["phases"][1]
         env, crit = phase["envelope"], phase["criteria"]
-        print("scenario %s (seed %d): follow %s for %g s, %g +- %g m behind, %g +- %g m above" % (
+        print("scenario %s (seed %d): follow %s for %g s after an approach of up to %g s, "
+              "%g +- %g m behind, %g +- %g m above" % (
             os.path.basename(scenario), SEED, phase["targets"][0], phase["duration"],
+            crit["approach_s"],
             env["distance"], env["distance_tolerance"], env["height"], env["height_tolerance"]))
         m, text, changes = run(tmp, scenario, True)
         inside = None
@@ -105,8 +110,11 @@ def main():
                   "follow: %.1f s of the %g s phase flown" % (f["elapsed"], phase["duration"]))
             check(f["longest_outside"] <= crit["max_outside_s"],
                   "follow: outside %.1f s > %g s" % (f["longest_outside"], crit["max_outside_s"]))
+            check(f["approach_time"] <= crit["approach_s"] + 0.5,
+                  "follow: approach %.1f s > the %g s allowance" % (f["approach_time"],
+                                                                    crit["approach_s"]))
             check(f["start_time"] is not None and
-                  abs(m["end_time"] - f["start_time"] - f["elapsed"]) < 0.5,
+                  abs(m["end_time"] - f["start_time"] - f["approach_time"] - f["elapsed"]) < 0.5,
                   "follow: the mission did not end at the phase's end")
             check((m["outcome"] == "success") == f["success"],
                   "follow: outcome %r with the follow phase %s" % (m["outcome"], f["state"]))

@@ -1,9 +1,12 @@
 #pragma once
-// The follow phase's score, kept up sample by sample: the vehicle's states and the target's
-// ground truth from the phase's start (the find that ends the search phase) to its duration,
-// scored by scoreFollow (navigation_metrics.h). Success: inside the envelope at least
-// min_inside_fraction of the phase, never outside longer than max_outside_s, no collision, no
-// keep-out violation during the phase, and the whole phase flown. ROS-free.
+// The follow phase's score, kept up sample by sample. The phase starts at the find that ends
+// the search phase; the vehicle then approaches the envelope, and the scored part of the phase
+// (its `duration`) starts at the first sample inside the envelope, or at the first sample
+// approach_s after the find if none was inside by then. From there the vehicle's states and
+// the target's ground truth are scored by scoreFollow (navigation_metrics.h). Success: inside
+// the envelope at least min_inside_fraction of the scored part, never outside longer than
+// max_outside_s in it, no collision and no keep-out violation from the find on, and the whole
+// duration flown. ROS-free.
 
 #include <optional>
 #include <string>
@@ -24,8 +27,9 @@ struct FollowPhaseScore {
   std::string target;  // the followed target's id
   PhaseState state = PhaseState::kPending;
   std::optional<double> start_time;  // the find
-  double duration = 0.0;             // the phase's, from mission.json
-  double elapsed = 0.0;              // of the phase, up to the last sample scored
+  double approach_time = 0.0;        // from the find to the scored part's start (or so far)
+  double duration = 0.0;             // the scored part's, from mission.json
+  double elapsed = 0.0;              // of the scored part, up to the last sample scored
   bool outside = false;              // the last sample lay outside the envelope
   double current_outside_s = 0.0;    // how long it has been outside (0 when inside)
   FollowScore envelope;              // inside fraction, errors, line of sight, longest outside
@@ -41,13 +45,16 @@ class FollowScorer {
   // naming "follow.<field>" for a bad envelope, criteria or duration.
   explicit FollowScorer(const scenario::MissionPhase& phase);
 
-  // The search phase succeeded at t: the follow phase begins. Later calls are ignored.
+  // The search phase succeeded at t: the follow phase begins with its approach. Later calls
+  // are ignored.
   void start(double t);
   bool started() const { return start_.has_value(); }
+  // The approach is over: the scored part has begun (at this time).
+  std::optional<double> scoredFrom() const { return scored_from_; }
   // One sample. Before the start or after the phase's end it is ignored (false). InputError
   // for a stamp that does not increase or a non-finite value, before anything is kept.
   bool add(const FollowSample& sample);
-  // The phase's duration has been flown (a sample at or after start + duration).
+  // The phase's duration has been flown (a sample at or after the scored start + duration).
   bool complete() const;
   // The phase can no longer succeed: it has been outside the envelope for longer than
   // max_outside_s at a stretch (it stays so once it has happened).
@@ -65,6 +72,8 @@ class FollowScorer {
   FollowEnvelope envelope_;
   FollowCriteria criteria_;
   std::optional<double> start_;
+  std::optional<double> scored_from_;
+  std::optional<double> last_t_;  // of any sample kept or used for the approach
   std::vector<FollowSample> samples_;
   std::optional<double> outside_since_;
   bool exceeded_ = false;

@@ -25,6 +25,11 @@ struct PursuitSettings {
   double clearance = 4.0;        // m above the tallest occluder near the UAV and the viewpoint
   double margin_px = 20.0;       // the vehicle's centre projects this far inside the image
   double speed_window = 1.0;     // s of sightings that estimate the speed
+  // Following an envelope (a follow phase): viewpoints only within envelope_radius
+  // (horizontally) of the point `standoff` behind the vehicle and within envelope_height of
+  // `height`, the centre when none of them sees the vehicle. 0: any viewpoint that sees it.
+  double envelope_radius = 0.0;
+  double envelope_height = 0.0;
   // Throws scenario::ConfigError naming "pursuit.<field>" and the bad value.
   void validate() const;
 };
@@ -80,13 +85,17 @@ struct PursuitView {
 // Chooses the viewpoint: the preferred one (standoff behind, height above, facing the vehicle's
 // heading), else the nearest of a ring of candidates around the vehicle (12 bearings x 4
 // standoffs x 2 heights, nadir included) from which a camera sees it; candidates inside a
-// keep-out zone active at t whose band holds the altitude are skipped. All candidates are
-// clamped into the altitude band and kept `clearance` above nearby occluders.
+// keep-out zone active at t whose band holds the altitude are skipped. With an envelope
+// (PursuitSettings::envelope_radius), the candidates lie inside it (8 bearings at 0.6 of its
+// radius x 3 heights) and its centre is kept when none sees the vehicle; the ring only when
+// the whole envelope is in a keep-out zone. All candidates are clamped into the altitude band
+// and kept `clearance` above nearby occluders.
 class ViewpointChooser {
  public:
   ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
                    const std::vector<scenario::KeepOutZone>& kozs, const PursuitSettings& settings);
-  // `climb`: metres added to the height (a wider view while the vehicle is lost). When no
+  // `climb`: metres added to the height (a wider view while the vehicle is lost; with an
+  // envelope at most 0.4 of its height tolerance). When no
   // candidate sees the vehicle, the nearest one outside the keep-out zones (visible false).
   PursuitView choose(const VehicleState& vehicle, const geometry::Vec3& uav, double t,
                      double climb = 0.0) const;

@@ -152,7 +152,8 @@ bool parsePhaseType(const std::string& s, PhaseType* out);
 
 // The follow envelope in the target's frame (x along its heading, z up) and the phase's
 // success test: inside at least min_inside_fraction of the phase, never outside longer than
-// max_outside_s.
+// max_outside_s. The phase's scored `duration` starts at the vehicle's first entry into the
+// envelope after the find, or approach_s after the find if it has not entered by then.
 struct FollowPhaseSpec {
   double distance = 15.0;            // d*, metres behind the target
   double distance_tolerance = 5.0;   // D, horizontal radius around that point
@@ -160,6 +161,7 @@ struct FollowPhaseSpec {
   double height_tolerance = 5.0;     // H
   double min_inside_fraction = 0.8;  // of the phase
   double max_outside_s = 10.0;
+  double approach_s = 0.0;  // allowance from the find to the envelope, seconds
 };
 
 // When a target counts as tracked in a frame, and the phase's success test: tracked at least
