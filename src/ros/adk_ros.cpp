@@ -474,39 +474,40 @@ void AdkRos::judgeTrackAtLimit(double t) {
   }
 }
 
+std::optional<std::string> AdkRos::phaseStartsAtFind(double t, bool started,
+                                                     const scenario::MissionPhase& phase) {
+  if (lifecycle_->state() != adk::MissionState::kRunning || started) return std::nullopt;
+  const auto& targets = metrics_->targets();
+  if (!std::all_of(targets.begin(), targets.end(), [](const auto& tm) { return tm.found; })) {
+    return std::nullopt;
+  }
+  const std::string noun = targets.size() == 1 ? "target" : "targets";
+  const std::string how = noun + (found_by_sighting_ ? " sighted" : " claimed");
+  if (search_phase_) publishPhase(t, *search_phase_, adk::PhaseState::kSucceeded, how);
+  publishPhase(t, phase, adk::PhaseState::kActive, how);
+  return how;
+}
+
 void AdkRos::checkObjective(double t) {
+  // The search phase ends at the find: the track or follow phase starts.
   if (track_) {
-    // The search phase ends at the find: the track phase starts.
-    if (lifecycle_->state() != adk::MissionState::kRunning || track_->started()) return;
-    const auto& targets = metrics_->targets();
-    if (!std::all_of(targets.begin(), targets.end(), [](const auto& tm) { return tm.found; })) {
-      return;
+    if (const auto how = phaseStartsAtFind(t, track_->started(), track_->phase())) {
+      track_->start(t);
+      ROS_INFO("adk: %s at t = %.3f s: the track phase '%s' starts (%.0f s)", how->c_str(), t,
+               track_->phase().id.c_str(), *track_->phase().duration);
     }
-    track_->start(t);
-    const std::string how = found_by_sighting_ ? "targets sighted" : "targets claimed";
-    if (search_phase_) publishPhase(t, *search_phase_, adk::PhaseState::kSucceeded, how);
-    publishPhase(t, track_->phase(), adk::PhaseState::kActive, how);
-    ROS_INFO("adk: %s at t = %.3f s: the track phase '%s' starts (%.0f s)", how.c_str(), t,
-             track_->phase().id.c_str(), *track_->phase().duration);
     return;
   }
   if (follow_) {
-    // The search phase ends at the find: the follow phase starts.
-    if (lifecycle_->state() != adk::MissionState::kRunning || follow_->started()) return;
-    const auto& targets = metrics_->targets();
-    if (!std::all_of(targets.begin(), targets.end(), [](const auto& tm) { return tm.found; })) {
-      return;
+    if (const auto how = phaseStartsAtFind(t, follow_->started(), follow_->phase())) {
+      follow_->start(t);
+      follow_koz_start_ = monitor_->violationDuration();
+      ROS_INFO(
+          "adk: %s at t = %.3f s: the follow phase '%s' starts (approach up to %g s, then "
+          "%.0f s scored)",
+          how->c_str(), t, follow_->phase().id.c_str(), follow_->phase().follow.approach_s,
+          *follow_->phase().duration);
     }
-    follow_->start(t);
-    follow_koz_start_ = monitor_->violationDuration();
-    const std::string how = found_by_sighting_ ? "target sighted" : "target claimed";
-    if (search_phase_) publishPhase(t, *search_phase_, adk::PhaseState::kSucceeded, how);
-    publishPhase(t, follow_->phase(), adk::PhaseState::kActive, how);
-    ROS_INFO(
-        "adk: %s at t = %.3f s: the follow phase '%s' starts (approach up to %g s, then "
-        "%.0f s scored)",
-        how.c_str(), t, follow_->phase().id.c_str(), follow_->phase().follow.approach_s,
-        *follow_->phase().duration);
     return;
   }
   if (lifecycle_->state() != adk::MissionState::kRunning || metrics_->isTrack()) return;

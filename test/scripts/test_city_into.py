@@ -17,25 +17,7 @@ import subprocess
 import sys
 import tempfile
 
-BIN = os.environ["HAMERITT_BIN_DIR"]
-SRC = os.environ["HAMERITT_SOURCE_DIR"]
-ENV = dict(os.environ, HAMERITT_CONFIG_DIR=os.path.join(SRC, "config"))
-passed = 0
-failed = 0
-
-
-def check(cond, name, why=""):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL %s %s" % (name, why))
-
-
-def run(*args):
-    return subprocess.run([os.path.join(BIN, args[0])] + list(args[1:]), env=ENV,
-                          capture_output=True, text=True)
+from tool_checks import BIN, ENV, SRC, check, counts, run  # noqa: E402
 
 
 def main():
@@ -93,8 +75,8 @@ def main():
         r = run("hameritt_validate", sim_path)
         check(r.returncode == 2 and "traffic.sha256" in r.stderr,
               "control: hameritt_validate refuses a changed episode file", r.stderr[-300:])
-    print("%d passed, %d failed" % (passed, failed))
-    sys.exit(1 if failed else 0)
+    print(counts.summary())
+    sys.exit(1 if counts.failed else 0)
 
 
 if __name__ == "__main__":

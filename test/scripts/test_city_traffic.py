@@ -36,26 +36,8 @@ except ImportError as e:  # Debian: python3-numpy
     print("test_city_traffic: %s" % e, file=sys.stderr)
     sys.exit(1)
 
-BIN = os.environ["HAMERITT_BIN_DIR"]
-SRC = os.environ["HAMERITT_SOURCE_DIR"]
-ENV = dict(os.environ, HAMERITT_CONFIG_DIR=os.path.join(SRC, "config"))
+from tool_checks import BIN, ENV, SRC, check, counts, run  # noqa: E402
 DT = 0.1
-passed = 0
-failed = 0
-
-
-def check(cond, name, why=""):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL %s %s" % (name, why))
-
-
-def run(*args):
-    return subprocess.run([os.path.join(BIN, args[0])] + list(args[1:]), env=ENV,
-                          capture_output=True, text=True)
 
 
 # ------------------------------------------------------------------ the signal timeline
@@ -582,8 +564,8 @@ def main():
             check(r.returncode == 2 and ("world.city.%s: %s" % (key, msg)) in r.stderr,
                   "%s out of range exits 2 naming the key and range" % key, r.stderr)
             check(not os.path.exists(out), "nothing written for a bad " + key)
-    print("%d passed, %d failed" % (passed, failed))
-    return 1 if failed else 0
+    print(counts.summary())
+    return 1 if counts.failed else 0
 
 
 if __name__ == "__main__":

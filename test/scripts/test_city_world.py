@@ -29,25 +29,7 @@ except ImportError as e:  # Debian: python3-jsonschema, python3-shapely
     print("test_city_world: %s" % e, file=sys.stderr)
     sys.exit(1)
 
-BIN = os.environ["HAMERITT_BIN_DIR"]
-SRC = os.environ["HAMERITT_SOURCE_DIR"]
-ENV = dict(os.environ, HAMERITT_CONFIG_DIR=os.path.join(SRC, "config"))
-passed = 0
-failed = 0
-
-
-def check(cond, name, why=""):
-    global passed, failed
-    if cond:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL %s %s" % (name, why))
-
-
-def run(*args):
-    return subprocess.run([os.path.join(BIN, args[0])] + list(args[1:]), env=ENV,
-                          capture_output=True, text=True)
+from tool_checks import BIN, ENV, SRC, check, counts, run  # noqa: E402
 
 
 def footprint(e):
@@ -189,8 +171,8 @@ def main():
         check(r.returncode == 2 and "world.extent_x: expected 500 to 2000" in r.stderr,
               "tile beyond 2 km exits 2", r.stderr)
         check(not os.path.exists(out), "nothing written for a bad tile")
-    print("%d passed, %d failed" % (passed, failed))
-    return 1 if failed else 0
+    print(counts.summary())
+    return 1 if counts.failed else 0
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,11 @@ class AdkRos {
   void publishState();
   void publishConstraints(double t);
   void checkObjective(double t);
+  // At the find of every target (mission running, the phase not yet started): publishes the
+  // search phase's success and `phase` active on adk/phase and says how the targets were found
+  // ("target sighted", "targets claimed", ...); otherwise nothing.
+  std::optional<std::string> phaseStartsAtFind(double t, bool started,
+                                               const scenario::MissionPhase& phase);
   // Avoid missions: ends the mission once the goal is reached, succeeded when the avoid phase's
   // criteria hold (adk/avoid_score.h), failed otherwise.
   void checkAvoid(double t);
