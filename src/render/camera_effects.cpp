@@ -102,10 +102,11 @@ void applyCameraEffects(const std::uint8_t* in, int width, int height, const Cam
   const bool noisy = fx.noise_std > 0 || salt_threshold > 0;
   // Per-row hash lanes (structure of arrays, so that the loops vectorize).
   scratch->lanes.resize(noisy ? 4 * static_cast<std::size_t>(width) : 0);
-  std::uint32_t* h0 = scratch->lanes.data();
-  std::uint32_t* h1 = h0 + width;
-  std::uint32_t* h2 = h1 + width;
-  std::uint32_t* h3 = h2 + width;
+  // Without noise the lanes are empty (data() may be null): no offset is applied to them then.
+  std::uint32_t* h0 = noisy ? scratch->lanes.data() : nullptr;
+  std::uint32_t* h1 = noisy ? h0 + width : nullptr;
+  std::uint32_t* h2 = noisy ? h1 + width : nullptr;
+  std::uint32_t* h3 = noisy ? h2 + width : nullptr;
   scratch->sums.resize(noisy ? static_cast<std::size_t>(n) : 0);
   std::int16_t* sums = scratch->sums.data();
   if (row_end < 0) row_end = height;
