@@ -17,11 +17,12 @@ fuzz_build() {
 # fuzz_run TARGET WORKDIR ARGS...: fuzzes from the committed seed corpus (new inputs go to
 # WORKDIR/corpus, crashes to WORKDIR/); prints libFuzzer's log to WORKDIR/log. ARGS come after
 # the defaults, so that they override them (libFuzzer keeps the last value of a flag).
+# FUZZ_BIN=NAME runs NAME_fuzzer on TARGET's corpus instead (mesh_ub: the UBSan-only mesh twin).
 fuzz_run() {
   local target="$1" work="$2"
   shift 2
   mkdir -p "$work/corpus"
-  "$FUZZ_BUILD_DIR/${target}_fuzzer" -timeout=10 -rss_limit_mb=2048 -max_len=200000 "$@" \
+  "$FUZZ_BUILD_DIR/${FUZZ_BIN:-$target}_fuzzer" -timeout=10 -rss_limit_mb=2048 -max_len=200000 "$@" \
     -print_final_stats=1 -artifact_prefix="$work/" "$work/corpus" \
     "$HAMERITT_ROOT/test/fuzz/corpus/$target" >"$work/log" 2>&1
 }
