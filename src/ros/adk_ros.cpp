@@ -195,6 +195,19 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     traffic_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "adk/traffic", 10);
   }
   if (follow_) follow_pub_ = gate_->advertise<hameritt::FollowStatus>(nh, "adk/follow", 10, true);
+  // The found targets' ground-truth state at a tracker's rate: what a maneuver client under test
+  // gets in place of a tracker, from the find on (maneuver_only by default).
+  double target_state_rate = mode_ == "maneuver_only" ? 10.0 : 0.0;
+  pnh.param("target_state_rate_hz", target_state_rate, target_state_rate);
+  if (!(target_state_rate >= 0.0 && target_state_rate <= 100.0)) {
+    throw scenario::ConfigError(
+        "~target_state_rate_hz: expected [0, 100] (0: no target state), got " +
+        scenario::formatNumber(target_state_rate));
+  }
+  target_state_period_ = target_state_rate > 0.0 ? 1.0 / target_state_rate : 0.0;
+  if (target_state_period_ > 0.0) {
+    target_state_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "adk/target_state", 20);
+  }
   if (track_) {
     if (sim_config_.uav.cameras.empty()) {
       throw ConfigError(sim_config_path + ": uav.cameras: a track mission needs a camera");
@@ -444,7 +457,33 @@ void AdkRos::onTruth(const hameritt::EntityStateArray::ConstPtr& msg) {
     truth_.add(msg->header.stamp.toSec(), fromMsg(*msg));
   } catch (const adk::InputError& e) {
     HAMERITT_ERROR_THROTTLE(5.0, "adk: %s: %s; ignored", truth_sub_.getTopic().c_str(), e.what());
+    return;
   }
+  publishTargetState(*msg);
+}
+
+void AdkRos::publishTargetState(const hameritt::EntityStateArray& truth) {
+  const double t = truth.header.stamp.toSec();
+  if (target_state_period_ <= 0.0 || finished_ || t + 1e-9 < next_target_state_t_ ||
+      lifecycle_->state() != adk::MissionState::kRunning) {
+    return;
+  }
+  hameritt::EntityStateArray m;
+  m.header = truth.header;
+  for (const auto& tm : metrics_->targets()) {
+    if (!tm.found) continue;
+    for (const auto& e : truth.entities) {
+      if (e.id == tm.id) m.entities.push_back(e);
+    }
+  }
+  if (m.entities.empty()) return;     // nothing found yet
+  if (next_target_state_t_ <= 0.0) {  // the first message: at the grid's next point
+    next_target_state_t_ = std::ceil(t / target_state_period_ - 1e-6) * target_state_period_;
+    if (t + 1e-9 < next_target_state_t_) return;
+  }
+  // On the rate's grid of sim time, whatever the ground truth's own rate.
+  next_target_state_t_ = (std::floor(t / target_state_period_ + 1e-6) + 1.0) * target_state_period_;
+  gate_->publish(target_state_pub_, m);
 }
 
 void AdkRos::onCrash(const hameritt::CrashEvent::ConstPtr& msg) {

@@ -14,6 +14,9 @@ mission.launch, maneuver_only, lock-step, as fast as it goes. Twice:
     exactly when the follow phase succeeded; the client's log says it took d* and h* from the
     mission; adk/phase (read with `rostopic echo`, not our code) carried search_1 active,
     search_1 succeeded and follow_1 active at the find, then follow_1 in the block's state;
+    adk/target_state (`rostopic echo`) carried only the target from the find on, at 10 Hz of
+    sim time, within 1 m of its scripted trajectory (controls: the same messages moved 2 m or
+    stamped 1 s early are caught);
   * negative control, pursue:=false (hover at the find): outcome "failed", the follow phase
     failed on its outside rule before its end, inside the envelope at least 50 points less than
     the pursuit, and adk/phase ends with follow_1 failed.
@@ -25,6 +28,7 @@ target's scripted trajectory), not the client's own account.
 """
 import csv
 import json
+import math
 import os
 import shutil
 import signal
@@ -48,6 +52,72 @@ def phase_changes(path):
     return [(r["field.phase"], r["field.type"], r["field.state"]) for r in rows]
 
 
+def trajectory_at(traj, t):
+    """(x, y) of a keyframe trajectory [[t, x, y, z, yaw], ...] at t, linearly interpolated."""
+    if t <= traj[0][0]:
+        return traj[0][1], traj[0][2]
+    for a, b in zip(traj, traj[1:]):
+        if t <= b[0]:
+            u = (t - a[0]) / (b[0] - a[0]) if b[0] > a[0] else 1.0
+            return a[1] + u * (b[1] - a[1]), a[2] + u * (b[2] - a[2])
+    return traj[-1][1], traj[-1][2]
+
+
+def target_state_problems(rows, target, find):
+    """What is wrong with adk/target_state's rows (`rostopic echo -p`): it must carry, from the
+    find on, only the target, on a 10 Hz grid of sim time, where its scripted trajectory puts it
+    (within 1 m). Returns (problems, summary)."""
+    if not rows:
+        return ["no message"], "no message"
+    stamps = [int(r["field.header.stamp"]) * 1e-9 for r in rows]
+    ids = set(r["field.entities0.id"] for r in rows)
+    extra = [k for k in rows[0] if k.startswith("field.entities1.")]
+    worst = max(math.hypot(float(r["field.entities0.pose.position.x"]) - x,
+                           float(r["field.entities0.pose.position.y"]) - y)
+                for r, (x, y) in ((r, trajectory_at(target["trajectory"], t))
+                                  for r, t in zip(rows, stamps)))
+    gaps = [b - a for a, b in zip(stamps, stamps[1:])] or [0.0]
+    rate = (len(stamps) - 1) / (stamps[-1] - stamps[0]) if len(stamps) > 1 else 0.0
+    summary = ("%d messages from %.2f s (find %.2f s) to %.2f s, %.2f Hz, ids %s, gaps %.3f-%.3f "
+               "s, farthest from the scripted trajectory %.3f m" % (
+                   len(rows), stamps[0], find, stamps[-1], rate, sorted(ids), min(gaps),
+                   max(gaps), worst))
+    problems = []
+    if ids != {target["id"]} or extra:
+        problems.append("carried %s, expected only %s" % (sorted(ids), target["id"]))
+    if not find - 1e-6 <= stamps[0] <= find + 0.15:
+        problems.append("starts at %.3f s, the find at %.3f s" % (stamps[0], find))
+    if not (9.5 <= rate <= 10.5 and min(gaps) >= 0.099):
+        problems.append("%.2f Hz, smallest gap %.3f s; expected 10 Hz" % (rate, min(gaps)))
+    if worst > 1.0:
+        problems.append("%.2f m from the scripted trajectory" % worst)
+    return problems, summary
+
+
+def check_target_state(label, scenario, path, m):
+    """adk/target_state as `rostopic echo` saw it, judged by target_state_problems; negative
+    control: the same rows with the positions moved 2 m, or stamped 1 s early, are caught."""
+    with open(os.path.join(scenario, "sim_config.json")) as fh:
+        sim = json.load(fh)
+    target = [e for e in sim["entities"] if e.get("role") == "target"][0]
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    find = (m.get("follow") or {}).get("start_time")
+    check(find is not None, "%s: no find, no adk/target_state to judge" % label)
+    if find is None:
+        return
+    problems, summary = target_state_problems(rows, target, find)
+    print("%s: adk/target_state: %s" % (label, summary))
+    check(not problems, "%s: adk/target_state: %s" % (label, "; ".join(problems)))
+    moved = [dict(r, **{"field.entities0.pose.position.x":
+                        str(float(r["field.entities0.pose.position.x"]) + 2.0)}) for r in rows]
+    early = [dict(r, **{"field.header.stamp": str(int(r["field.header.stamp"]) - 10**9)})
+             for r in rows]
+    for name, doctored in (("moved 2 m", moved), ("stamped 1 s early", early)):
+        p, _ = target_state_problems(doctored, target, find)
+        check(bool(p), "%s: the control with the states %s passed" % (label, name))
+
+
 def run(tmp, scenario, pursue):
     label = "follow" if pursue else "hover"
     out = os.path.join(tmp, label)
@@ -56,6 +126,9 @@ def run(tmp, scenario, pursue):
     # adk/phase as rostopic sees it: subscribed before the ADK starts, so no change is missed.
     echo = subprocess.Popen(["rostopic", "echo", "-p", "/adk/phase"], stdout=open(phases, "w"),
                             stderr=subprocess.DEVNULL)
+    states = os.path.join(tmp, label + "_target_state.csv")
+    echo_states = subprocess.Popen(["rostopic", "echo", "-p", "/adk/target_state"],
+                                   stdout=open(states, "w"), stderr=subprocess.DEVNULL)
     try:
         # A guard against a hang only: what is judged is the outcome, not how long it took.
         rc, text, m = launch_mission(
@@ -63,10 +136,12 @@ def run(tmp, scenario, pursue):
              "real_time_factor:=0", "pursue:=%s" % ("true" if pursue else "false")],
             out, log, label, check, 900)
     finally:
-        echo.send_signal(signal.SIGINT)
-        echo.wait(30)
+        for e in (echo, echo_states):
+            e.send_signal(signal.SIGINT)
+            e.wait(30)
     if m is None:
         return None, text, []
+    check_target_state(label, scenario, states, m)
     errors = [e.message for e in METRICS.iter_errors(m)]
     check(rc == 0, "%s: the launch exited %d" % (label, rc))
     check(not errors, "%s: metrics.json does not validate: %s" % (label, errors))

@@ -70,6 +70,8 @@ class AdkRos {
   void onClock(const rosgraph_msgs::Clock::ConstPtr& msg);
   void onOdometry(const nav_msgs::Odometry::ConstPtr& msg);
   void onTruth(const hameritt::EntityStateArray::ConstPtr& msg);
+  // adk/target_state: the found targets' entries of a ground-truth message, at its rate.
+  void publishTargetState(const hameritt::EntityStateArray& truth);
   void onCrash(const hameritt::CrashEvent::ConstPtr& msg);
   void onBoxes(std::size_t camera, const hameritt::BoundingBoxArray::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
@@ -170,7 +172,7 @@ class AdkRos {
   std::size_t track_camera_ = 0;
   bool crashed_ = false;
   std::map<std::string, adk::PhaseState> phase_states_;  // the last published, by phase id
-  double traffic_period_ = 0.5;  // s between adk/traffic reports; 0: none
+  double traffic_period_ = 0.5;                          // s between adk/traffic reports; 0: none
   double next_traffic_t_ = 0.0;
   std::unique_ptr<adk::ClockWatchdog> watchdog_;
   adk::GroundTruthHistory truth_{10.0};
@@ -183,6 +185,9 @@ class AdkRos {
   std::vector<double> next_footprint_t_;
   bool finished_ = false;
   bool write_failed_ = false;
+  // adk/target_state: its period (0: off) and the sim time of the next message.
+  double target_state_period_ = 0.0;
+  double next_target_state_t_ = 0.0;
   // The simulator's end, waiting for the odometry up to its time.
   bool sim_end_pending_ = false;
   double sim_end_t_ = 0.0;
@@ -192,7 +197,7 @@ class AdkRos {
 
   ros::Publisher mission_pub_, markers_pub_, uav_pub_, constraints_pub_, events_pub_,
       perception_pub_, scores_pub_, state_pub_, metrics_pub_, avoid_pub_, follow_pub_, phase_pub_,
-      traffic_pub_, track_pub_;
+      traffic_pub_, track_pub_, target_state_pub_;
   ros::Subscriber clock_sub_, odom_sub_, truth_sub_, crash_sub_, detection_sub_, sim_end_sub_,
       tracks_sub_;
   std::vector<ros::Subscriber> box_subs_;
