@@ -10,6 +10,7 @@
 #include "hameritt/generation/avoid.h"
 #include "hameritt/generation/target_slots.h"
 #include "hameritt/geometry/segment.h"
+#include "hameritt/planning/chase.h"
 #include "hameritt/planning/look_at.h"
 #include "hameritt/planning/validity.h"
 #include "hameritt/planning/vehicle_routes.h"
@@ -2074,6 +2075,68 @@ class ScenarioBuilder {
 
   void finishGroups() { sc_.sim.groups = currentGroups(); }
 
+  // The perception-only flight of a follow or track mission (planning::planChasePath): climb at
+  // the start to mid-band, then pursue the phase's first target and keep its chase point to the
+  // time limit. follow: the envelope's centre (d* behind along the car's path, h* above it),
+  // with the camera that sees it best; track: straight above it at mid-band, with the camera
+  // that scores the phase (down). False (and the look-at flight instead) for the other classes,
+  // when the chase cannot go on (a keep-out zone over it), or when it sees the target less than
+  // half of the time after catching up.
+  bool planChase(const planning::WorldValidity& validity,
+                 const planning::UavPlannerSettings& settings, const Vec3& ground, const Vec3& air,
+                 double climbed) {
+    const UavSpec& uav = sc_.sim.uav;
+    const MissionPhase* phase = nullptr;
+    for (const auto& p : sc_.mission.phases) {
+      if (p.type == PhaseType::kFollow || p.type == PhaseType::kTrack) phase = &p;
+    }
+    if (phase == nullptr || phase->targets.empty()) return false;
+    const ScenarioEntity* target = nullptr;
+    for (const auto& se : sc_.sim.entities) {
+      if (se.entity.id == phase->targets.front()) target = &se;
+    }
+    if (target == nullptr || target->trajectory.empty()) return false;
+    const bool follow = phase->type == PhaseType::kFollow;
+    planning::ChaseSettings chase;
+    chase.behind = follow ? phase->follow.distance : 0.0;
+    chase.height = follow ? phase->follow.height : air.z();
+    // The camera that sees the target best from the chase point: facing it with the front
+    // camera, or the down camera with the target along the image's width (turned a quarter) or
+    // its height; track: the down camera, which scores the phase. The first of the best.
+    std::vector<std::pair<std::string, double>> options = {{"down", 0.0}};
+    if (follow) options = {{"front", 0.0}, {"down", 0.5 * geometry::kPi}, {"down", 0.0}};
+    std::optional<planning::ChaseResult> best;
+    const CameraSpec* best_camera = nullptr;
+    for (const auto& [name, yaw_offset] : options) {
+      for (const auto& c : uav.cameras) {
+        if (c.name != name) continue;
+        chase.yaw_offset = yaw_offset;
+        planning::ChaseResult r = planning::planChasePath(
+            validity, c, air, climbed, sc_.mission.time_limit, target->trajectory,
+            target->entity.box.size, uav.altitude_min, uav.altitude_max, settings, chase);
+        if (r.status != planning::PlanStatus::kExact) return false;  // the same flight for all
+        if (!best || r.seen > best->seen) {
+          best = std::move(r);
+          best_camera = &c;
+        }
+      }
+    }
+    if (!best) return false;
+    const planning::ChaseResult& r = *best;
+    const CameraSpec* camera = best_camera;
+    PerceptionPath pp;
+    pp.status = "chase";
+    pp.camera = camera->name;
+    // A chase that does not see the target at least half of the time after catching up (held
+    // behind a tower in the city) gives way to the look-at flight.
+    if (!(r.frames > 0 && r.seen * 2 >= r.frames)) return false;
+    pp.targets_seen.push_back(target->entity.id);
+    pp.trajectory = {{0.0, ground.x(), ground.y(), ground.z(), uav.start.yaw}};
+    for (const auto& k : r.path) pp.trajectory.push_back(k);
+    sc_.sim.uav.perception_path = pp;
+    return true;
+  }
+
   // The perception-only flight (planning::planLookAtPath with the down camera over the
   // mission's validity): climb at the start to mid-band, hover there until every moving target
   // has stopped, then visit a viewpoint of each target (parked: its box centre; moving: the
@@ -2103,6 +2166,7 @@ class ScenarioBuilder {
     const Vec3 air(uav.start.x, uav.start.y,
                    roundMilli(0.5 * (uav.altitude_min + uav.altitude_max)));
     const double climbed = roundMilli((air.z() - ground.z()) / settings.speed.climb_rate);
+    if (planChase(validity, settings, ground, air, climbed)) return;
     const double t0 = std::max(climbed + 1.0, std::ceil(hold));
     PerceptionPath pp;
     pp.trajectory = {{0.0, ground.x(), ground.y(), ground.z(), uav.start.yaw},

@@ -29,13 +29,13 @@ using strict_json::idx;
 using strict_json::numbers;
 using Obj = strict_json::Object;
 
-
-// uav.perception_path: a planner status, the targets seen and a strictly increasing trajectory.
+// uav.perception_path: a planner status ("chase": a follow or track mission's chase path), the
+// targets seen and a strictly increasing trajectory.
 PerceptionPath readPerceptionPath(Obj o) {
   PerceptionPath pp;
   pp.status = o.string("status");
-  static const std::set<std::string> kStatuses = {"exact", "approximate", "no_solution",
-                                                  "invalid_start", "invalid_goal", "timeout"};
+  static const std::set<std::string> kStatuses = {
+      "exact", "approximate", "no_solution", "invalid_start", "invalid_goal", "timeout", "chase"};
   if (!kStatuses.count(pp.status)) {
     throw ConfigError(o.file() + ": " + o.at("status") + ": expected a planner status, got \"" +
                       pp.status + "\"");
@@ -53,7 +53,6 @@ PerceptionPath readPerceptionPath(Obj o) {
   o.finish();
   return pp;
 }
-
 
 std::vector<std::string> strings(const json& v, const std::string& path, const std::string& file) {
   std::vector<std::string> out;
