@@ -33,7 +33,7 @@ FollowEnvelope envelopeOf(const scenario::FollowPhaseSpec& f) {
 }  // namespace
 
 FollowScorer::FollowScorer(const scenario::MissionPhase& phase)
-    : phase_(phase), envelope_(envelopeOf(phase.follow)) {
+    : phase_(phase), envelope_(envelopeOf(phase.follow)), accumulator_(FollowEnvelope()) {
   const std::string where = "follow phase '" + phase.id + "': ";
   if (phase.type != scenario::PhaseType::kFollow || phase.targets.size() != 1) {
     throw scenario::ConfigError(where + "expected a follow phase with one target");
@@ -43,6 +43,7 @@ FollowScorer::FollowScorer(const scenario::MissionPhase& phase)
   }
   try {
     envelope_.validate();
+    accumulator_ = FollowAccumulator(envelope_);
   } catch (const scenario::ConfigError& e) {
     throw scenario::ConfigError(where + "follow." + e.what());
   }
@@ -89,6 +90,7 @@ bool FollowScorer::add(const FollowSample& s) {
     scored_from_ = s.t;
   }
   samples_.push_back(s);
+  accumulator_.add(s);
   if (inside) {
     outside_since_.reset();
   } else if (!outside_since_) {
@@ -108,7 +110,7 @@ FollowPhaseScore FollowScorer::score(double koz_seconds, bool collision, bool en
   r.start_time = start_;
   r.koz_seconds = koz_seconds;
   r.collision = collision;
-  r.envelope = scoreFollow(samples_, envelope_);
+  r.envelope = accumulator_.result();
   if (scored_from_) {
     r.approach_time = *scored_from_ - *start_;
     r.elapsed = samples_.back().t - *scored_from_;

@@ -156,50 +156,67 @@ bool insideEnvelope(const FollowSample& s, const FollowEnvelope& e) {
 }
 
 FollowScore scoreFollow(const std::vector<FollowSample>& samples, const FollowEnvelope& e) {
-  e.validate();
-  FollowScore r;
-  r.samples = samples.size();
-  if (samples.empty()) return r;
-  std::vector<double> dist;
-  double sum_d2 = 0.0, sum_h2 = 0.0, inside_s = 0.0, los_s = 0.0;
-  bool outside = false;
-  double outside_since = 0.0;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const auto& s = samples[i];
-    requireIncreasing(s.t, i ? samples[i - 1].t : 0.0, i);
-    const std::string at = "sample " + std::to_string(i);
+  FollowAccumulator a(e);
+  for (const auto& s : samples) a.add(s);
+  return a.result();
+}
+
+FollowAccumulator::FollowAccumulator(const FollowEnvelope& envelope) : e_(envelope) {
+  e_.validate();
+}
+
+void FollowAccumulator::add(const FollowSample& s) {
+  requireIncreasing(s.t, n_ ? last_t_ : 0.0, n_);
+  // (The message is only built for a bad sample.)
+  if (!s.vehicle.allFinite() || !s.target.allFinite() || !std::isfinite(s.target_yaw)) {
+    const std::string at = "sample " + std::to_string(n_);
     requireFinite(s.vehicle, at + ": vehicle");
     requireFinite(s.target, at + ": target");
-    if (!std::isfinite(s.target_yaw)) throw InputError(at + ": target_yaw is not finite");
-    const auto [d, h] = envelopeErrors(s, e);
-    dist.push_back(d);
-    sum_d2 += d * d;
-    sum_h2 += h * h;
-    const bool in = d <= e.distance_tolerance && std::fabs(h) <= e.height_tolerance;
-    const double dt = i + 1 < samples.size() ? samples[i + 1].t - s.t : 0.0;
-    if (in) inside_s += dt;
-    if (s.line_of_sight) los_s += dt;
-    if (!in && !outside) {
-      outside = true;
-      outside_since = s.t;
-    } else if (in && outside) {
-      outside = false;
-      r.longest_outside_s = std::max(r.longest_outside_s, s.t - outside_since);
-    }
+    throw InputError(at + ": target_yaw is not finite");
   }
-  if (outside) {
-    r.longest_outside_s = std::max(r.longest_outside_s, samples.back().t - outside_since);
+  const auto [d, h] = envelopeErrors(s, e_);
+  const bool in = d <= e_.distance_tolerance && std::fabs(h) <= e_.height_tolerance;
+  // The previous sample holds until this one.
+  if (n_ > 0) {
+    const double dt = s.t - last_t_;
+    if (last_in_) inside_s_ += dt;
+    if (last_los_) los_s_ += dt;
+  } else {
+    first_t_ = s.t;
   }
-  r.duration_s = samples.back().t - samples.front().t;
+  dist_.push_back(d);
+  sum_d2_ += d * d;
+  sum_h2_ += h * h;
+  if (!in && !outside_) {
+    outside_ = true;
+    outside_since_ = s.t;
+  } else if (in && outside_) {
+    outside_ = false;
+    longest_outside_ = std::max(longest_outside_, s.t - outside_since_);
+  }
+  ++n_;
+  last_t_ = s.t;
+  last_in_ = in;
+  last_los_ = s.line_of_sight;
+}
+
+FollowScore FollowAccumulator::result() const {
+  FollowScore r;
+  r.samples = n_;
+  if (n_ == 0) return r;
+  r.longest_outside_s = longest_outside_;
+  if (outside_) r.longest_outside_s = std::max(r.longest_outside_s, last_t_ - outside_since_);
+  r.duration_s = last_t_ - first_t_;
   if (r.duration_s > 0.0) {
-    r.inside_fraction = inside_s / r.duration_s;
-    r.line_of_sight_fraction = los_s / r.duration_s;
+    r.inside_fraction = inside_s_ / r.duration_s;
+    r.line_of_sight_fraction = los_s_ / r.duration_s;
   }
-  const double n = static_cast<double>(samples.size());
-  r.rms_distance_error_m = std::sqrt(sum_d2 / n);
-  r.rms_height_error_m = std::sqrt(sum_h2 / n);
-  std::sort(dist.begin(), dist.end());
-  const std::size_t rank = (95 * samples.size() + 99) / 100;  // ceil(0.95 n), in integers
+  const double n = static_cast<double>(n_);
+  r.rms_distance_error_m = std::sqrt(sum_d2_ / n);
+  r.rms_height_error_m = std::sqrt(sum_h2_ / n);
+  const std::size_t rank = (95 * n_ + 99) / 100;  // ceil(0.95 n), in integers
+  std::vector<double> dist = dist_;
+  std::nth_element(dist.begin(), dist.begin() + static_cast<std::ptrdiff_t>(rank - 1), dist.end());
   r.p95_distance_error_m = dist[rank - 1];
   return r;
 }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -214,6 +215,71 @@ TEST(Follow, EnvelopeHandWorked) {
   EXPECT_TRUE(insideEnvelope(high[1], e));
   // Open at the end: outside from t = 3 to the last sample at 5.
   EXPECT_DOUBLE_EQ(scoreFollow(follow({0, 0, 0, 9, 9, 9}), e).longest_outside_s, 2.0);
+}
+
+// The batch score written out plainly (sort for the p95, dt to the next sample): the reference
+// for the accumulator's live score after every sample.
+FollowScore referenceFollow(const std::vector<FollowSample>& s, const FollowEnvelope& e) {
+  FollowScore r;
+  r.samples = s.size();
+  std::vector<double> dist;
+  double d2 = 0, h2 = 0, in_s = 0, los_s = 0, since = 0;
+  bool out = false;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Vec3 want =
+        s[i].target - e.distance * Vec3(std::cos(s[i].target_yaw), std::sin(s[i].target_yaw), 0);
+    const double d = (s[i].vehicle - want).head<2>().norm();
+    const double h = s[i].vehicle.z() - s[i].target.z() - e.height;
+    const bool in = d <= e.distance_tolerance && std::fabs(h) <= e.height_tolerance;
+    const double dt = i + 1 < s.size() ? s[i + 1].t - s[i].t : 0.0;
+    in_s += in ? dt : 0.0;
+    los_s += s[i].line_of_sight ? dt : 0.0;
+    if (!in && !out) since = s[i].t;
+    if (in && out) r.longest_outside_s = std::max(r.longest_outside_s, s[i].t - since);
+    out = !in;
+    dist.push_back(d);
+    d2 += d * d;
+    h2 += h * h;
+  }
+  if (out) r.longest_outside_s = std::max(r.longest_outside_s, s.back().t - since);
+  r.duration_s = s.back().t - s.front().t;
+  r.inside_fraction = r.duration_s > 0 ? in_s / r.duration_s : 0.0;
+  r.line_of_sight_fraction = r.duration_s > 0 ? los_s / r.duration_s : 0.0;
+  r.rms_distance_error_m = std::sqrt(d2 / s.size());
+  r.rms_height_error_m = std::sqrt(h2 / s.size());
+  std::sort(dist.begin(), dist.end());
+  r.p95_distance_error_m = dist[static_cast<std::size_t>(std::ceil(0.95 * s.size())) - 1];
+  return r;
+}
+
+TEST(Follow, AccumulatorMatchesTheReferenceAfterEverySample) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> lag(-3.0, 9.0);
+  std::vector<double> off;
+  for (int i = 0; i < 400; ++i) off.push_back(lag(rng));
+  const auto samples = follow(off);
+  const FollowEnvelope e;
+  FollowAccumulator a(e);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    a.add(samples[i]);
+    const std::vector<FollowSample> prefix(samples.begin(), samples.begin() + i + 1);
+    const FollowScore x = a.result(), r = referenceFollow(prefix, e);
+    ASSERT_EQ(x.samples, r.samples) << i;
+    ASSERT_NEAR(x.inside_fraction, r.inside_fraction, 1e-12) << i;
+    ASSERT_NEAR(x.line_of_sight_fraction, r.line_of_sight_fraction, 1e-12) << i;
+    ASSERT_DOUBLE_EQ(x.longest_outside_s, r.longest_outside_s) << i;
+    ASSERT_NEAR(x.rms_distance_error_m, r.rms_distance_error_m, 1e-9) << i;
+    ASSERT_NEAR(x.rms_height_error_m, r.rms_height_error_m, 1e-9) << i;
+    ASSERT_DOUBLE_EQ(x.p95_distance_error_m, r.p95_distance_error_m) << i;
+  }
+  // The random lags leave the envelope and come back (the figures above are not all trivial).
+  EXPECT_GT(a.result().longest_outside_s, 0.0);
+  EXPECT_GT(a.result().inside_fraction, 0.2);
+  EXPECT_LT(a.result().inside_fraction, 0.9);
+  // A sample out of order is refused and changes nothing.
+  const FollowScore before = a.result();
+  EXPECT_THROW(a.add(samples.front()), InputError);
+  EXPECT_EQ(a.result().samples, before.samples);
 }
 
 TEST(Follow, RejectsMalformedInput) {

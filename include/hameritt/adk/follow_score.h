@@ -75,6 +75,7 @@ class FollowScorer {
   std::optional<double> scored_from_;
   std::optional<double> last_t_;  // of any sample kept or used for the approach
   std::vector<FollowSample> samples_;
+  FollowAccumulator accumulator_;  // the scored samples' envelope figures, kept as they come
   std::optional<double> outside_since_;
   bool exceeded_ = false;
 };
