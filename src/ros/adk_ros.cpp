@@ -349,6 +349,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
   }
   const Eigen::Isometry3d pose = poseOf(*msg);
   const Eigen::Vector3d p = pose.translation();
+  if (track_) poses_.add(t, pose);
   const Eigen::Vector3d v = worldVelocityOf(*msg);
   try {
     for (const auto& e : monitor_->add(t, p)) gate_->publish(events_pub_, toMsg(e));
@@ -761,8 +762,32 @@ void AdkRos::addTrackFrame(const hameritt::BoundingBoxArray& msg) {
     g.occlusion = std::clamp(static_cast<double>(b.occlusion), 0.0, 1.0);
     targets.push_back(g);
   }
+  const double stamp = msg.header.stamp.toSec();
+  // The targets without a box: hidden in the camera's view (occlusion level full) or out of it.
+  // Without the UAV's pose at the frame (no odometry within 0.5 s) they stay out of the frame.
+  const auto base = poses_.at(stamp, 0.5);
+  if (!base) {
+    HAMERITT_ERROR_THROTTLE(5.0,
+                            "adk: camera %s: no odometry within 0.5 s of the frame at %.3f s: "
+                            "its targets without a box count as out of view",
+                            msg.camera.c_str(), stamp);
+  } else {
+    std::vector<adk::TargetExtent> extents;
+    for (const auto& e : truthAt(stamp)) {
+      const auto& ids = track_->phase().targets;
+      const auto s = scenario_index_.find(e.id);
+      if (s == scenario_index_.end() || std::find(ids.begin(), ids.end(), e.id) == ids.end()) {
+        continue;
+      }
+      const auto& size = sim_config_.entities[s->second].entity.box.size;
+      extents.push_back({e.id, scenario::boxFromPose(e.position, e.yaw, size)});
+    }
+    const auto& cam = sim_config_.uav.cameras[track_camera_];
+    targets = adk::withHiddenTargets(std::move(targets), extents, intrinsics_[track_camera_],
+                                     adk::opticalPose(*base, cam));
+  }
   try {
-    track_->addFrame(msg.header.stamp.toSec(), targets);
+    track_->addFrame(stamp, targets);
   } catch (const adk::InputError& e) {
     HAMERITT_ERROR_THROTTLE(5.0, "adk: camera %s: %s; ignored", msg.camera.c_str(), e.what());
   }

@@ -15,6 +15,11 @@ score precision 1 on the frames with a report, and say success. Negative control
 run "lost" hides the targets from t = 3 s and sends no report: the phase fails as soon as a loss
 passes max_reacquire_s, with no report and no error counted; a metrics.json doctored with a
 negative count or without its report_errors fails the schema.
+Run "lost" also shows that a hidden target in the camera's view counts at occlusion level
+"full": the UAV hovers 40 m above the first target (its sim_config trajectory) until half the
+reacquire limit after the loss, so its hidden frames until then project into the image and
+count as "full"; then it hovers 300 m off, and its frames there are out of view (not in
+in_view_frames, in no level): the frames a renderer-only ground truth loses.
 """
 import copy
 import json
@@ -55,8 +60,23 @@ def tracked(eid, x, w=40.0):
     return TrackedBox(target_id=eid, x=float(x), y=100.0, w=w, h=40.0)
 
 
-def fly(scenario, out, log, camera, targets, duration, lost_from):
-    """One ADK run; returns (exit code, expected counts) once it has ended (metrics written)."""
+def position_at(trajectory, t):
+    """(x, y, z) of a sim_config trajectory ([t, x, y, z, yaw] points) at t, linear between
+    its points."""
+    pts = trajectory
+    if t <= pts[0][0]:
+        return tuple(pts[0][1:4])
+    for a, b in zip(pts, pts[1:]):
+        if t <= b[0]:
+            f = (t - a[0]) / (b[0] - a[0])
+            return tuple(a[k] + f * (b[k] - a[k]) for k in (1, 2, 3))
+    return tuple(pts[-1][1:4])
+
+
+def fly(scenario, out, log, camera, targets, duration, lost_from, above=None):
+    """One ADK run; returns (exit code, expected counts) once it has ended (metrics written).
+    above: (trajectory, until): the UAV hovers 40 m above that trajectory until sim time
+    `until`, 300 m east of it after; None: at (0, 0, 40)."""
     adk = subprocess.Popen(
         [os.path.join(BIN, "adk"), "__name:=adk", "_mission:=%s/mission.json" % scenario,
          "_sim_config:=%s/sim_config.json" % scenario, "_output_dir:=" + out,
@@ -91,7 +111,14 @@ def fly(scenario, out, log, camera, targets, duration, lost_from):
         od.header.frame_id = "map"
         od.pose.pose.position.z = 40.0
         od.pose.pose.orientation.w = 1.0
+        if above is not None:
+            x, y, z = position_at(above[0], t)
+            od.pose.pose.position.x = x + (0.0 if t < above[1] - 1e-9 else 300.0)
+            od.pose.pose.position.y = y
+            od.pose.pose.position.z = z + 40.0
         pubs["odom"].publish(od)
+        if above is not None:
+            time.sleep(0.004)  # the frame follows its odometry, as the simulator's render does
         shows = t >= 1.0 - 1e-9 and (lost_from is None or t < lost_from)
         arr = BoundingBoxArray(camera=camera)
         arr.header.stamp = stamp
@@ -202,9 +229,12 @@ def main():
             del bad["track"]["report_errors"]
             check(any(METRICS.iter_errors(bad)), "schema accepts a track without report_errors")
         # Run "lost" (negative control): the targets hidden from t = 3 s fail the phase.
+        with open(os.path.join(scenario, "sim_config.json")) as f:
+            first = [e for e in json.load(f)["entities"] if e["id"] == targets[0]][0]
+        switch = 3.0 + limit / 2
         out = os.path.join(tmp, "lost")
         rc, _ = fly(scenario, out, os.path.join(tmp, "lost.log"), camera, targets, duration,
-                    3.0)
+                    3.0, (first["trajectory"], switch))
         check(rc == 0, "lost: adk exit %s" % rc)
         state, m = metrics_state(os.path.join(out, "metrics.json"), METRICS)
         check(state == "complete", "lost: metrics.json %s" % state)
@@ -218,6 +248,25 @@ def main():
         check(3.0 + limit < end < 3.0 + limit + 1.0, "lost: ended at %s s" % end)
         check(tr.get("reports") == 0 and tr.get("report_errors", {}).get("total") == 0,
               "lost: reports %s" % tr.get("reports"))
+        # The first target: shown from the frame after the find's (the find at 1 s starts the
+        # phase after its own frame is judged) to 2.8 s, hidden in view from 3 s until the
+        # switch ("full"), out of view after it.
+        shown = int(round((3.0 - (tr.get("start_time") or 0.0)) / DT)) - 1
+        pt = (tr.get("per_target") or [{}])[0]
+        levels = pt.get("by_occlusion", {})
+        want_full = int(round((switch - 3.0) / DT))
+        full = levels.get("full", {})
+        out_of_view = pt.get("frames", 0) - pt.get("in_view_frames", 0)
+        print("lost: %s: %s frames, none %s, full %s (expected %d, tracked %s), out of view %s"
+              % (pt.get("id"), pt.get("frames"), levels.get("none", {}).get("frames"),
+                 full.get("frames"), want_full, full.get("tracked_fraction"), out_of_view))
+        check(levels.get("none", {}).get("frames") == shown and shown == 9,
+              "lost: none %s, expected %d" % (levels.get("none"), shown))
+        check(full.get("frames") == want_full and want_full > 0, "lost: full %s" % full)
+        check(full.get("tracked_fraction") == 0.0, "lost: full tracked %s" % full)
+        check(pt.get("in_view_frames") == shown + want_full, "lost: in view %s"
+              % pt.get("in_view_frames"))
+        check(out_of_view > 0, "lost: out of view %s" % out_of_view)
     finally:
         stop_master(core)
     return check.summary(tmp)

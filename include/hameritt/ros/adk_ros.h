@@ -30,6 +30,7 @@
 #include "hameritt/adk/coverage.h"
 #include "hameritt/adk/detection_scoring.h"
 #include "hameritt/adk/metrics.h"
+#include "hameritt/adk/target_view.h"
 #include "hameritt/ros/lockstep.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
@@ -170,6 +171,9 @@ class AdkRos {
   // camera track_camera_ and the client's reports.
   std::unique_ptr<adk::TrackScorer> track_;
   std::size_t track_camera_ = 0;
+  // The UAV's recent odometry poses: where the track camera was at each frame's stamp, to
+  // project the targets the renderer gave no box (adk/target_view.h).
+  adk::PoseHistory poses_{5.0};
   bool crashed_ = false;
   std::map<std::string, adk::PhaseState> phase_states_;  // the last published, by phase id
   double traffic_period_ = 0.5;                          // s between adk/traffic reports; 0: none
