@@ -82,6 +82,15 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   double pursuit_rate = 10.0;
   pnh.param("pursue", pursue_, pursue_);
   pnh.param("publish_tracks", publish_tracks_, publish_tracks_);
+  pnh.param("drive_off_speed", drive_off_speed_, drive_off_speed_);
+  if (!(drive_off_speed_ >= 0)) throw scenario::ConfigError("~drive_off_speed: expected >= 0");
+  std::string track_boxes = "perfect_perception";
+  pnh.param("track_boxes", track_boxes, track_boxes);
+  if (track_boxes != "perfect_perception" && track_boxes != "detector") {
+    throw scenario::ConfigError("~track_boxes: expected perfect_perception or detector, got '" +
+                                track_boxes + "'");
+  }
+  boxes_from_detector_ = track_boxes == "detector";
   pnh.param("pursuit_standoff", pursuit_.standoff, pursuit_.standoff);
   pnh.param("pursuit_height", pursuit_.height, pursuit_.height);
   pnh.param("pursuit_lead", pursuit_.lead, pursuit_.lead);
@@ -132,6 +141,9 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
         gate_->subscribe(nh, "adk/perfect_perception", 20, &Self::onPerfectPerception, this);
     if (publish_tracks_) {
       tracks_pub_ = gate_->advertise<hameritt::TrackReport>(nh, "perception/tracks", 50);
+      if (boxes_from_detector_) {
+        blobs_sub_ = gate_->subscribe(nh, "perception/blobs", 20, &Self::onBlobs, this);
+      }
     }
   }
   if (pursue_) {
@@ -228,6 +240,10 @@ void CoverageSearchClientRos::replan(const std::string& why) {
       scenario::Mission open = *mission_;
       for (auto& a : open.aois) a.window.nlt.reset();
       plan_ = clients::planSearch(open, settings_, progress);
+      // What the search finds past the windows may have driven off from its area since.
+      clients::ContextSettings context;
+      context.drive_off_speed = drive_off_speed_;
+      filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get(), context);
       ROS_INFO("%s: no cell can be reached inside the windows: searching the areas past them",
                kClientName);
     }
@@ -428,10 +444,16 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
   }
   if (associated) predictor_->observe(t, associated->first, associated->second);
-  if (track_phase_ && pursuing_ && tracks_pub_) {
+  if (track_phase_ && pursuing_ && tracks_pub_ && !boxes_from_detector_) {
     publishTracks(*msg,
                   associated ? std::optional<geometry::Vec3>(associated->first) : std::nullopt);
   }
+}
+
+void CoverageSearchClientRos::onBlobs(const hameritt::PerceptionReport::ConstPtr& msg) {
+  if (!mission_ || !filter_ || !track_phase_ || !pursuing_ || !tracks_pub_ || stopped_) return;
+  const double t = msg->header.stamp.toSec() - mission_start_;
+  publishTracks(*msg, predictor_->predict(t).position);
 }
 
 bool CoverageSearchClientRos::parkedAt(const geometry::Vec3& p) const {
