@@ -56,7 +56,9 @@ namespace hameritt::ros_wrappers {
 // hameritt/PerceptionReport, nearest the pursued vehicle's predicted position), ~avoid (true: fly
 // an avoid mission with the pilot), ~avoid_rate_hz (10), ~avoid_speed_fraction (0.6),
 // ~avoid_horizontal_buffer (9 m), ~avoid_vertical_buffer (6 m), ~avoid_horizon (10 s),
-// ~drive_off_speed (13 m/s, the generator's fastest car: once the search goes on past the
+// ~track_claim_camera ("down": on a track phase, each target is claimed once, when this
+// camera sees it, the pursuit starting at the first sighting; "": claims as in the other
+// classes), ~drive_off_speed (13 m/s, the generator's fastest car: once the search goes on past the
 // areas' windows, a sighting that far from its area per second since the window closed still
 // passes the context filter). Avoid
 // missions: sub adk/traffic (hameritt/EntityStateArray), pub uav/cmd_pose.
@@ -73,6 +75,9 @@ class CoverageSearchClientRos {
   void onProgress(const hameritt::FollowProgress::ConstPtr& msg);
   void onState(const topic_tools::ShapeShifter::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
+  // With ~track_claim_camera: a frame after the one that claimed the last target (the phase
+  // starts at that claim), so that no report precedes the phase.
+  bool reportsDue(const hameritt::PerceptionReport& msg) const;
   // A sighting at p is a parked car of the public map.
   bool parkedAt(const geometry::Vec3& p) const;
   // perception/tracks: for each mission target, the box of the sighting in `msg` that matches
@@ -144,6 +149,11 @@ class CoverageSearchClientRos {
   // Where the reported boxes come from: false, perfect perception; true, the detector's blobs.
   bool boxes_from_detector_ = false;
   bool track_phase_ = false;
+  // A track phase: each target is claimed once, when this camera sees it ("": at every sighting,
+  // as in the other classes); the pursuit starts at the first sighting from any camera.
+  std::string track_claim_camera_ = "down";
+  std::set<std::string> track_claimed_;
+  double reports_after_ = -1.0;  // the stamp of the frame that claimed the last target
   ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_,
       traffic_sub_, blobs_sub_;
 };
