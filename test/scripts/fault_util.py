@@ -1,6 +1,7 @@
 """Shared pieces of the write-fault, full-disk, duration-end, pursuit and follow tests: a tally
 of checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics without
 a mission, one generated scenario, and a mission.launch run read back."""
+import csv
 import json
 import os
 import signal
@@ -112,3 +113,24 @@ def launch_mission(args, out, log, label, check, guard, master_uri=None):
     except (OSError, ValueError) as e:
         check(False, "%s: metrics.json: %s" % (label, e))
         return rc, text, None
+
+
+def phase_changes(path):
+    """[(phase, type, state)] from `rostopic echo -p` output, in order."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return [(r["field.phase"], r["field.type"], r["field.state"]) for r in rows]
+
+
+def launch_mission_phases(args, out, log, phases, label, check, guard):
+    """launch_mission, with adk/phase as `rostopic echo` (not our code) sees it written to PHASES:
+    subscribed before the ADK starts, so no change is missed. Returns (exit code, log text,
+    metrics.json or None, [(phase, type, state)] in order)."""
+    echo = subprocess.Popen(["rostopic", "echo", "-p", "/adk/phase"], stdout=open(phases, "w"),
+                            stderr=subprocess.DEVNULL)
+    try:
+        rc, text, m = launch_mission(args, out, log, label, check, guard)
+    finally:
+        echo.send_signal(signal.SIGINT)
+        echo.wait(30)
+    return rc, text, m, phase_changes(phases)
