@@ -1,6 +1,7 @@
-"""Shared pieces of the write-fault, full-disk, duration-end, pursuit and follow tests: a tally
-of checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics without
-a mission, one generated scenario, and a mission.launch run read back."""
+"""Shared pieces of the write-fault, full-disk, duration-end, pursuit, follow and track tests: a
+tally of checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics
+without a mission, one generated scenario, and a mission.launch run read back (with the adk/phase
+changes rostopic saw)."""
 import csv
 import json
 import os
