@@ -95,6 +95,7 @@ void ContextSettings::validate() const {
   need(region_tolerance >= 0, "region_tolerance", "metres >= 0", region_tolerance);
   need(distance_tolerance >= 0, "distance_tolerance", "metres >= 0", distance_tolerance);
   need(over_tolerance >= 0, "over_tolerance", "metres >= 0", over_tolerance);
+  need(drive_off_speed >= 0, "drive_off_speed", "m/s >= 0", drive_off_speed);
   need(bearing_tolerance_deg >= 0 && bearing_tolerance_deg <= 180, "bearing_tolerance_deg",
        "degrees in [0, 180]", bearing_tolerance_deg);
   thresholds.validate();
@@ -115,12 +116,25 @@ std::vector<const scenario::TargetDescription*> ContextFilter::targetsMatching(
   return out;
 }
 
-std::string ContextFilter::regionOf(const Vec2& p, double t) const {
+std::string ContextFilter::regionOf(const Vec2& p, double t, bool* driven_off) const {
+  *driven_off = false;
   for (const auto& a : mission_.aois) {
     if (a.window.active(t) && a.polygon.distance(p) <= settings_.region_tolerance) return a.id;
   }
   for (const auto& r : mission_.routes) {
     if (r.band.distance(p) <= settings_.region_tolerance) return r.id;
+  }
+  const bool moving = mission_.cls == scenario::ScenarioClass::kPursuit ||
+                      mission_.cls == scenario::ScenarioClass::kFollow ||
+                      mission_.cls == scenario::ScenarioClass::kTrack;
+  if (!moving || settings_.drive_off_speed <= 0) return "";
+  for (const auto& a : mission_.aois) {
+    if (!a.window.nlt || t <= *a.window.nlt) continue;
+    const double reach = settings_.drive_off_speed * (t - *a.window.nlt);
+    if (a.polygon.distance(p) <= settings_.region_tolerance + reach) {
+      *driven_off = true;
+      return a.id;
+    }
   }
   return "";
 }
@@ -129,8 +143,9 @@ ContextVerdict ContextFilter::check(const CandidatePose& c, double t,
                                     const scenario::TargetDescription& target) const {
   ContextVerdict v;
   const Vec2 p = c.position.head<2>();
+  bool driven_off = false;
   if (!mission_.aois.empty() || !mission_.routes.empty()) {
-    v.region_id = regionOf(p, t);
+    v.region_id = regionOf(p, t, &driven_off);
     if (v.region_id.empty()) {
       v.reason = "outside every active area of interest and route band at t=" + fmt(t);
       return v;
@@ -142,7 +157,7 @@ ContextVerdict ContextFilter::check(const CandidatePose& c, double t,
   if (mission_.cls == scenario::ScenarioClass::kPursuit ||
       mission_.cls == scenario::ScenarioClass::kFollow ||
       mission_.cls == scenario::ScenarioClass::kTrack) {
-    for (const auto& a : mission_.aois) static_target |= a.id == v.region_id;
+    for (const auto& a : mission_.aois) static_target |= a.id == v.region_id && !driven_off;
   }
   // The mission's targets with this description: the candidate may be any of them.
   std::vector<const scenario::TargetDescription*> candidates;
@@ -178,7 +193,8 @@ ContextVerdict ContextFilter::check(const CandidatePose& c, double t,
       v.relations_checked = checked;
       v.relations_skipped = skipped;
       v.reason = "in " + (v.region_id.empty() ? std::string("the mission area") : v.region_id) +
-                 ", " + std::to_string(checked) + " relations hold, " + std::to_string(skipped) +
+                 (driven_off ? " (within reach past its window)" : "") + ", " +
+                 std::to_string(checked) + " relations hold, " + std::to_string(skipped) +
                  " not checkable";
       return v;
     }

@@ -2,6 +2,7 @@
 
 #include <ros/console.h>
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -90,16 +91,11 @@ clients::Observation toObservation(const hameritt::PerceivedEntity& e) {
   return o;
 }
 
-hameritt::Detection makeDetection(const std::string& client,
-                                  const scenario::TargetDescription& target,
-                                  const geometry::Vec3& position, double confidence,
-                                  const ros::Time& stamp) {
-  hameritt::Detection d;
-  d.header.stamp = stamp;
-  d.header.frame_id = "map";
-  d.client = client;
-  d.description = clients::describe(target);
-  d.entity_class = target.cls;
+namespace {
+
+// The description's attributes (the empty ones left out).
+std::vector<hameritt::KeyValue> descriptionAttributes(const scenario::TargetDescription& target) {
+  std::vector<hameritt::KeyValue> out;
   const std::pair<const char*, const std::string*> fields[] = {
       {"vehicle_class", &target.vehicle_class},
       {"make", &target.make},
@@ -110,8 +106,42 @@ hameritt::Detection makeDetection(const std::string& client,
     hameritt::KeyValue kv;
     kv.key = key;
     kv.value = *value;
-    d.attributes.push_back(kv);
+    out.push_back(kv);
   }
+  return out;
+}
+
+}  // namespace
+
+hameritt::PerceivedEntity toPerceivedBlob(const scenario::TargetDescription& target,
+                                          const clients::CarCandidate& blob) {
+  hameritt::PerceivedEntity e;
+  e.entity_class = target.cls;
+  e.attributes = descriptionAttributes(target);
+  e.position.x = blob.position.x();
+  e.position.y = blob.position.y();
+  e.position.z = blob.position.z();
+  e.yaw = blob.yaw;
+  e.box.entity_class = target.cls;
+  e.box.x_min = blob.box.x;
+  e.box.y_min = blob.box.y;
+  e.box.x_max = blob.box.x + blob.box.width - 1;
+  e.box.y_max = blob.box.y + blob.box.height - 1;
+  e.box.visible_pixels = static_cast<std::uint32_t>(std::max(0, blob.pixels));
+  return e;
+}
+
+hameritt::Detection makeDetection(const std::string& client,
+                                  const scenario::TargetDescription& target,
+                                  const geometry::Vec3& position, double confidence,
+                                  const ros::Time& stamp) {
+  hameritt::Detection d;
+  d.header.stamp = stamp;
+  d.header.frame_id = "map";
+  d.client = client;
+  d.description = clients::describe(target);
+  d.entity_class = target.cls;
+  d.attributes = descriptionAttributes(target);
   d.position.x = position.x();
   d.position.y = position.y();
   d.position.z = position.z();

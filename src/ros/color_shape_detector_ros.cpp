@@ -108,6 +108,8 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
   pnh.param("max_rate_hz", max_rate_, max_rate_);
   pnh.param("min_confidence", min_confidence_, min_confidence_);
   pnh.param("mission_start_time", mission_start_, mission_start_);
+  pnh.param("claim", claim_, claim_);
+  pnh.param("publish_blobs", publish_blobs_, publish_blobs_);
   if (!(max_rate_ > 0)) throw scenario::ConfigError("~max_rate_hz: expected > 0");
 
   // The honesty rule: the public map and the UAV's own cameras, never the scenario's entities.
@@ -178,7 +180,12 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
             }));
     cameras_.push_back(std::move(cam));
   }
-  detection_pub_ = gate_->advertise<hameritt::Detection>(nh, "perception/detections", 50);
+  if (claim_) {
+    detection_pub_ = gate_->advertise<hameritt::Detection>(nh, "perception/detections", 50);
+  }
+  if (publish_blobs_) {
+    blobs_pub_ = gate_->advertise<hameritt::PerceptionReport>(nh, "perception/blobs", 20);
+  }
   mission_sub_ = gate_->subscribe(nh, "mission", 1, &ColorShapeDetectorRos::onMission, this);
   state_sub_ = gate_->subscribe(nh, "adk/state", 10, &ColorShapeDetectorRos::onState, this);
   ROS_INFO("%s: %zu camera(s), waiting for the mission", kClientName, cameras_.size());
@@ -257,6 +264,9 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
     }
     camera->last_processed = stamp;
     const double t = stamp - mission_start_;
+    hameritt::PerceptionReport blobs;
+    blobs.header = image->header;
+    blobs.camera = camera->name;
     std::set<std::string> looked;  // one pass per distinct description
     for (const auto& target : mission_->objective.targets) {
       const std::string key =
@@ -271,6 +281,8 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
                     c.position.x(), c.position.y(), c.reject.c_str());
           continue;
         }
+        if (publish_blobs_) blobs.entities.push_back(toPerceivedBlob(target, c));
+        if (!claim_) continue;
         clients::CandidatePose p;
         p.position = c.position;
         p.yaw = c.yaw;
@@ -297,6 +309,7 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
             camera->name.c_str(), c.length, c.width, confidence, v.reason.c_str());
       }
     }
+    if (publish_blobs_) gate_->publish(blobs_pub_, blobs);
   } catch (const std::exception& e) {
     ROS_WARN_THROTTLE(5.0, "%s: %s frame at %.3f skipped: %s", kClientName, camera->name.c_str(),
                       stamp, e.what());

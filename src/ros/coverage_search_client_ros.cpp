@@ -82,6 +82,16 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   double pursuit_rate = 10.0;
   pnh.param("pursue", pursue_, pursue_);
   pnh.param("publish_tracks", publish_tracks_, publish_tracks_);
+  pnh.param("drive_off_speed", drive_off_speed_, drive_off_speed_);
+  pnh.param("track_claim_camera", track_claim_camera_, track_claim_camera_);
+  if (!(drive_off_speed_ >= 0)) throw scenario::ConfigError("~drive_off_speed: expected >= 0");
+  std::string track_boxes = "perfect_perception";
+  pnh.param("track_boxes", track_boxes, track_boxes);
+  if (track_boxes != "perfect_perception" && track_boxes != "detector") {
+    throw scenario::ConfigError("~track_boxes: expected perfect_perception or detector, got '" +
+                                track_boxes + "'");
+  }
+  boxes_from_detector_ = track_boxes == "detector";
   pnh.param("pursuit_standoff", pursuit_.standoff, pursuit_.standoff);
   pnh.param("pursuit_height", pursuit_.height, pursuit_.height);
   pnh.param("pursuit_lead", pursuit_.lead, pursuit_.lead);
@@ -132,6 +142,9 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
         gate_->subscribe(nh, "adk/perfect_perception", 20, &Self::onPerfectPerception, this);
     if (publish_tracks_) {
       tracks_pub_ = gate_->advertise<hameritt::TrackReport>(nh, "perception/tracks", 50);
+      if (boxes_from_detector_) {
+        blobs_sub_ = gate_->subscribe(nh, "perception/blobs", 20, &Self::onBlobs, this);
+      }
     }
   }
   if (pursue_) {
@@ -187,6 +200,8 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
     predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
   }
   covered_.clear();
+  track_claimed_.clear();
+  reports_after_ = -1.0;
   planned_ = stopped_ = exhausted_ = pursuing_ = false;
   avoid_.reset();
   avoid_planned_ = avoid_arrived_ = false;
@@ -228,6 +243,10 @@ void CoverageSearchClientRos::replan(const std::string& why) {
       scenario::Mission open = *mission_;
       for (auto& a : open.aois) a.window.nlt.reset();
       plan_ = clients::planSearch(open, settings_, progress);
+      // What the search finds past the windows may have driven off from its area since.
+      clients::ContextSettings context;
+      context.drive_off_speed = drive_off_speed_;
+      filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get(), context);
       ROS_INFO("%s: no cell can be reached inside the windows: searching the areas past them",
                kClientName);
     }
@@ -376,6 +395,10 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
   // The pursued vehicle: the sighting of the description nearest the prediction, within the
   // gate (a tracker's data association; the context describes t = 0 and the AOI only).
   const bool tracking = pursue_ && predictor_ && predictor_->tracking();
+  // A track phase: the pursuit starts at the first sighting, from any camera; the claims wait
+  // until the tracking camera sees each target (with ~found_by_sighting off, the ADK's find and
+  // so the phase's start are the claim).
+  const bool defer_claims = track_phase_ && pursue_ && predictor_ && !track_claim_camera_.empty();
   std::vector<clients::VehicleState> predicted;
   double nearest = 0.0;
   if (tracking) {
@@ -399,7 +422,7 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
         associated = std::make_pair(p, static_cast<double>(e.yaw));
       }
     }
-    if (pursuing_) continue;
+    if (pursuing_ && !defer_claims) continue;
     clients::ContextVerdict v;
     v.accepted = true;
     if (use_context_) {
@@ -415,11 +438,26 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
                         clients::describe(target).c_str(), p.x(), p.y(), v.reason.c_str());
       continue;
     }
-    // The first accepted sighting starts the track that a pursuit follows.
-    if (pursue_ && predictor_ && !tracking && !associated) {
+    // The first accepted sighting starts the track that a pursuit follows; on a track phase, a
+    // sighting in the tracking camera restarts a track lost past its gate (not a parked car).
+    const bool restart = defer_claims && tracking && lost_ && !parked &&
+                         msg->camera == track_claim_camera_ &&
+                         t - predictor_->last().t > kLostAfter;
+    if (pursue_ && predictor_ && (!tracking || restart) && !associated) {
       associated = std::make_pair(p, static_cast<double>(e.yaw));
     }
-    if (!claims_.claim(p, t)) continue;
+    if (defer_claims) {
+      // A track target is claimed once, when the tracking camera holds it.
+      const std::string& id = v.target_id.empty() ? target.id : v.target_id;
+      if (msg->camera != track_claim_camera_ || parked || track_claimed_.count(id)) continue;
+      track_claimed_.insert(id);
+      // The phase starts once every target is claimed: reports from the next frame on.
+      if (track_claimed_.size() >= mission_->objective.targets.size()) {
+        reports_after_ = msg->header.stamp.toSec();
+      }
+    } else if (!claims_.claim(p, t)) {
+      continue;
+    }
     const double confidence =
         clients::claimConfidence(1.0, v.relations_checked, v.relations_skipped);
     gate_->publish(detection_pub_,
@@ -428,10 +466,30 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
   }
   if (associated) predictor_->observe(t, associated->first, associated->second);
-  if (track_phase_ && pursuing_ && tracks_pub_) {
+  if (defer_claims && !pursuing_ && associated) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "first sighting at (%.1f, %.1f) from the %s camera",
+                  associated->first.x(), associated->first.y(), msg->camera.c_str());
+    startPursuit(buf);
+  }
+  if (track_phase_ && pursuing_ && tracks_pub_ && !boxes_from_detector_ && reportsDue(*msg)) {
     publishTracks(*msg,
                   associated ? std::optional<geometry::Vec3>(associated->first) : std::nullopt);
   }
+}
+
+void CoverageSearchClientRos::onBlobs(const hameritt::PerceptionReport::ConstPtr& msg) {
+  if (!mission_ || !filter_ || !track_phase_ || !pursuing_ || !tracks_pub_ || stopped_ ||
+      !reportsDue(*msg)) {
+    return;
+  }
+  const double t = msg->header.stamp.toSec() - mission_start_;
+  publishTracks(*msg, predictor_->predict(t).position);
+}
+
+bool CoverageSearchClientRos::reportsDue(const hameritt::PerceptionReport& msg) const {
+  if (track_claim_camera_.empty()) return true;
+  return reports_after_ >= 0 && msg.header.stamp.toSec() > reports_after_;
 }
 
 bool CoverageSearchClientRos::parkedAt(const geometry::Vec3& p) const {

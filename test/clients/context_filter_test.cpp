@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/public_config.h"
 #include "hameritt/scenario/error.h"
@@ -95,6 +97,40 @@ TEST_F(ContextFilterTest, TheTargetPassesInsideItsWindowOnly) {
   off.position += Vec3(0.4, -0.3, 0);
   off.yaw += 0.08;
   EXPECT_TRUE(filter.check(off, 100.0, target()).accepted);
+}
+
+TEST_F(ContextFilterTest, AMovingTargetPassesWithinReachOfItsAreaPastTheWindow) {
+  // The same mission as a track mission: its target may drive off once aoi_1's window closes.
+  scenario::Mission track = *mission_;
+  track.cls = scenario::ScenarioClass::kTrack;
+  track.aois.erase(std::remove_if(track.aois.begin(), track.aois.end(),
+                                  [](const auto& a) { return a.id != "aoi_1"; }),
+                   track.aois.end());
+  ASSERT_EQ(track.aois.size(), 1u);
+  const double nlt = track.aois.front().window.nlt.value();  // 192
+  ContextSettings reach;
+  reach.drive_off_speed = 13.0;
+  const ContextFilter filter(track, world_, reach);
+  // In the area past its window: accepted, its relations (t = 0) no longer checked.
+  const ContextVerdict in = filter.check(at("car_706"), nlt + 8, target());
+  EXPECT_TRUE(in.accepted) << in.reason;
+  EXPECT_EQ(in.region_id, "aoi_1");
+  EXPECT_EQ(in.relations_checked, 0);
+  EXPECT_EQ(in.relations_skipped, 6);
+  // 50 m outside the area: out of reach 1 s after the window (14.5 m), within it after 5 s.
+  CandidatePose away = at("car_706");
+  while (track.aois.front().polygon.distance(away.position.head<2>()) < 50.0) {
+    away.position.x() += 0.5;
+  }
+  EXPECT_FALSE(filter.check(away, nlt + 1, target()).accepted);
+  EXPECT_TRUE(filter.check(away, nlt + 5, target()).accepted);
+  EXPECT_FALSE(filter.check(away, nlt - 1, target()).accepted);  // inside the window: in the area
+  // Negative controls: no reach (the default), or a target that does not move (area search).
+  EXPECT_FALSE(ContextFilter(track, world_).check(away, nlt + 5, target()).accepted);
+  EXPECT_FALSE(ContextFilter(*mission_, world_, reach).check(away, nlt + 5, target()).accepted);
+  ContextSettings bad;
+  bad.drive_off_speed = -1.0;
+  EXPECT_THROW(bad.validate(), scenario::ConfigError);
 }
 
 TEST_F(ContextFilterTest, EveryConfuserOfTheScenarioIsRejected) {

@@ -1,6 +1,8 @@
-"""Shared pieces of the write-fault, full-disk, duration-end, pursuit and follow tests: a tally
-of checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics without
-a mission, one generated scenario, and a mission.launch run read back."""
+"""Shared pieces of the write-fault, full-disk, duration-end, pursuit, follow and track tests: a
+tally of checks, the metrics.json schema (python3-jsonschema), an ADK that writes its metrics
+without a mission, one generated scenario, and a mission.launch run read back (with the adk/phase
+changes rostopic saw)."""
+import csv
 import json
 import os
 import signal
@@ -112,3 +114,27 @@ def launch_mission(args, out, log, label, check, guard, master_uri=None):
     except (OSError, ValueError) as e:
         check(False, "%s: metrics.json: %s" % (label, e))
         return rc, text, None
+
+
+def phase_changes(path):
+    """[(phase, type, state)] from `rostopic echo -p` output, in order."""
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return [(r["field.phase"], r["field.type"], r["field.state"]) for r in rows]
+
+
+def launch_mission_phases(args, out, log, phases, label, check, guard, echoes=None):
+    """launch_mission, with adk/phase as `rostopic echo` (not our code) sees it written to PHASES:
+    subscribed before the ADK starts, so no change is missed; `echoes` ({topic: path}) are
+    recorded the same way. Returns (exit code, log text, metrics.json or None, [(phase, type,
+    state)] in order)."""
+    topics = dict(echoes or {}, **{"/adk/phase": phases})
+    procs = [subprocess.Popen(["rostopic", "echo", "-p", t], stdout=open(p, "w"),
+                              stderr=subprocess.DEVNULL) for t, p in topics.items()]
+    try:
+        rc, text, m = launch_mission(args, out, log, label, check, guard)
+    finally:
+        for e in procs:
+            e.send_signal(signal.SIGINT)
+            e.wait(30)
+    return rc, text, m, phase_changes(phases)

@@ -31,25 +31,16 @@ import json
 import math
 import os
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
 
 from graph_util import private_master_port, start_master, stop_master
-from fault_util import Checks, generate_one, launch_mission, metrics_validator
+from fault_util import Checks, generate_one, launch_mission_phases, metrics_validator
 
 PORT = private_master_port(32000)
 SEED = int(os.environ.get("HAMERITT_FOLLOW_SEED", "3"))
 METRICS = metrics_validator()
 check = Checks()
-
-
-def phase_changes(path):
-    """[(phase, type, state)] from `rostopic echo -p` output, in order."""
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return [(r["field.phase"], r["field.type"], r["field.state"]) for r in rows]
 
 
 def trajectory_at(traj, t):
@@ -123,22 +114,12 @@ def run(tmp, scenario, pursue):
     out = os.path.join(tmp, label)
     log = os.path.join(tmp, label + ".log")
     phases = os.path.join(tmp, label + "_phase.csv")
-    # adk/phase as rostopic sees it: subscribed before the ADK starts, so no change is missed.
-    echo = subprocess.Popen(["rostopic", "echo", "-p", "/adk/phase"], stdout=open(phases, "w"),
-                            stderr=subprocess.DEVNULL)
     states = os.path.join(tmp, label + "_target_state.csv")
-    echo_states = subprocess.Popen(["rostopic", "echo", "-p", "/adk/target_state"],
-                                   stdout=open(states, "w"), stderr=subprocess.DEVNULL)
-    try:
-        # A guard against a hang only: what is judged is the outcome, not how long it took.
-        rc, text, m = launch_mission(
-            ["scenario:=" + scenario, "mode:=maneuver_only", "lockstep:=true",
-             "real_time_factor:=0", "pursue:=%s" % ("true" if pursue else "false")],
-            out, log, label, check, 900)
-    finally:
-        for e in (echo, echo_states):
-            e.send_signal(signal.SIGINT)
-            e.wait(30)
+    # A guard against a hang only: what is judged is the outcome, not how long it took.
+    rc, text, m, changes = launch_mission_phases(
+        ["scenario:=" + scenario, "mode:=maneuver_only", "lockstep:=true",
+         "real_time_factor:=0", "pursue:=%s" % ("true" if pursue else "false")],
+        out, log, phases, label, check, 900, {"/adk/target_state": states})
     if m is None:
         return None, text, []
     check_target_state(label, scenario, states, m)
@@ -146,7 +127,6 @@ def run(tmp, scenario, pursue):
     check(rc == 0, "%s: the launch exited %d" % (label, rc))
     check(not errors, "%s: metrics.json does not validate: %s" % (label, errors))
     check("follow" in m, "%s: metrics.json has no follow block" % label)
-    changes = phase_changes(phases)
     f = m.get("follow", {})
     print("%s: outcome %s (%s), end_time %.1f s; follow phase %s from %s, approach %.1f s, "
           "then %.1f of %.0f s scored, "

@@ -52,6 +52,10 @@ struct ContextSettings {
   double over_tolerance = 0.75;       // m, ON_TOP_OF / NOT_ON_TOP_OF footprint containment
   double bearing_tolerance_deg = 35;  // directional relations: |bearing - evidence bearing|
   bool check_relations = true;
+  // m/s; 0: off. A moving target (pursuit, follow, track) may drive off once its area's window
+  // has closed: t seconds past the window's end, a candidate up to drive_off_speed * t (plus
+  // region_tolerance) outside the area still counts as in it, its relations unchecked.
+  double drive_off_speed = 0.0;
   scenario::RelationConfig thresholds;  // the generator's operator thresholds
   void validate() const;
 };
@@ -86,6 +90,8 @@ struct ContextVerdict {
 // related objects that are not in the static world (scenario cars, pedestrians, convoy and
 // vignette groups), line of sight and dz (need the true box), and every relation when the
 // target moves (route search; pursuit once its AOI window has closed): relations describe t = 0.
+// With drive_off_speed, a moving target's candidate within reach of its AOI past the window's end
+// passes the region gate (region_id the AOI's, its relations skipped).
 // A mission with several targets of this description accepts the candidate when one target's
 // context holds.
 class ContextFilter {
@@ -107,7 +113,9 @@ class ContextFilter {
   // "" when the relation holds (or is skipped: *skipped = true), else why it does not.
   std::string checkRelation(const scenario::SceneRelation& rel, const CandidatePose& c,
                             bool* skipped) const;
-  std::string regionOf(const geometry::Vec2& p, double t) const;
+  // The AOI or route the point is in at t ("" when none); *driven_off: in an AOI's reach past
+  // its window only (drive_off_speed).
+  std::string regionOf(const geometry::Vec2& p, double t, bool* driven_off) const;
 
   const scenario::Mission& mission_;
   const scenario::World* world_;

@@ -33,6 +33,12 @@ clients::PinholeCamera fromMsg(const sensor_msgs::CameraInfo& msg);
 // attributes (never its id or role).
 clients::Observation toObservation(const hameritt::PerceivedEntity& e);
 
+// A detector's blob of `target`'s colour as a perceived entity: its image box (inclusive
+// bounds), colour pixels, measured position and long-axis yaw, and the description's class and
+// attributes (no entity id or role: the detector does not know them).
+hameritt::PerceivedEntity toPerceivedBlob(const scenario::TargetDescription& target,
+                                          const clients::CarCandidate& blob);
+
 // A claim: "I see `target` at `position`" from the frame stamped `stamp`.
 hameritt::Detection makeDetection(const std::string& client,
                                   const scenario::TargetDescription& target,

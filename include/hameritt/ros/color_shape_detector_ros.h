@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "hameritt/Mission.h"
+#include "hameritt/PerceptionReport.h"
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/color_detector.h"
 #include "hameritt/clients/context_filter.h"
@@ -31,7 +32,10 @@ namespace hameritt::ros_wrappers {
 // Topics (relative names), per camera c of ~cameras: sub uav/camera/<c>/image_raw (rgb8),
 // uav/camera/<c>/depth (32FC1, matched by exact stamp), uav/camera/<c>/camera_info; sub mission
 // (latched), adk/state (any type); tf map -> the image's frame (else map -> uav/base_link and the
-// sim_config's mount); pub perception/detections (hameritt/Detection).
+// sim_config's mount); pub perception/detections (hameritt/Detection); with ~publish_blobs,
+// pub perception/blobs (hameritt/PerceptionReport: per processed frame, the accepted blobs of
+// each target description's colour with their image box and measured position, stamped with
+// the image's header; entity_id and role empty, attributes the description's).
 //
 // Parameters (private): ~sim_config (required; public part only), ~cameras (["down"]),
 // ~max_rate_hz (2: frames processed per camera and second of sim time), ~colors/<name> (lists of
@@ -39,7 +43,8 @@ namespace hameritt::ros_wrappers {
 // ~min_blob_pixels, ~open_kernel, ~close_kernel, ~height_min, ~height_max, ~merge_gap,
 // ~size_tolerance, ~max_range, ~reject_border (clients::DetectorSettings), ~region_tolerance,
 // ~distance_tolerance, ~bearing_tolerance_deg, ~check_relations (clients::ContextSettings),
-// ~claim_radius (4 m), ~claim_hold (30 s), ~min_confidence (0), ~mission_start_time (0).
+// ~claim_radius (4 m), ~claim_hold (30 s), ~min_confidence (0), ~mission_start_time (0),
+// ~claim (true: publish claims on perception/detections), ~publish_blobs (false).
 // config/perception_client.yaml holds the defaults (launch/clients.launch loads it).
 class ColorShapeDetectorRos {
  public:
@@ -79,14 +84,14 @@ class ColorShapeDetectorRos {
   std::unique_ptr<clients::ContextFilter> filter_;
   clients::ClaimLedger claims_;
   double max_rate_ = 2.0, min_confidence_ = 0.0, mission_start_ = 0.0;
-  bool ended_ = false;
+  bool ended_ = false, claim_ = true, publish_blobs_ = false;
 
   tf2_ros::Buffer tf_;
   // Fills tf_ on its own thread; in lock-step, gated /tf and /tf_static subscriptions do.
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   ros::Subscriber tf_sub_, tf_static_sub_;
   std::vector<std::unique_ptr<Camera>> cameras_;
-  ros::Publisher detection_pub_;
+  ros::Publisher detection_pub_, blobs_pub_;
   ros::Subscriber mission_sub_, state_sub_;
 };
 

@@ -50,10 +50,18 @@ namespace hameritt::ros_wrappers {
 // must pass the context filter), ~claim_radius (4 m), ~claim_hold (30 s), ~mission_start_time
 // (0: sim time of mission time 0), ~rate_hz (2), ~pursue (true: pursue a track objective's
 // target after its find instead of hovering), ~pursuit_standoff (8 m), ~pursuit_height (20 m),
-// ~pursuit_lead (1 s), ~pursuit_rate_hz (10), ~avoid (true: fly an avoid mission with the
-// pilot), ~avoid_rate_hz (10), ~avoid_speed_fraction (0.6), ~avoid_horizontal_buffer (9 m),
-// ~avoid_vertical_buffer (6 m), ~avoid_horizon (10 s). Avoid missions: sub adk/traffic
-// (hameritt/EntityStateArray), pub uav/cmd_pose.
+// ~pursuit_lead (1 s), ~pursuit_rate_hz (10), ~publish_tracks (true: on a track phase, while
+// pursuing, each target's box goes out on perception/tracks), ~track_boxes (perfect_perception:
+// the boxes of adk/perfect_perception | detector: those of the detector's perception/blobs,
+// hameritt/PerceptionReport, nearest the pursued vehicle's predicted position), ~avoid (true: fly
+// an avoid mission with the pilot), ~avoid_rate_hz (10), ~avoid_speed_fraction (0.6),
+// ~avoid_horizontal_buffer (9 m), ~avoid_vertical_buffer (6 m), ~avoid_horizon (10 s),
+// ~track_claim_camera ("down": on a track phase, each target is claimed once, when this
+// camera sees it, the pursuit starting at the first sighting; "": claims as in the other
+// classes), ~drive_off_speed (13 m/s, the generator's fastest car: once the search goes on past the
+// areas' windows, a sighting that far from its area per second since the window closed still
+// passes the context filter). Avoid
+// missions: sub adk/traffic (hameritt/EntityStateArray), pub uav/cmd_pose.
 class CoverageSearchClientRos {
  public:
   // Throws scenario::ConfigError for bad parameters or files (the node exits with ROS_FATAL).
@@ -67,6 +75,9 @@ class CoverageSearchClientRos {
   void onProgress(const hameritt::FollowProgress::ConstPtr& msg);
   void onState(const topic_tools::ShapeShifter::ConstPtr& msg);
   void onDetection(const hameritt::Detection::ConstPtr& msg);
+  // With ~track_claim_camera: a frame after the one that claimed the last target (the phase
+  // starts at that claim), so that no report precedes the phase.
+  bool reportsDue(const hameritt::PerceptionReport& msg) const;
   // A sighting at p is a parked car of the public map.
   bool parkedAt(const geometry::Vec3& p) const;
   // perception/tracks: for each mission target, the box of the sighting in `msg` that matches
@@ -75,6 +86,9 @@ class CoverageSearchClientRos {
   void publishTracks(const hameritt::PerceptionReport& msg,
                      const std::optional<geometry::Vec3>& near);
   void onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg);
+  // ~track_boxes detector: the detector's blobs of a frame become the track report, each
+  // target's the blob nearest the pursued vehicle's predicted position.
+  void onBlobs(const hameritt::PerceptionReport::ConstPtr& msg);
   void onTick();
   // Pursuit: starts it (after the find of a track objective's target) and flies it.
   void startPursuit(const std::string& why);
@@ -98,6 +112,9 @@ class CoverageSearchClientRos {
   std::unique_ptr<scenario::World> world_;
   clients::CoverageSettings settings_;
   std::optional<scenario::Mission> mission_;
+  // Once the search goes on past the areas' windows, the context filter accepts a sighting
+  // within this reach (m/s past the window's end) of its area: the target may have driven off.
+  double drive_off_speed_ = 13.0;
   std::unique_ptr<clients::ContextFilter> filter_;
   bool repeat_ = true, stop_on_detection_ = true, claim_ = false, use_context_ = true;
   double mission_start_ = 0.0;
@@ -129,9 +146,16 @@ class CoverageSearchClientRos {
   ros::Publisher waypoints_pub_, plan_pub_, detection_pub_, pose_pub_, tracks_pub_;
   // A track phase: while pursuing, the boxes of the targets it sees go out on perception/tracks.
   bool publish_tracks_ = true;
+  // Where the reported boxes come from: false, perfect perception; true, the detector's blobs.
+  bool boxes_from_detector_ = false;
   bool track_phase_ = false;
+  // A track phase: each target is claimed once, when this camera sees it ("": at every sighting,
+  // as in the other classes); the pursuit starts at the first sighting from any camera.
+  std::string track_claim_camera_ = "down";
+  std::set<std::string> track_claimed_;
+  double reports_after_ = -1.0;  // the stamp of the frame that claimed the last target
   ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_,
-      traffic_sub_;
+      traffic_sub_, blobs_sub_;
 };
 
 }  // namespace hameritt::ros_wrappers
