@@ -19,6 +19,7 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/rng.h"
 #include "hameritt/scenario/signal_compliance.h"
+#include "hameritt/scenario/traffic_clearance.h"
 #include "hameritt/scenario/trajectory.h"
 
 namespace hameritt::scenario {
@@ -2030,11 +2031,31 @@ class ScenarioBuilder {
       add(std::move(se.entity), "pedestrian", std::move(se.trajectory));
     }
     const TrafficEpisode& ep = traffic.episode->episode;
+    // The episode's cars never see the mission's own: those that would come near one are
+    // withheld from this scenario (each still takes its id, so that the others keep theirs).
+    std::vector<MovingFootprint> own, ambient;
+    for (const auto& se : sc_.sim.entities) {
+      if (isMissionCar(se)) own.push_back(footprintOf(se));
+    }
     for (std::size_t i = 0; i < traffic.cars.size(); ++i) {
-      ScenarioEntity se =
-          episodeCarEntity(ep, i, std::move(traffic.cars[i].trajectory), nextCarId());
+      MovingFootprint f;
+      f.trajectory = &traffic.episode->trajectories[i];
+      f.time_shift = traffic.offset;
+      f.length = ep.cars[i].size.x();
+      f.width = ep.cars[i].size.y();
+      ambient.push_back(f);
+    }
+    const std::vector<std::size_t> held = trafficToWithhold(own, ambient, sc_.mission.time_limit);
+    for (std::size_t i = 0, h = 0; i < traffic.cars.size(); ++i) {
+      const std::string id = nextCarId();
+      ref.car_ids.push_back(id);
+      if (h < held.size() && held[h] == i) {
+        ref.withheld.push_back(id);
+        ++h;
+        continue;
+      }
+      ScenarioEntity se = episodeCarEntity(ep, i, std::move(traffic.cars[i].trajectory), id);
       se.entity.block = world_.blockAt(se.entity.box.center2());
-      ref.car_ids.push_back(se.entity.id);
       sc_.sim.entities.push_back(std::move(se));
     }
     if (traffic.episode->text) {

@@ -198,8 +198,7 @@ MapData parseDocuments(const json& mission, const json& sim, const std::string& 
     // A batch's city scenario: its traffic cars and crowd are a window of a shared traffic
     // episode file, resolved (and checked) by the simulator's reader.
     const scenario::SimConfig full = scenario::loadSimConfig(sim_file);
-    const std::size_t n =
-        full.traffic ? full.traffic->car_ids.size() + full.traffic->pedestrian_ids.size() : 0;
+    const std::size_t n = full.traffic ? full.traffic->entityCount() : 0;
     for (std::size_t i = full.entities.size() - n; i < full.entities.size(); ++i) {
       const scenario::ScenarioEntity& se = full.entities[i];
       MoverData mv;

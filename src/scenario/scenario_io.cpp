@@ -293,9 +293,7 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s, bool traffic_by_reference
   // growing a 100 KB buffer by doubling would copy it several times.
   std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;
   const std::size_t written =
-      s.entities.size() - (s.traffic && traffic_by_reference
-                               ? s.traffic->car_ids.size() + s.traffic->pedestrian_ids.size()
-                               : 0);
+      s.entities.size() - (s.traffic && traffic_by_reference ? s.traffic->entityCount() : 0);
   for (std::size_t k = 0; k < written; ++k) points += s.entities[k].trajectory.size() + 8;
   for (const auto& a : s.aircraft) points += a.trajectory.size() + 4;
   w.clear(8192 + 64 * points);
@@ -415,7 +413,13 @@ void writeSimConfig(JsonWriter& w, const SimConfig& s, bool traffic_by_reference
     w.endArray();
     w.key("pedestrians").beginArray();
     for (const auto& id : r.pedestrian_ids) w.value(id);
-    w.endArray().endObject();
+    w.endArray();
+    if (!r.withheld.empty()) {
+      w.key("withheld").beginArray();
+      for (const auto& id : r.withheld) w.value(id);
+      w.endArray();
+    }
+    w.endObject();
   }
   if (s.spec) {
     w.key("spec").beginObject();

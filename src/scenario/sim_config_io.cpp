@@ -1,5 +1,6 @@
 #include "hameritt/scenario/sim_config_io.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -196,7 +197,8 @@ namespace {
 // sim_config.json's "traffic": the reference to a traffic episode file, resolved: the file is
 // read (relative to the directory of `file`), its SHA-256 checked, the window checked to lie
 // within the episode and the signal plan to be the episode's shifted by the offset; the
-// pedestrians and then the cars are appended to s.entities.
+// pedestrians and then the cars not withheld are appended to s.entities: this is where a
+// withheld car leaves the scenario, for every reader of it.
 TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& file,
                                        std::set<std::string>* ids) {
   TrafficEpisodeRef r;
@@ -211,6 +213,7 @@ TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& 
   }
   r.car_ids = strings(t.array("cars"), t.at("cars"), file);
   r.pedestrian_ids = strings(t.array("pedestrians"), t.at("pedestrians"), file);
+  if (t.has("withheld")) r.withheld = strings(t.array("withheld"), t.at("withheld"), file);
   t.finish();
   if (r.file.empty() || r.file.find('\0') != std::string::npos) {
     t.error("file", "expected a file name");
@@ -271,11 +274,24 @@ TrafficEpisodeRef readTrafficReference(Obj& t, SimConfig& s, const std::string& 
                                               episodePedestrianWindow(e, i, r.offset, s.duration),
                                               r.pedestrian_ids[i]));
   }
+  std::set<std::string> withheld;
+  for (std::size_t k = 0; k < r.withheld.size(); ++k) {
+    const auto it = std::find(r.car_ids.begin(), r.car_ids.end(), r.withheld[k]);
+    if (it == r.car_ids.end()) {
+      throw ConfigError(file + ": " + idx("traffic.withheld", k) +
+                        ": expected one of traffic.cars, got \"" + r.withheld[k] + "\"");
+    }
+    if (!withheld.insert(r.withheld[k]).second) {
+      throw ConfigError(file + ": " + idx("traffic.withheld", k) + ": duplicate id \"" +
+                        r.withheld[k] + "\"");
+    }
+  }
   for (std::size_t i = 0; i < e.cars.size(); ++i) {
     if (!ids->insert(r.car_ids[i]).second) {
       throw ConfigError(file + ": " + idx("traffic.cars", i) + ": duplicate id \"" + r.car_ids[i] +
                         "\"");
     }
+    if (withheld.count(r.car_ids[i])) continue;
     s.entities.push_back(
         episodeCarEntity(e, i, episodeCarWindow(e, i, r.offset, s.duration), r.car_ids[i]));
   }

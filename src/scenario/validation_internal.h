@@ -193,6 +193,10 @@ class Semantics {
   // signalised intersections only when its signal lets it (rule "signal";
   // scenario/signal_compliance.h).
   void signalCompliance(const json& ents);
+  // In a city: no car of the mission overlaps an ambient car of the scenario (rule
+  // "traffic_clearance", sampled every kClearanceStep; scenario/traffic_clearance.h), at the
+  // withheld list of a traffic reference, else at the mission car.
+  void trafficClearance(const SimConfig& sc, const std::map<std::string, std::size_t>& index);
 
   // Samples [t, x, y, z, yaw] of a timed path at `pointer`: t >= 0 and strictly increasing
   // (malformed samples are the schema's to report).

@@ -3,6 +3,7 @@
 
 #include "hameritt/scenario/signal_compliance.h"
 #include "hameritt/scenario/sim_config_io.h"
+#include "hameritt/scenario/traffic_clearance.h"
 #include "validation_internal.h"
 
 namespace hameritt::scenario::validation_internal {
@@ -98,6 +99,34 @@ void Semantics::signalCompliance(const json& ents) {
       if (e.allowed) continue;
       add(jsonPointerAppend("/entities", it->second) + "/trajectory", "signal",
           se.entity.id + " (" + se.role + ") " + describeEntry(e, *sc.signals));
+    }
+  }
+  trafficClearance(sc, index);
+}
+
+void Semantics::trafficClearance(const SimConfig& sc,
+                                 const std::map<std::string, std::size_t>& index) {
+  std::vector<const ScenarioEntity*> own, ambient;
+  for (const auto& se : sc.entities) {
+    if (isMissionCar(se)) own.push_back(&se);
+    if (se.entity.cls == EntityClass::kCar && se.role == "traffic") ambient.push_back(&se);
+  }
+  std::vector<MovingFootprint> fo, fa;
+  for (const auto* se : own) fo.push_back(footprintOf(*se));
+  for (const auto* se : ambient) fa.push_back(footprintOf(*se));
+  for (const std::size_t i : trafficToWithhold(fo, fa, sc.duration, 0.0)) {
+    for (std::size_t m = 0; m < own.size(); ++m) {
+      const auto t = firstOverlap(fo[m], fa[i], sc.duration, 0.0);
+      if (!t) continue;
+      const auto it = index.find(own[m]->entity.id);
+      const std::string where = sc.traffic ? std::string("/traffic/withheld")
+                                : it != index.end()
+                                    ? jsonPointerAppend("/entities", it->second) + "/trajectory"
+                                    : std::string("/entities");
+      add(where, "traffic_clearance",
+          ambient[i]->entity.id + " (traffic) overlaps " + own[m]->entity.id + " (" + own[m]->role +
+              ") at t = " + num(*t) + " s: expected the ambient car withheld");
+      break;
     }
   }
 }

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -726,6 +727,32 @@ TEST(CityTrafficEpisode, BatchReferencesReadBackAsTheGeneratedScenario) {
   ASSERT_GE(k["traffic"]["pedestrians"].size(), 300u);
   k["traffic"]["pedestrians"].erase(k["traffic"]["pedestrians"].size() - 1);
   EXPECT_NE(failure(k.dump()).find("traffic.pedestrians: expected"), std::string::npos);
+  // A withheld car leaves the scenario for every reader of the file; an id that is not one of
+  // the episode's cars, or one named twice, is refused naming the field.
+  writeText(first_path, first_text);
+  const SimConfig all = loadSimConfig(first_path);
+  nlohmann::json held = j["traffic"].value("withheld", nlohmann::json::array());
+  std::string kept;
+  for (const auto& id : j["traffic"]["cars"]) {
+    if (std::find(held.begin(), held.end(), id) == held.end()) kept = id.get<std::string>();
+  }
+  ASSERT_FALSE(kept.empty());
+  k = j;
+  k["traffic"]["withheld"] = held;
+  k["traffic"]["withheld"].push_back(kept);
+  writeText(first_path, k.dump());
+  const SimConfig fewer = loadSimConfig(first_path);
+  EXPECT_EQ(fewer.entities.size() + 1, all.entities.size());
+  EXPECT_EQ(fewer.traffic->entityCount() + 1, all.traffic->entityCount());
+  for (const auto& se : fewer.entities) EXPECT_NE(se.entity.id, kept);
+  k["traffic"]["withheld"].push_back("car_999999");
+  const std::string unknown = failure(k.dump());
+  EXPECT_NE(unknown.find("traffic.withheld[" + std::to_string(held.size() + 1) +
+                         "]: expected one of traffic.cars, got \"car_999999\""),
+            std::string::npos)
+      << unknown;
+  k["traffic"]["withheld"].back() = kept;
+  EXPECT_NE(failure(k.dump()).find("duplicate id"), std::string::npos);
   // A signal plan not shifted with the offset.
   k = j;
   const double t0 = j["traffic"]["offset"].get<double>();

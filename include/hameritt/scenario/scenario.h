@@ -331,9 +331,11 @@ struct SignalPlan {
 };
 
 // The ambient cars and crowd of a city scenario taken from a traffic episode file that a batch
-// shares (scenario/city_traffic.h): the scenario's t = 0 is the episode's t = offset. In memory
-// they are also the last entities (pedestrian_ids.size() pedestrians, then car_ids.size() cars);
-// simConfigJson() writes them inline, and a batch writes this reference instead.
+// shares (scenario/city_traffic.h): the scenario's t = 0 is the episode's t = offset. The cars
+// named in `withheld` are not part of the scenario: they would come near one of its own cars
+// (scenario/traffic_clearance.h). In memory the others are also the last entities
+// (pedestrian_ids.size() pedestrians, then the cars not withheld, in order); simConfigJson()
+// writes them inline, and a batch writes this reference instead.
 struct TrafficEpisodeRef {
   std::string file;  // relative to the directory of sim_config.json
   int episode = 0;
@@ -341,7 +343,13 @@ struct TrafficEpisodeRef {
   std::string sha256;                       // of the file's bytes, lowercase hex
   std::vector<std::string> car_ids;         // the entity id of each of the episode's cars, in order
   std::vector<std::string> pedestrian_ids;  // and of each of its pedestrians
+  std::vector<std::string> withheld;        // car ids left out of the scenario, in car order
   std::shared_ptr<const std::string> text;  // the file's bytes (set by the generator)
+
+  // How many of the last entities the reference stands for.
+  std::size_t entityCount() const {
+    return pedestrian_ids.size() + car_ids.size() - withheld.size();
+  }
 };
 
 struct SimConfig {

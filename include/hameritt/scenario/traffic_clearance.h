@@ -1,0 +1,56 @@
+#pragma once
+// The city mission's own cars against the ambient traffic: the ambient cars are simulated once
+// per traffic episode, shared by every scenario that draws it, and never see a scenario's own
+// cars. A scenario therefore withholds every ambient car that would come near one of its own
+// cars (SimConfig::traffic's withheld ids): the footprints are compared every
+// kClearanceStep seconds over the scenario's duration.
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "hameritt/scenario/scenario.h"
+
+namespace hameritt::scenario {
+
+// The sampling step of the comparison (s) and the margin by which a scenario keeps the ambient
+// cars it keeps away from its own (m, on every side of each footprint).
+constexpr double kClearanceStep = 0.1;
+constexpr double kTrafficClearance = 0.5;
+
+// A car's footprint moving along a trajectory: a length x width rectangle centred on the pose,
+// along its yaw. The scenario's t is the trajectory's t - time_shift (an episode car's
+// trajectory runs on episode time, the scenario starting at its offset). A trajectory with a
+// single point, or none, stands at `pose`.
+struct MovingFootprint {
+  const Trajectory* trajectory = nullptr;
+  TrajectoryPoint pose;
+  double time_shift = 0.0;
+  double length = 4.5;
+  double width = 1.8;
+};
+
+// The footprint of a scenario entity: its box's length and width along its trajectory, or at
+// its box when it has none.
+MovingFootprint footprintOf(const ScenarioEntity& se);
+
+// Whether a scenario entity is one of the mission's own cars: a car of any role but "traffic".
+bool isMissionCar(const ScenarioEntity& se);
+
+// Whether two rectangles (centres, yaws, half length and half width) overlap: the
+// separating-axis test on their four edge normals (Gottschalk, Lin and Manocha 1996, "OBBTree").
+bool rectanglesOverlap(double ax, double ay, double ayaw, double ahl, double ahw, double bx,
+                       double by, double byaw, double bhl, double bhw);
+
+// The first t = k * kClearanceStep in [0, duration] at which the footprints of a and b, each
+// grown by `margin` on every side, overlap; nullopt when they never do.
+std::optional<double> firstOverlap(const MovingFootprint& a, const MovingFootprint& b,
+                                   double duration, double margin);
+
+// The indices (ascending) of the `traffic` cars whose footprint comes within `margin` of a
+// `mission` car's at some sample of [0, duration].
+std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& mission,
+                                           const std::vector<MovingFootprint>& traffic,
+                                           double duration, double margin = kTrafficClearance);
+
+}  // namespace hameritt::scenario

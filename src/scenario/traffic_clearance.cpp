@@ -1,0 +1,187 @@
+#include "hameritt/scenario/traffic_clearance.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hameritt/geometry/types.h"
+
+namespace hameritt::scenario {
+
+namespace {
+
+// Fine samples per block of the broad phase: two cars' fine samples are compared only where the
+// boxes that bound their footprints over a block meet.
+constexpr std::size_t kBlock = 20;
+
+struct Box {
+  double min_x, min_y, max_x, max_y;
+  bool meets(const Box& o) const {
+    return min_x <= o.max_x && o.min_x <= max_x && min_y <= o.max_y && o.min_y <= max_y;
+  }
+};
+
+// The pose of a footprint at scenario time t, walking its trajectory forward (t never
+// decreases between calls): the interpolation of sampleTrajectory() without its search.
+class Cursor {
+ public:
+  explicit Cursor(const MovingFootprint& f) : f_(f) {}
+
+  bool moving() const { return f_.trajectory && f_.trajectory->size() >= 2; }
+
+  TrajectoryPoint at(double t) {
+    if (!moving()) return f_.pose;
+    const Trajectory& tr = *f_.trajectory;
+    const double te = t + f_.time_shift;
+    while (i_ + 1 < tr.size() && tr[i_ + 1].t <= te) ++i_;
+    if (te <= tr.front().t) return tr.front();
+    if (i_ + 1 >= tr.size()) return tr.back();
+    const TrajectoryPoint &a = tr[i_], &b = tr[i_ + 1];
+    const double u = b.t > a.t ? (te - a.t) / (b.t - a.t) : 1.0;
+    TrajectoryPoint p;
+    p.t = te;
+    p.x = a.x + u * (b.x - a.x);
+    p.y = a.y + u * (b.y - a.y);
+    p.yaw = geometry::wrapPi(a.yaw + u * geometry::wrapPi(b.yaw - a.yaw));
+    return p;
+  }
+
+  // Extends b by the trajectory's vertices strictly inside (ta, tb) of scenario time, from the
+  // cursor's place on (which at(ta) has set).
+  void vertices(double ta, double tb, Box* b) const {
+    if (!moving()) return;
+    const Trajectory& tr = *f_.trajectory;
+    for (std::size_t k = i_ + 1; k < tr.size() && tr[k].t < tb + f_.time_shift; ++k) {
+      if (tr[k].t <= ta + f_.time_shift) continue;
+      b->min_x = std::min(b->min_x, tr[k].x);
+      b->max_x = std::max(b->max_x, tr[k].x);
+      b->min_y = std::min(b->min_y, tr[k].y);
+      b->max_y = std::max(b->max_y, tr[k].y);
+    }
+  }
+
+ private:
+  const MovingFootprint& f_;
+  std::size_t i_ = 0;
+};
+
+std::size_t fineSamples(double duration) {
+  return static_cast<std::size_t>(std::floor(duration / kClearanceStep + 1e-9)) + 1;
+}
+
+double reach(const MovingFootprint& f, double margin) {
+  return 0.5 * std::hypot(f.length + 2 * margin, f.width + 2 * margin);
+}
+
+// The boxes that hold the footprint (grown by margin) over each block of fine samples.
+std::vector<Box> blockBoxes(const MovingFootprint& f, std::size_t n, double margin) {
+  const double r = reach(f, margin);
+  std::vector<Box> out;
+  out.reserve((n + kBlock - 1) / kBlock);
+  Cursor c(f);
+  for (std::size_t k0 = 0; k0 < n; k0 += kBlock) {
+    const double ta = static_cast<double>(k0) * kClearanceStep;
+    const double tb = static_cast<double>(std::min(k0 + kBlock, n) - 1) * kClearanceStep;
+    const TrajectoryPoint a = c.at(ta);
+    Box b{a.x, a.y, a.x, a.y};
+    c.vertices(ta, tb, &b);
+    const TrajectoryPoint e = c.at(tb);
+    b.min_x = std::min(b.min_x, e.x) - r;
+    b.max_x = std::max(b.max_x, e.x) + r;
+    b.min_y = std::min(b.min_y, e.y) - r;
+    b.max_y = std::max(b.max_y, e.y) + r;
+    out.push_back(b);
+  }
+  return out;
+}
+
+TrajectoryPoint poseAt(const MovingFootprint& f, double t) {
+  if (!f.trajectory || f.trajectory->size() < 2) return f.pose;
+  return sampleTrajectory(*f.trajectory, t + f.time_shift);
+}
+
+// The first fine sample of block `j` at which a and b overlap (grown by margin).
+std::optional<double> overlapInBlock(const MovingFootprint& a, const MovingFootprint& b,
+                                     std::size_t j, std::size_t n, double margin) {
+  const double rr = reach(a, margin) + reach(b, margin);
+  for (std::size_t k = j * kBlock; k < std::min((j + 1) * kBlock, n); ++k) {
+    const double t = static_cast<double>(k) * kClearanceStep;
+    const TrajectoryPoint p = poseAt(a, t), q = poseAt(b, t);
+    if (std::hypot(p.x - q.x, p.y - q.y) > rr) continue;
+    if (rectanglesOverlap(p.x, p.y, p.yaw, 0.5 * a.length + margin, 0.5 * a.width + margin, q.x,
+                          q.y, q.yaw, 0.5 * b.length + margin, 0.5 * b.width + margin)) {
+      return t;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+MovingFootprint footprintOf(const ScenarioEntity& se) {
+  MovingFootprint f;
+  f.trajectory = &se.trajectory;
+  f.pose.x = se.entity.box.center.x();
+  f.pose.y = se.entity.box.center.y();
+  f.pose.yaw = se.entity.box.yaw;
+  f.length = se.entity.box.size.x();
+  f.width = se.entity.box.size.y();
+  return f;
+}
+
+bool isMissionCar(const ScenarioEntity& se) {
+  return se.entity.cls == EntityClass::kCar && se.role != "traffic";
+}
+
+bool rectanglesOverlap(double ax, double ay, double ayaw, double ahl, double ahw, double bx,
+                       double by, double byaw, double bhl, double bhw) {
+  const double dx = bx - ax, dy = by - ay;
+  const double ca = std::cos(ayaw), sa = std::sin(ayaw), cb = std::cos(byaw), sb = std::sin(byaw);
+  // Half the extent of a rectangle (half sizes hl, hw along yaw (c, s)) along the axis (ux, uy).
+  auto extent = [](double c, double s, double hl, double hw, double ux, double uy) {
+    return hl * std::abs(c * ux + s * uy) + hw * std::abs(-s * ux + c * uy);
+  };
+  const double axes[4][2] = {{ca, sa}, {-sa, ca}, {cb, sb}, {-sb, cb}};
+  for (const auto& u : axes) {
+    const double d = std::abs(dx * u[0] + dy * u[1]);
+    if (d > extent(ca, sa, ahl, ahw, u[0], u[1]) + extent(cb, sb, bhl, bhw, u[0], u[1])) {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::optional<double> firstOverlap(const MovingFootprint& a, const MovingFootprint& b,
+                                   double duration, double margin) {
+  const std::size_t n = fineSamples(duration);
+  const std::vector<Box> ba = blockBoxes(a, n, margin), bb = blockBoxes(b, n, margin);
+  for (std::size_t j = 0; j < ba.size(); ++j) {
+    if (!ba[j].meets(bb[j])) continue;
+    if (const auto t = overlapInBlock(a, b, j, n, margin)) return t;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& mission,
+                                           const std::vector<MovingFootprint>& traffic,
+                                           double duration, double margin) {
+  const std::size_t n = fineSamples(duration);
+  std::vector<std::vector<Box>> own;
+  own.reserve(mission.size());
+  for (const auto& m : mission) own.push_back(blockBoxes(m, n, margin));
+  std::vector<std::size_t> out;
+  if (mission.empty()) return out;
+  for (std::size_t i = 0; i < traffic.size(); ++i) {
+    const std::vector<Box> boxes = blockBoxes(traffic[i], n, margin);
+    bool near = false;
+    for (std::size_t m = 0; m < mission.size() && !near; ++m) {
+      for (std::size_t j = 0; j < boxes.size() && !near; ++j) {
+        near = boxes[j].meets(own[m][j]) &&
+               overlapInBlock(mission[m], traffic[i], j, n, margin).has_value();
+      }
+    }
+    if (near) out.push_back(i);
+  }
+  return out;
+}
+
+}  // namespace hameritt::scenario

@@ -1,0 +1,135 @@
+// The mission's own cars against the ambient traffic (scenario/traffic_clearance.h): the
+// separating-axis test, which ambient cars a scenario withholds, and generated city scenarios
+// in which no mission car overlaps an ambient car that is left. Each check has a negative
+// control that shows it can fail.
+
+#include "hameritt/scenario/traffic_clearance.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "hameritt/generation/generator.h"
+#include "hameritt/scenario/city_traffic.h"
+#include "test_util.h"
+
+namespace hameritt::scenario {
+namespace {
+
+// A car driving along +x at `speed` from x0 at t = 0 (y fixed), over 60 s.
+Trajectory driveX(double x0, double y, double speed, double t0 = 0.0) {
+  return {{t0, x0, y, 0.0, 0.0}, {t0 + 60.0, x0 + 60.0 * speed, y, 0.0, 0.0}};
+}
+
+MovingFootprint moving(const Trajectory& t, double shift = 0.0) {
+  MovingFootprint f;
+  f.trajectory = &t;
+  f.time_shift = shift;
+  return f;
+}
+
+MovingFootprint standing(double x, double y, double yaw) {
+  MovingFootprint f;
+  f.pose.x = x;
+  f.pose.y = y;
+  f.pose.yaw = yaw;
+  return f;
+}
+
+TEST(TrafficClearance, SeparatingAxesTellRotatedBoxesApart) {
+  // Two 4.5 x 1.8 m cars side by side, 1.9 m apart: apart; 1.7 m: overlapping.
+  EXPECT_FALSE(rectanglesOverlap(0, 0, 0, 2.25, 0.9, 0, 1.9, 0, 2.25, 0.9));
+  EXPECT_TRUE(rectanglesOverlap(0, 0, 0, 2.25, 0.9, 0, 1.7, 0, 2.25, 0.9));
+  // A car turned by -45 degrees off the corner of another, 0.41 m apart (Shapely): their
+  // bounding boxes and circles meet, the rectangles do not. The control: turned by +45 degrees
+  // the same pair overlaps.
+  const double k = 0.25 * M_PI;
+  EXPECT_FALSE(rectanglesOverlap(0, 0, 0, 2.25, 0.9, 3.0, 2.0, -k, 2.25, 0.9));
+  EXPECT_TRUE(rectanglesOverlap(0, 0, 0, 2.25, 0.9, 3.0, 2.0, k, 2.25, 0.9));
+  // Symmetric in its arguments.
+  EXPECT_FALSE(rectanglesOverlap(3.0, 2.0, -k, 2.25, 0.9, 0, 0, 0, 2.25, 0.9));
+  EXPECT_TRUE(rectanglesOverlap(3.0, 2.0, k, 2.25, 0.9, 0, 0, 0, 2.25, 0.9));
+}
+
+TEST(TrafficClearance, WithholdsTheCarsThatComeNearAMissionCar) {
+  const Trajectory own = driveX(0.0, 0.0, 10.0);  // the mission car: 0 -> 600 m along y = 0
+  const Trajectory next_lane = driveX(0.0, 3.5, 10.0);
+  const Trajectory close_lane = driveX(0.0, 2.1, 10.0);  // 0.3 m between their sides
+  // A car crossing y = 0 at x = 300 m at episode time 130 s: at scenario time 30 s (the mission
+  // car's time there) when the episode window starts at 100 s.
+  const Trajectory crossing = {{100.0, 300.0, -300.0, 0.0, 0.5 * M_PI},
+                               {160.0, 300.0, 300.0, 0.0, 0.5 * M_PI}};
+  std::vector<MovingFootprint> traffic = {
+      standing(250.0, 0.0, 0.0),   // 0: in the mission car's lane
+      moving(next_lane),           // 1: beside it, 1.7 m apart
+      moving(close_lane),          // 2: beside it, 0.3 m apart
+      moving(crossing, 100.0),     // 3: meets it at the crossing
+      standing(250.0, -5.0, 0.0),  // 4: off its lane
+  };
+  const std::vector<MovingFootprint> mission = {moving(own)};
+  EXPECT_EQ(trafficToWithhold(mission, traffic, 60.0), (std::vector<std::size_t>{0, 2, 3}));
+  // Without the margin the car 0.3 m away is kept; the others stay as they were.
+  EXPECT_EQ(trafficToWithhold(mission, traffic, 60.0, 0.0), (std::vector<std::size_t>{0, 3}));
+  // The first overlap: the mission car's front (2.25 m ahead) meets the standing car's back
+  // (2.25 m behind 250 m) at 24.55 s; the samples are 0.1 s apart.
+  const auto t = firstOverlap(mission[0], traffic[0], 60.0, 0.0);
+  ASSERT_TRUE(t.has_value());
+  EXPECT_NEAR(*t, 24.6, 1e-9);
+  // The controls: the crossing car on scenario time (no shift) is at x = 300 m 30 s too early;
+  // a window that ends before the meeting sees none of it.
+  traffic[3] = moving(crossing, 0.0);
+  EXPECT_EQ(trafficToWithhold(mission, traffic, 60.0, 0.0), (std::vector<std::size_t>{0}));
+  EXPECT_TRUE(trafficToWithhold(mission, traffic, 20.0, 0.0).empty());
+  EXPECT_TRUE(trafficToWithhold({}, traffic, 60.0).empty());
+}
+
+// Generated city scenarios (a route search, a track, a follow): the ambient cars left in memory
+// never overlap a mission car; each withheld car, rebuilt from the episode's bytes, comes within
+// the clearance of one, and some overlap one: the control, the same check on the cars withheld.
+TEST(TrafficClearance, GeneratedCityScenariosKeepTheirCarsApart) {
+  GeneratorConfig cfg = testing::shippedConfig();
+  cfg.perception_paths = false;
+  std::size_t held_total = 0, held_overlapping = 0;
+  for (const auto& [cls, seed] :
+       {std::pair{ScenarioClass::kRouteSearch, 3ULL}, std::pair{ScenarioClass::kTrack, 4ULL},
+        std::pair{ScenarioClass::kFollow, 5ULL}}) {
+    const Scenario s = generateScenario(testing::shippedCityWorld(), cfg, cls, seed);
+    ASSERT_TRUE(s.sim.traffic.has_value());
+    const TrafficEpisodeRef& ref = *s.sim.traffic;
+    std::vector<MovingFootprint> own, ambient;
+    for (const auto& se : s.sim.entities) {
+      if (isMissionCar(se)) own.push_back(footprintOf(se));
+      if (se.role == "traffic") ambient.push_back(footprintOf(se));
+    }
+    ASSERT_FALSE(own.empty());
+    EXPECT_EQ(ambient.size() + ref.withheld.size(), ref.car_ids.size());
+    EXPECT_TRUE(trafficToWithhold(own, ambient, s.sim.duration, 0.0).empty());
+    EXPECT_TRUE(trafficToWithhold(own, ambient, s.sim.duration).empty());
+    ASSERT_TRUE(ref.text);
+    const TrafficEpisode e = parseTrafficEpisode(*ref.text, "episode");
+    std::vector<Trajectory> windows;
+    windows.reserve(ref.withheld.size());
+    std::vector<MovingFootprint> held;
+    for (const auto& id : ref.withheld) {
+      const auto i = static_cast<std::size_t>(
+          std::find(ref.car_ids.begin(), ref.car_ids.end(), id) - ref.car_ids.begin());
+      ASSERT_LT(i, e.cars.size()) << id;
+      windows.push_back(episodeCarWindow(e, i, ref.offset, s.sim.duration));
+      MovingFootprint f = moving(windows.back());
+      f.length = e.cars[i].size.x();
+      f.width = e.cars[i].size.y();
+      held.push_back(f);
+    }
+    // Rounded to the millimetre in the window: 1 cm of slack.
+    EXPECT_EQ(trafficToWithhold(own, held, s.sim.duration, kTrafficClearance + 0.01).size(),
+              held.size());
+    held_total += held.size();
+    held_overlapping += trafficToWithhold(own, held, s.sim.duration, 0.0).size();
+  }
+  EXPECT_GT(held_total, 0u);
+  EXPECT_GT(held_overlapping, 0u);
+}
+
+}  // namespace
+}  // namespace hameritt::scenario
