@@ -101,6 +101,8 @@ TrackPhaseScore TrackScorer::score(bool ended) const {
   s.frames = recorder_.frames();
   s.reports = recorder_.reports();
   s.errors = recorder_.errors();
+  // At the end, a report still waiting for its frame never got one.
+  if (ended) s.errors.unmatched_stamp += recorder_.pendingReports();
   if (!start_) {
     s.state = ended ? PhaseState::kFailed : PhaseState::kPending;
     if (ended) s.failure = "the search phase did not succeed";

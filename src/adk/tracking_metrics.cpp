@@ -629,12 +629,22 @@ void TrackingRecorder::addFrame(double t, std::vector<TargetTruth> targets) {
   if (!std::isfinite(t)) throw InputError("tracking frame: t is not finite");
   if (!frames_.empty() && !(t > frames_.back().t)) {
     frames_.clear();
+    pending_.clear();
     have_report_ = false;
   }
   TrackingFrame f;
   f.t = t;
   f.targets = std::move(targets);
   frames_.push_back(std::move(f));
+  // The reports that came before this frame: matched now, or unmatched if it passed them.
+  while (!pending_.empty() && pending_.front().first <= t + 1e-3) {
+    if (std::fabs(pending_.front().first - t) <= 1e-3) {
+      apply(&frames_.back(), pending_.front().second);
+    } else {
+      ++errors_.unmatched_stamp;
+    }
+    pending_.pop_front();
+  }
 }
 
 void TrackingRecorder::addReport(double stamp, const std::vector<ReportedTrack>& tracks) {
@@ -654,10 +664,22 @@ void TrackingRecorder::addReport(double stamp, const std::vector<ReportedTrack>&
     }
     if (it->t < stamp - 1e-3) break;
   }
+  if (!frame && (frames_.empty() || stamp > frames_.back().t + 1e-3)) {
+    pending_.emplace_back(stamp, tracks);  // ahead of its frame: it waits
+    if (pending_.size() > kMaxPending) {
+      pending_.pop_front();
+      ++errors_.unmatched_stamp;
+    }
+    return;
+  }
   if (!frame) {
     ++errors_.unmatched_stamp;
     return;
   }
+  apply(frame, tracks);
+}
+
+void TrackingRecorder::apply(TrackingFrame* frame, const std::vector<ReportedTrack>& tracks) {
   frame->tracks.clear();
   std::set<std::string> seen;
   for (const auto& r : tracks) {

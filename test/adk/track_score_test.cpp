@@ -120,13 +120,15 @@ TEST(TrackScorer, MalformedReportsAreCountedAndBadInputRejected) {
                                 {"car_1", PixelBox{NAN, 0, 5, 5}}}));
   s.addReport(0.55, {});  // no such frame
   s.addReport(0.4, {});   // out of order
-  const TrackPhaseScore r = s.score(false);
-  EXPECT_EQ(r.reports, 3u);
+  s.addReport(5.0, {});   // ahead of every frame: waits, unmatched only at the end
+  EXPECT_EQ(s.score(false).errors.unmatched_stamp, 1u);
+  const TrackPhaseScore r = s.score(true);
+  EXPECT_EQ(r.reports, 4u);
   EXPECT_EQ(r.errors.unknown_id, 1u);
   EXPECT_EQ(r.errors.bad_box, 1u);
-  EXPECT_EQ(r.errors.unmatched_stamp, 1u);
+  EXPECT_EQ(r.errors.unmatched_stamp, 2u);
   EXPECT_EQ(r.errors.out_of_order, 1u);
-  EXPECT_EQ(r.errors.total(), 4u);
+  EXPECT_EQ(r.errors.total(), 5u);
   EXPECT_THROW(s.addFrame(NAN, {}), InputError);
   EXPECT_THROW(s.addFrame(2.0, {{"car_1", PixelBox{0, 0, -1, 5}, 0.9, 0.1}}), InputError);
   EXPECT_THROW(TrackScorer(trackPhase(0.0)), scenario::ConfigError);

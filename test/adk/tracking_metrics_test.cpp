@@ -440,6 +440,35 @@ TEST(ScoreTracking, MatchesIndependentReferenceOnRandomSequences) {
   EXPECT_GE(sequences_off, 55);
 }
 
+TEST(TrackingRecorder, AReportBeforeItsFrameWaitsForIt) {
+  // The client answers a frame before the ADK has it (two subscriptions, no order between them).
+  const auto seq = handSequence();
+  TrackingRecorder early({"car"}, {});
+  for (const auto& f : seq) {
+    early.addReport(f.t, f.tracks);
+    EXPECT_EQ(early.pendingReports(), 1u);
+    early.addFrame(f.t, f.targets);
+    EXPECT_EQ(early.pendingReports(), 0u);
+  }
+  EXPECT_EQ(early.errors().total(), 0u);
+  const auto batch = scoreTracking(seq, {"car"});
+  EXPECT_DOUBLE_EQ(early.score().targets[0].precision, batch.targets[0].precision);
+  EXPECT_DOUBLE_EQ(early.score().clear.mota, batch.clear.mota);
+  // Control: a report for a frame that never comes is unmatched once a later frame passes it,
+  // and a flood of them waits no longer than kMaxPending reports.
+  TrackingRecorder missed({"car"}, {});
+  missed.addFrame(1.0, {});
+  missed.addReport(1.5, {});
+  missed.addFrame(2.0, {});
+  EXPECT_EQ(missed.errors().unmatched_stamp, 1u);
+  EXPECT_EQ(missed.pendingReports(), 0u);
+  for (std::size_t k = 0; k < TrackingRecorder::kMaxPending + 10; ++k) {
+    missed.addReport(3.0 + static_cast<double>(k), {});
+  }
+  EXPECT_EQ(missed.pendingReports(), TrackingRecorder::kMaxPending);
+  EXPECT_EQ(missed.errors().unmatched_stamp, 11u);
+}
+
 TEST(TrackingRecorder, ScoresLikeTheBatchAndCountsMalformedReports) {
   const auto seq = handSequence();
   TrackingRecorder clean({"car"}, {});
@@ -466,7 +495,9 @@ TEST(TrackingRecorder, ScoresLikeTheBatchAndCountsMalformedReports) {
   EXPECT_EQ(e.unknown_id, 6u);
   EXPECT_EQ(e.bad_box, 12u);
   EXPECT_EQ(e.duplicate_id, 4u);  // the four frames with a box
-  EXPECT_EQ(e.unmatched_stamp, 6u);
+  // Stamped between frames: unmatched once the next frame passes it; the last one still waits.
+  EXPECT_EQ(e.unmatched_stamp, 5u);
+  EXPECT_EQ(noisy.pendingReports(), 1u);
   EXPECT_EQ(e.out_of_order, 6u);
   EXPECT_EQ(e.unknown_id + e.bad_box + e.duplicate_id, bad_sent);
   EXPECT_EQ(noisy.reports(), 18u);
@@ -486,7 +517,7 @@ TEST(TrackingRecorder, ScoresLikeTheBatchAndCountsMalformedReports) {
     late.addFrame(f.t, f.targets);
     late.addReport(f.t + 0.5, f.tracks);
   }
-  EXPECT_EQ(late.errors().unmatched_stamp, 6u);
+  EXPECT_EQ(late.errors().unmatched_stamp + late.pendingReports(), 6u);
   EXPECT_DOUBLE_EQ(late.score().targets[0].precision, 0.0);
   // A clock restart (simulator reset) starts a new recording.
   late.addFrame(0.0, {});

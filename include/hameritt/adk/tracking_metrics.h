@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstddef>
+#include <deque>
 #include <map>
 #include <string>
 #include <vector>
@@ -207,10 +208,16 @@ class TrackingRecorder {
   void addFrame(double t, std::vector<TargetTruth> targets);
   // A client report for the frame stamped `stamp`: bad tracks are dropped one by one (an
   // unknown id, a bad box, a repeated id), a whole report with an out-of-order or unmatched
-  // stamp is dropped. A second report for a frame replaces the first.
+  // stamp is dropped. A second report for a frame replaces the first. A report stamped after the
+  // newest frame waits for its frame (a client may answer a frame before the ADK has it: two
+  // subscriptions, no order between them); it is unmatched once a later frame comes instead,
+  // or when more than kMaxPending wait.
   void addReport(double stamp, const std::vector<ReportedTrack>& tracks);
+  static constexpr std::size_t kMaxPending = 64;
 
   const TrackReportErrors& errors() const { return errors_; }
+  // Reports still waiting for their frame (unmatched if the recording ends now).
+  std::size_t pendingReports() const { return pending_.size(); }
   std::size_t frames() const { return frames_.size(); }
   std::size_t reports() const { return reports_; }
   // Every score over the frames so far.
@@ -220,10 +227,12 @@ class TrackingRecorder {
   std::vector<std::string> target_ids_;
   TrackingSettings settings_;
   std::vector<TrackingFrame> frames_;
+  std::deque<std::pair<double, std::vector<ReportedTrack>>> pending_;  // in stamp order
   TrackReportErrors errors_;
   std::size_t reports_ = 0;
   bool have_report_ = false;
   double last_report_ = 0.0;
+  void apply(TrackingFrame* frame, const std::vector<ReportedTrack>& tracks);
 };
 
 }  // namespace hameritt::adk
