@@ -31,6 +31,18 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 
+// The period of an optional report's rate parameter ~NAME in [0, 100] Hz (0: off, period 0).
+double optionalPeriod(ros::NodeHandle& pnh, const std::string& name, double default_hz,
+                      const std::string& off) {
+  double hz = default_hz;
+  pnh.param(name, hz, hz);
+  if (!(hz >= 0.0 && hz <= 100.0)) {
+    throw scenario::ConfigError("~" + name + ": expected [0, 100] (0: " + off + "), got " +
+                                scenario::formatNumber(hz));
+  }
+  return hz > 0.0 ? 1.0 / hz : 0.0;
+}
+
 using scenario::ConfigError;
 
 ros::Time stampOf(double t) {
@@ -183,28 +195,15 @@ AdkRos::AdkRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   metrics_pub_ = gate_->advertise<hameritt::MissionMetrics>(nh, "adk/metrics", 1, true);
   if (avoid_) avoid_pub_ = gate_->advertise<hameritt::AvoidStatus>(nh, "adk/avoid", 10, true);
   // The ADS-B-like traffic reports of an avoid mission's aircraft.
-  double traffic_rate = 2.0;
-  pnh.param("traffic_rate_hz", traffic_rate, traffic_rate);
-  if (!(traffic_rate >= 0.0 && traffic_rate <= 100.0)) {
-    throw scenario::ConfigError(
-        "~traffic_rate_hz: expected [0, 100] (0: no traffic reports), got " +
-        std::to_string(traffic_rate));
-  }
-  traffic_period_ = traffic_rate > 0.0 ? 1.0 / traffic_rate : 0.0;
+  traffic_period_ = optionalPeriod(pnh, "traffic_rate_hz", 2.0, "no traffic reports");
   if (avoid_ && traffic_period_ > 0.0) {
     traffic_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "adk/traffic", 10);
   }
   if (follow_) follow_pub_ = gate_->advertise<hameritt::FollowStatus>(nh, "adk/follow", 10, true);
   // The found targets' ground-truth state at a tracker's rate: what a maneuver client under test
   // gets in place of a tracker, from the find on (maneuver_only by default).
-  double target_state_rate = mode_ == "maneuver_only" ? 10.0 : 0.0;
-  pnh.param("target_state_rate_hz", target_state_rate, target_state_rate);
-  if (!(target_state_rate >= 0.0 && target_state_rate <= 100.0)) {
-    throw scenario::ConfigError(
-        "~target_state_rate_hz: expected [0, 100] (0: no target state), got " +
-        scenario::formatNumber(target_state_rate));
-  }
-  target_state_period_ = target_state_rate > 0.0 ? 1.0 / target_state_rate : 0.0;
+  target_state_period_ = optionalPeriod(pnh, "target_state_rate_hz",
+                                        mode_ == "maneuver_only" ? 10.0 : 0.0, "no target state");
   if (target_state_period_ > 0.0) {
     target_state_pub_ = gate_->advertise<hameritt::EntityStateArray>(nh, "adk/target_state", 20);
   }
