@@ -69,7 +69,7 @@ void FollowScorer::start(double t) {
 }
 
 bool FollowScorer::complete() const {
-  return scored_from_ && !samples_.empty() && samples_.back().t >= *scored_from_ + *phase_.duration;
+  return scored_from_ && *last_t_ >= *scored_from_ + *phase_.duration;
 }
 
 bool FollowScorer::add(const FollowSample& s) {
@@ -89,7 +89,6 @@ bool FollowScorer::add(const FollowSample& s) {
     if (!inside && s.t < *start_ + phase_.follow.approach_s) return true;
     scored_from_ = s.t;
   }
-  samples_.push_back(s);
   accumulator_.add(s);
   if (inside) {
     outside_since_.reset();
@@ -113,12 +112,12 @@ FollowPhaseScore FollowScorer::score(double koz_seconds, bool collision, bool en
   r.envelope = accumulator_.result();
   if (scored_from_) {
     r.approach_time = *scored_from_ - *start_;
-    r.elapsed = samples_.back().t - *scored_from_;
+    r.elapsed = *last_t_ - *scored_from_;
   } else if (start_ && last_t_) {
     r.approach_time = *last_t_ - *start_;
   }
   r.outside = outside_since_.has_value();
-  if (outside_since_) r.current_outside_s = samples_.back().t - *outside_since_;
+  if (outside_since_) r.current_outside_s = *last_t_ - *outside_since_;
   char buf[160];
   if (!start_) {
     r.failure = "the search phase did not find the target";

@@ -119,8 +119,8 @@ ChaseResult planChasePath(const WorldValidity& validity, const scenario::CameraS
     return scenario::TrajectoryPoint{scenario::roundMilli(t), q.x(), q.y(), q.z(),
                                      scenario::roundMilli(yaw)};
   };
-  auto judge = [&](const scenario::TrajectoryPoint& k) {
-    const Vec3 c = chasePoint(k.t);
+  // `c`: the chase point at the keyframe's time.
+  auto judge = [&](const scenario::TrajectoryPoint& k, const Vec3& c) {
     if (!r.caught_t && (Vec3(k.x, k.y, k.z) - c).norm() <= chase.caught_radius) r.caught_t = k.t;
     if (!r.caught_t) return;
     const scenario::TrajectoryPoint tp = scenario::sampleTrajectory(target, k.t);
@@ -133,11 +133,12 @@ ChaseResult planChasePath(const WorldValidity& validity, const scenario::CameraS
     }
   };
   r.path.push_back(keyframe(t0));
-  judge(r.path.back());
+  Vec3 c = chasePoint(t0);
+  judge(r.path.back(), c);
   const int steps = static_cast<int>(std::floor((t_end - t0) / chase.step + 1e-9));
   for (int i = 0; i < steps; ++i) {
     const double t = t0 + i * chase.step, tn = t0 + (i + 1) * chase.step;
-    const Vec3 c = chasePoint(t), cn = chasePoint(tn);
+    const Vec3 cn = chasePoint(tn);  // (c: the chase point at t, carried from the last step)
     // Feed-forward of the chase point's motion plus a pull towards it, then the limits.
     Vec3 want = (cn - c) / chase.step + (c - q) / chase.time_constant;
     want = clampNorm2(want, sp.max_speed - 0.01);  // (keyframes are rounded to the millimetre)
@@ -170,7 +171,8 @@ ChaseResult planChasePath(const WorldValidity& validity, const scenario::CameraS
     v = (next - q) / chase.step;
     q = next;
     r.path.push_back(keyframe(tn));
-    judge(r.path.back());
+    judge(r.path.back(), cn);
+    c = cn;
   }
   r.status = PlanStatus::kExact;
   return r;

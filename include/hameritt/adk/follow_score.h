@@ -73,8 +73,8 @@ class FollowScorer {
   FollowCriteria criteria_;
   std::optional<double> start_;
   std::optional<double> scored_from_;
-  std::optional<double> last_t_;  // of any sample kept or used for the approach
-  std::vector<FollowSample> samples_;
+  // Of any sample kept or used for the approach: once scoring has begun, the last scored one.
+  std::optional<double> last_t_;
   FollowAccumulator accumulator_;  // the scored samples' envelope figures, kept as they come
   std::optional<double> outside_since_;
   bool exceeded_ = false;
