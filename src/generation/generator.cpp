@@ -1099,6 +1099,16 @@ class ScenarioBuilder {
         trajs.push_back(traj);
       }
     }
+    // In the city each stops clear of the intersection ahead, on an arterial at the kerb; the
+    // second 12 m behind the first (else the scenario keeps one target).
+    if (auto st = cityStop(trajs[0])) trajs[0] = std::move(*st);
+    if (trajs.size() == 2) {
+      if (auto st = cityStop(trajs[1], &trajs[0])) {
+        trajs[1] = std::move(*st);
+      } else {
+        trajs.pop_back();
+      }
+    }
     const int n_targets = static_cast<int>(trajs.size());
     Group convoy;
     convoy.id = "convoy_1";
@@ -1252,6 +1262,7 @@ class ScenarioBuilder {
     std::vector<int> nodes;  // street nodes passed, the goal node last
     std::uint64_t seed = 0;
     planning::SpeedProfile speed;
+    TrajectoryPoint end;  // where the route stops (before cityStop moves the stop)
   };
   Trajectory driveOff(double depart, bool use_spec, const catalog::CarModel** model, int* slot,
                       DriveOffRoute* route_out = nullptr) {
@@ -1323,7 +1334,7 @@ class ScenarioBuilder {
       }
       traj = prefix;
       traj.insert(traj.end(), route.trajectory.begin() + 1, route.trajectory.end());
-      if (route_out) *route_out = DriveOffRoute{route.nodes, route_seed, speed};
+      if (route_out) *route_out = DriveOffRoute{route.nodes, route_seed, speed, traj.back()};
     }
     for (int t : tried) slot_taken_[static_cast<std::size_t>(t)] = 0;
     if (traj.empty()) {
@@ -1347,6 +1358,7 @@ class ScenarioBuilder {
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
     slot_taken_[static_cast<std::size_t>(slot)] = 1;
     const Vec2 fwd(std::cos(sl.yaw), std::sin(sl.yaw));
+    if (auto st = cityStop(traj)) traj = std::move(*st);
     traj = obeyCitySignals(traj, model->length);
     Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
     m.objective.type = "track";
@@ -1556,7 +1568,7 @@ class ScenarioBuilder {
     start.x = roundMilli(p.x - back * std::cos(p.yaw));
     start.y = roundMilli(p.y - back * std::sin(p.yaw));
     start.t = roundMilli(p.t + 2.5);
-    const TrajectoryPoint& le = lead->trajectory.back();
+    const TrajectoryPoint& le = pursuit_route_.end;
     planning::RouteGoal g;
     g.pose = TrajectoryPoint{0.0, roundMilli(le.x - 12.0 * std::cos(le.yaw)),
                              roundMilli(le.y - 12.0 * std::sin(le.yaw)), 0.0, le.yaw};
@@ -1569,6 +1581,10 @@ class ScenarioBuilder {
     TrajectoryPoint wait = start;
     wait.t = 0.0;
     traj.insert(traj.begin(), wait);  // waits in its lane until it departs
+    // In the city it stops 12 m behind the first target (else none).
+    const std::optional<Trajectory> stopped = cityStop(traj, &lead->trajectory);
+    if (!stopped) return;
+    traj = *stopped;
     // In the city it stops at the signals, and behind the first target while that one waits.
     traj = obeyCitySignals(traj, model->length, &lead->trajectory, lead->entity.box.size.x());
     Entity target = makeCar(*model, color, Vec3(traj[0].x, traj[0].y, traj[0].z), traj[0].yaw);
@@ -1707,6 +1723,7 @@ class ScenarioBuilder {
     if (chosen.empty())
       throw GenerationError("no route for the hostile vehicle clear of the start and goal");
     const auto& model = catalog::pickModel(rng_);
+    if (auto st = cityStop(chosen)) chosen = std::move(*st);
     chosen = obeyCitySignals(chosen, model.length);
     Entity e = makeCar(model, catalog::pick(rng_, catalog::carColors()),
                        Vec3(chosen[0].x, chosen[0].y, chosen[0].z), chosen[0].yaw);
@@ -1994,6 +2011,23 @@ class ScenarioBuilder {
       if (a.intersections[i].offset != b.intersections[i].offset) return false;
     }
     return true;
+  }
+
+  // A mission car's trajectory that ends in a lane, in the city: it stops before the
+  // intersection ahead and, on an arterial, pulls over to the kerb (planning::stopAtKerb), so
+  // that the ambient traffic keeps its lanes and boxes; `lead`: the car ahead of it in a convoy,
+  // stopped already. nullopt when the stop has to move and cannot (the caller keeps a lead's
+  // trajectory as it is and drops a follower); in the suburb the trajectory unchanged.
+  std::optional<Trajectory> cityStop(const Trajectory& traj, const Trajectory* lead = nullptr) {
+    if (world_.params().type != WorldType::kCity) return traj;
+    const CityParams& cp = world_.params().city;
+    planning::KerbStop k;
+    k.sidewalk_width = cp.sidewalk_width;
+    k.kerb_street_width = cp.arterial_width;
+    if (lead && !lead->empty()) k.behind = lead->back();
+    planning::KerbStopResult r = planning::stopAtKerb(world_, traj, k, routeSettings());
+    if (!r.ok) return std::nullopt;
+    return std::move(r.trajectory);
   }
 
   std::uint64_t citySeed() const { return deriveSeed(seed_, 0x4349545954524146ULL); }

@@ -482,6 +482,144 @@ void RouteSettings::validate() const {
        sample_spacing);
 }
 
+void KerbStop::validate() const {
+  auto need = [](bool ok, const char* f, const char* what, double v) {
+    if (!ok)
+      throw scenario::ConfigError(std::string("kerb_stop.") + f + ": expected " + what +
+                                  ", got " + scenario::formatNumber(v));
+  };
+  need(sidewalk_width >= 0 && sidewalk_width <= 20, "sidewalk_width", "metres in [0, 20]",
+       sidewalk_width);
+  need(stop_back >= 0 && stop_back <= 20, "stop_back", "metres in [0, 20]", stop_back);
+  need(kerb_street_width > 0 && kerb_street_width <= 100, "kerb_street_width",
+       "metres in (0, 100]", kerb_street_width);
+  need(kerb_gap >= 0 && kerb_gap <= 5, "kerb_gap", "metres in [0, 5]", kerb_gap);
+  need(decel > 0 && decel <= 10, "decel", "m/s^2 in (0, 10]", decel);
+  need(max_decel >= decel && max_decel <= 10, "max_decel", "m/s^2 in [decel, 10]", max_decel);
+  need(min_run >= 1 && min_run <= 500, "min_run", "metres in [1, 500]", min_run);
+  need(max_slope > 0 && max_slope <= 1, "max_slope", "a slope in (0, 1]", max_slope);
+  need(follow_gap >= 0 && follow_gap <= 100, "follow_gap", "metres in [0, 100]", follow_gap);
+}
+
+KerbStopResult stopAtKerb(const World& w, const scenario::Trajectory& traj, const KerbStop& k,
+                          const RouteSettings& s) {
+  k.validate();
+  s.validate();
+  KerbStopResult r;
+  r.trajectory = traj;
+  if (traj.size() < 2) return r;
+  const scenario::TrajectoryPoint& end = traj.back();
+  const Vec2 pe(end.x, end.y);
+  double dist = 0;
+  const int e = nearestEdge(w, pe, &dist);
+  if (e < 0) return r;
+  const Leg leg = directed(w, e, end.yaw);
+  const scenario::StreetEdge& ed = w.edges()[static_cast<std::size_t>(e)];
+  const Vec2 a = w.nodes()[static_cast<std::size_t>(leg.u)].position;
+  const Vec2 b = w.nodes()[static_cast<std::size_t>(leg.v)].position;
+  const double len = (b - a).norm();
+  if (len < 1e-6) return r;
+  const Vec2 dir = (b - a) / len, right(dir.y(), -dir.x());
+  const double yaw = std::atan2(dir.y(), dir.x());
+  if (std::abs(geometry::wrapPi(end.yaw - yaw)) > 0.02) return r;  // not along its street
+  auto alongOf = [&](const scenario::TrajectoryPoint& p) { return (Vec2(p.x, p.y) - a).dot(dir); };
+  auto latOf = [&](const scenario::TrajectoryPoint& p) { return (Vec2(p.x, p.y) - a).dot(right); };
+  const double lat_lane = latOf(end), s_end = alongOf(end);
+  // The intersection box ahead: the widest crossing street's half width and its crosswalk.
+  double box = 0.0;
+  for (int ei : w.adjacency()[static_cast<std::size_t>(leg.v)]) {
+    if (ei == e) continue;
+    box = std::max(box, 0.5 * w.edges()[static_cast<std::size_t>(ei)].width + k.sidewalk_width);
+  }
+  double s_stop = s_end;
+  if (box > 0.0) s_stop = std::min(s_stop, len - box - k.stop_back - 0.5 * s.vehicle_length);
+  if (k.behind) {
+    const Vec2 q(k.behind->x, k.behind->y);
+    const double ql = (q - a).dot(dir), qa = (q - a).dot(right);
+    if (ql > -k.follow_gap && ql < len && std::abs(qa) < 0.5 * ed.width &&
+        std::cos(k.behind->yaw - yaw) > 0.9) {
+      s_stop = std::min(s_stop, ql - k.follow_gap);
+    }
+  }
+  const bool wide = ed.width >= k.kerb_street_width - 1e-9;
+  const double lat_stop =
+      wide ? std::max(lat_lane, 0.5 * ed.width - k.kerb_gap - 0.5 * s.vehicle_width) : lat_lane;
+  if (s_stop >= s_end - 1e-3 && lat_stop <= lat_lane + 0.05) return r;  // already clear
+  r.ok = false;
+  // The final straight: the samples from the end back that keep the lane and its heading.
+  std::size_t k0 = traj.size() - 1;
+  while (k0 > 0) {
+    const scenario::TrajectoryPoint& p = traj[k0 - 1];
+    if (std::abs(latOf(p) - lat_lane) > 0.05 || std::abs(geometry::wrapPi(p.yaw - yaw)) > 0.02 ||
+        alongOf(p) > alongOf(traj[k0]) + 1e-6) {
+      break;
+    }
+    --k0;
+  }
+  const double s_straight = alongOf(traj[k0]);
+  // Time and mean speed at arc s of the straight (the sample pair around it).
+  auto sampleAt = [&](double sa, double* t, double* v) {
+    std::size_t i = k0;
+    while (i + 2 < traj.size() && alongOf(traj[i + 1]) <= sa) ++i;
+    const double s0 = alongOf(traj[i]), s1 = alongOf(traj[i + 1]);
+    const double t0 = traj[i].t, t1 = traj[i + 1].t;
+    const double u = s1 > s0 + 1e-9 ? std::clamp((sa - s0) / (s1 - s0), 0.0, 1.0) : 0.0;
+    *t = t0 + u * (t1 - t0);
+    *v = t1 > t0 + 1e-9 ? (s1 - s0) / (t1 - t0) : 0.0;
+  };
+  const double dlat = lat_stop - lat_lane;
+  const double min_run = std::max(k.min_run, std::abs(dlat) * geometry::kPi / (2 * k.max_slope));
+  double s_start = std::max(s_straight, s_stop - min_run), t0 = 0.0, v0 = 0.0;
+  for (int it = 0; it < 4; ++it) {
+    sampleAt(s_start, &t0, &v0);
+    s_start = std::max(s_straight, s_stop - std::max(min_run, v0 * v0 / (2 * k.decel)));
+  }
+  sampleAt(s_start, &t0, &v0);
+  const double run = s_stop - s_start;
+  if (run < 1.0 || v0 < 0.5) return r;
+  if (std::abs(dlat) * geometry::kPi / (2 * run) > k.max_slope + 1e-9) return r;
+  // The blend: along the street s_start -> s_stop, sideways lat_lane -> lat_stop (cosine).
+  const int n = std::max(2, static_cast<int>(std::ceil(run / 1.0)));
+  std::vector<Pose> poses;
+  std::vector<double> arc{0.0};
+  for (int j = 0; j <= n; ++j) {
+    const double u = static_cast<double>(j) / n;
+    const double lat = lat_lane + dlat * 0.5 * (1.0 - std::cos(geometry::kPi * u));
+    const double slope = dlat * 0.5 * geometry::kPi * std::sin(geometry::kPi * u) / run;
+    const Vec2 p = a + dir * (s_start + run * u) + right * lat;
+    const Vec2 h = dir + right * slope;
+    poses.push_back(Pose{p, std::atan2(h.y(), h.x())});
+    if (j > 0) arc.push_back(arc.back() + (p - poses[poses.size() - 2].p).norm());
+  }
+  const double decel = v0 * v0 / (2 * arc.back());
+  if (decel > k.max_decel) return r;
+  const std::shared_ptr<const StreetIndex> index = streetIndex(w);
+  for (const Pose& q : poses) {
+    if (!carValid(w, *index, q, s)) return r;
+  }
+  using scenario::roundMilli;
+  scenario::Trajectory out;
+  for (std::size_t i = 0; i < traj.size(); ++i) {
+    if (i >= k0 && alongOf(traj[i]) >= s_start - 1e-3) break;
+    out.push_back(traj[i]);
+  }
+  for (int j = 0; j <= n; ++j) {
+    const double c = arc[static_cast<std::size_t>(j)];
+    const double t =
+        j == n ? t0 + v0 / decel : t0 + (v0 - std::sqrt(std::max(0.0, v0 * v0 - 2 * decel * c))) / decel;
+    const Pose& q = poses[static_cast<std::size_t>(j)];
+    scenario::TrajectoryPoint p{roundMilli(t), roundMilli(q.p.x()), roundMilli(q.p.y()), 0.0,
+                                roundMilli(q.yaw)};
+    if (!out.empty() && !(p.t > out.back().t)) p.t = roundMilli(out.back().t + 1e-3);
+    out.push_back(p);
+  }
+  r.ok = true;
+  r.changed = true;
+  r.at_kerb = dlat > 0.05;
+  r.trajectory = std::move(out);
+  return r;
+}
+
 void clearRouteCaches() {
   std::lock_guard<std::mutex> lock(street_index_mutex);
   street_indexes.clear();

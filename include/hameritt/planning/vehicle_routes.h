@@ -63,6 +63,46 @@ RouteResult planVehicleRoute(const scenario::World& world, const scenario::Traje
                              const RouteGoal& goal, std::uint64_t seed,
                              const SpeedProfile& speed = {}, const RouteSettings& settings = {});
 
+// Where a car that ends its route on a street stops: with its front before the intersection
+// ahead (the crossing streets' carriageway and crosswalks), and on a wide street (the lanes that
+// the city's traffic drives) at the kerb, out of the lanes. validate() throws ConfigError naming
+// "kerb_stop.<field>".
+struct KerbStop {
+  double sidewalk_width = 1.8;  // crosswalk depth beyond a crossing street's kerb (m)
+  double stop_back = 1.0;       // the front stays this far before the crosswalk (m)
+  // Streets at least this wide are pulled over on (m); narrower ones keep the car in its lane.
+  double kerb_street_width = 20.0;
+  double kerb_gap = 0.5;    // between the car's side and the kerb (m)
+  double decel = 2.0;       // preferred braking to the stop (m/s^2)
+  double max_decel = 3.0;   // the most braking accepted (m/s^2)
+  double min_run = 30.0;    // the shortest stretch of the final straight used (m)
+  double max_slope = 0.35;  // the most sideways drift per metre along the street
+  // A car stopped ahead in the same lane (a convoy's lead): the centre stops `follow_gap`
+  // behind its centre.
+  std::optional<scenario::TrajectoryPoint> behind;
+  double follow_gap = 12.0;
+  void validate() const;
+};
+
+struct KerbStopResult {
+  // False when the stop had to move (into the intersection, onto the car ahead) but could not
+  // (a short final straight, too hard braking, an obstacle at the kerb): the trajectory is then
+  // the input unchanged.
+  bool ok = true;
+  bool changed = false;  // the trajectory's tail was replaced
+  bool at_kerb = false;  // it ends at the kerb
+  scenario::Trajectory trajectory;
+};
+
+// Replaces the tail of a car's trajectory (ending at rest, on the straight of its final street,
+// as planVehicleRoute and scenario::planDrive leave it) by a stop before the intersection ahead
+// and, on a wide street, a cosine blend to the kerb while it brakes at constant deceleration
+// from its speed where the blend starts. Unchanged (ok) where it already stops clear. The car's
+// footprint (settings.vehicle_length x vehicle_width) stays on the street and off the world's
+// obstacles. Deterministic; times and positions rounded to the millimetre.
+KerbStopResult stopAtKerb(const scenario::World& world, const scenario::Trajectory& traj,
+                          const KerbStop& stop, const RouteSettings& settings = {});
+
 // Drops the structures kept per world for vehicle routes (street index, validated route
 // pieces); the next route on a world builds them again. Routes do not depend on them.
 void clearRouteCaches();
