@@ -485,14 +485,14 @@ void RouteSettings::validate() const {
 void KerbStop::validate() const {
   auto need = [](bool ok, const char* f, const char* what, double v) {
     if (!ok)
-      throw scenario::ConfigError(std::string("kerb_stop.") + f + ": expected " + what +
-                                  ", got " + scenario::formatNumber(v));
+      throw scenario::ConfigError(std::string("kerb_stop.") + f + ": expected " + what + ", got " +
+                                  scenario::formatNumber(v));
   };
   need(sidewalk_width >= 0 && sidewalk_width <= 20, "sidewalk_width", "metres in [0, 20]",
        sidewalk_width);
   need(stop_back >= 0 && stop_back <= 20, "stop_back", "metres in [0, 20]", stop_back);
-  need(kerb_street_width > 0 && kerb_street_width <= 100, "kerb_street_width",
-       "metres in (0, 100]", kerb_street_width);
+  need(kerb_street_width > 0 && kerb_street_width <= 100, "kerb_street_width", "metres in (0, 100]",
+       kerb_street_width);
   need(kerb_gap >= 0 && kerb_gap <= 5, "kerb_gap", "metres in [0, 5]", kerb_gap);
   need(decel > 0 && decel <= 10, "decel", "m/s^2 in (0, 10]", decel);
   need(max_decel >= decel && max_decel <= 10, "max_decel", "m/s^2 in [decel, 10]", max_decel);
@@ -605,8 +605,8 @@ KerbStopResult stopAtKerb(const World& w, const scenario::Trajectory& traj, cons
   }
   for (int j = 0; j <= n; ++j) {
     const double c = arc[static_cast<std::size_t>(j)];
-    const double t =
-        j == n ? t0 + v0 / decel : t0 + (v0 - std::sqrt(std::max(0.0, v0 * v0 - 2 * decel * c))) / decel;
+    const double t = j == n ? t0 + v0 / decel
+                            : t0 + (v0 - std::sqrt(std::max(0.0, v0 * v0 - 2 * decel * c))) / decel;
     const Pose& q = poses[static_cast<std::size_t>(j)];
     scenario::TrajectoryPoint p{roundMilli(t), roundMilli(q.p.x()), roundMilli(q.p.y()), 0.0,
                                 roundMilli(q.yaw)};

@@ -179,7 +179,8 @@ StopFigures stopFigures(int e, const scenario::Trajectory& tr, double sidewalk, 
   const Vec2 d = (b - a).normalized(), n(d.y(), -d.x());
   double box = 0.0;
   for (int ei : w.adjacency()[static_cast<std::size_t>(ed.b)]) {
-    if (ei != e) box = std::max(box, 0.5 * w.edges()[static_cast<std::size_t>(ei)].width + sidewalk);
+    if (ei != e)
+      box = std::max(box, 0.5 * w.edges()[static_cast<std::size_t>(ei)].width + sidewalk);
   }
   const Vec2 end(tr.back().x, tr.back().y);
   StopFigures f;
@@ -202,8 +203,8 @@ StopFigures stopFigures(int e, const scenario::Trajectory& tr, double sidewalk, 
     i = j;
   }
   for (std::size_t k = 1; k < tv.size(); ++k) {
-    f.max_decel = std::max(f.max_decel, (tv[k - 1].second - tv[k].second) /
-                                            (tv[k].first - tv[k - 1].first));
+    f.max_decel =
+        std::max(f.max_decel, (tv[k - 1].second - tv[k].second) / (tv[k].first - tv[k - 1].first));
   }
   return f;
 }
@@ -283,7 +284,8 @@ TEST(VehicleRoutesTest, CityRouteEndsPullOverToTheKerbBeforeTheIntersection) {
     EXPECT_FALSE(in_lane.at_kerb);
     if (wide) {
       EXPECT_GT(stopFigures(static_cast<int>(e), in_lane.trajectory, k.sidewalk_width,
-                            rs.vehicle_length, rs.vehicle_width).kerb_gap,
+                            rs.vehicle_length, rs.vehicle_width)
+                    .kerb_gap,
                 k.kerb_gap + 2.0);
     }
   }
