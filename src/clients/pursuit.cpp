@@ -68,6 +68,14 @@ bool StreetPredictor::observe(double t, const Vec3& position, double yaw) {
   return true;
 }
 
+bool StreetPredictor::observe(double t, const Vec3& position, double yaw, double speed) {
+  if (!std::isfinite(speed) || speed < 0.0) return false;
+  if (!observe(t, position, yaw)) return false;
+  recent_.back().speed = speed;
+  last_.speed = speed;
+  return true;
+}
+
 bool StreetPredictor::observe(double t, const Vec3& position) {
   double yaw = last_.yaw;
   if (!recent_.empty()) {
@@ -164,6 +172,34 @@ std::vector<VehicleState> StreetPredictor::walk(double t, Branches branches) con
   return ends;
 }
 
+GroupView groupView(const std::vector<VehicleState>& vehicles, const scenario::CameraSpec& camera,
+                    double margin) {
+  GroupView g;
+  if (vehicles.empty()) return g;
+  g.centre = vehicles.front();
+  if (vehicles.size() == 1) return g;
+  // The two farthest apart set the line; the midpoint of the extremes is the centre.
+  std::size_t a = 0, b = 1;
+  double span = -1.0;
+  for (std::size_t i = 0; i < vehicles.size(); ++i) {
+    for (std::size_t j = i + 1; j < vehicles.size(); ++j) {
+      const double d = (vehicles[i].position - vehicles[j].position).head<2>().norm();
+      if (d > span) span = d, a = i, b = j;
+    }
+  }
+  g.centre.position = 0.5 * (vehicles[a].position + vehicles[b].position);
+  Vec2 d = (vehicles[b].position - vehicles[a].position).head<2>();
+  // Across the line, to the left of the first vehicle's heading (so that the yaw does not flip).
+  const double h = vehicles.front().yaw;
+  if (d.dot(Vec2(std::cos(h), std::sin(h))) < 0.0) d = -d;
+  const double yaw = std::atan2(d.y(), d.x()) + 0.5 * geometry::kPi;
+  g.centre.yaw = std::atan2(std::sin(yaw), std::cos(yaw));
+  // Half the span and the margin within half the image's width, the optical axis straight down.
+  const double half = std::tan(0.5 * camera.hfov_deg * geometry::kPi / 180.0);
+  g.height = (0.5 * span + margin) / std::max(half, 1e-6);
+  return g;
+}
+
 ViewpointChooser::ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
                                    const std::vector<scenario::KeepOutZone>& kozs,
                                    const PursuitSettings& settings)
@@ -201,6 +237,7 @@ bool ViewpointChooser::kozClear(const Vec3& a, const Vec3& b, double t) const {
 std::optional<std::string> ViewpointChooser::seenBy(const Vec3& position, double yaw,
                                                     const Vec3& target) const {
   for (const auto& cam : uav_.cameras) {
+    if (!settings_.camera.empty() && cam.name != settings_.camera) continue;
     if (!planning::projectToImage(cam, position, yaw, target, settings_.margin_px)) continue;
     const Vec3 c = planning::cameraPosition(cam, position, yaw);
     if (world_.occluders().clear(c, target)) return cam.name;
@@ -271,7 +308,8 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
     if (!inKoz(preferred.position, t)) return preferred;
     if (fallback) return *fallback;
   }
-  const double s = settings_.standoff;
+  // The ring's scale: the standoff, at least 6 m (straight above, a ring of 0 m is one point).
+  const double s = std::max(settings_.standoff, 6.0);
   const double ranges[] = {0.0, 0.5 * s, 1.5 * s + 4.0, 3.0 * s + 12.0};
   const double heights[] = {h0, h0 + 10.0};
   for (double h : heights) {

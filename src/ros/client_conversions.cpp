@@ -3,6 +3,7 @@
 #include <ros/console.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -129,6 +130,17 @@ hameritt::PerceivedEntity toPerceivedBlob(const scenario::TargetDescription& tar
   e.box.y_max = blob.box.y + blob.box.height - 1;
   e.box.visible_pixels = static_cast<std::uint32_t>(std::max(0, blob.pixels));
   return e;
+}
+
+clients::VehicleState toVehicleState(const hameritt::EntityState& e, double t) {
+  clients::VehicleState v;
+  v.t = t;
+  v.position = geometry::Vec3(e.pose.position.x, e.pose.position.y, e.pose.position.z);
+  const auto& q = e.pose.orientation;
+  v.yaw = std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+  const double vx = e.velocity.linear.x, vy = e.velocity.linear.y;
+  v.speed = std::max(0.0, vx * std::cos(v.yaw) + vy * std::sin(v.yaw));
+  return v;
 }
 
 hameritt::Detection makeDetection(const std::string& client,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "hameritt/clients/public_config.h"
@@ -48,6 +49,10 @@ double associationGate(double unseen) { return std::min(25.0, 2.5 + 2.0 * std::m
 constexpr double kBranchAfter = 0.5;
 // A sighting this close to a parked car of the public map is that car.
 constexpr double kParkedRadius = 1.5;
+// Several targets held in one image: metres to spare beyond the outermost ones.
+constexpr double kGroupMargin = 4.0;
+// A sighting this close to the pursued vehicle's prediction is that vehicle.
+constexpr double kSameVehicle = 6.0;
 // Detection claims come seconds apart: their gate.
 constexpr double kAssociationGate = 15.0;
 
@@ -84,6 +89,11 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   pnh.param("publish_tracks", publish_tracks_, publish_tracks_);
   pnh.param("drive_off_speed", drive_off_speed_, drive_off_speed_);
   pnh.param("track_claim_camera", track_claim_camera_, track_claim_camera_);
+  pnh.param("use_target_state", use_target_state_, use_target_state_);
+  pnh.param("track_standoff", track_standoff_, track_standoff_);
+  if (!(track_standoff_ >= 0 && std::isfinite(track_standoff_))) {
+    throw scenario::ConfigError("~track_standoff: expected a finite number >= 0");
+  }
   if (!(drive_off_speed_ >= 0)) throw scenario::ConfigError("~drive_off_speed: expected >= 0");
   std::string track_boxes = "perfect_perception";
   pnh.param("track_boxes", track_boxes, track_boxes);
@@ -154,6 +164,9 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
     }
     pose_pub_ = gate_->advertise<geometry_msgs::PoseStamped>(nh, "uav/cmd_pose", 10);
     predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
+    if (use_target_state_) {
+      target_state_sub_ = gate_->subscribe(nh, "adk/target_state", 20, &Self::onTargetState, this);
+    }
     gate_->every(nh, 1.0 / pursuit_rate, [this] { onPursuitTick(); });
   }
   if (avoid_enabled_) {
@@ -194,6 +207,18 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
         kClientName, phase.id.c_str(), pursuit_.standoff, pursuit_.height, pursuit_.envelope_radius,
         pursuit_.envelope_height);
   }
+  // A track phase scores one camera's frames: viewpoints for it alone, above the vehicle.
+  track_camera_.reset();
+  if (track_phase_ && !track_claim_camera_.empty()) {
+    for (const auto& c : sim_.uav.cameras) {
+      // Several targets are held in its image from straight above: a nadir camera only.
+      if (c.name == track_claim_camera_ && c.mount_rpy.y() > 80.0) track_camera_ = c;
+    }
+    pursuit_.camera = track_claim_camera_;
+    pursuit_.standoff = track_standoff_;
+    ROS_INFO("%s: track phase: viewpoints for the %s camera, %.1f m behind, %.1f m above",
+             kClientName, pursuit_.camera.c_str(), pursuit_.standoff, pursuit_.height);
+  }
   if (pursue_) {
     chooser_ =
         std::make_unique<clients::ViewpointChooser>(*world_, sim_.uav, mission_->kozs, pursuit_);
@@ -201,6 +226,9 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   }
   covered_.clear();
   track_claimed_.clear();
+  state_target_.clear();
+  other_targets_.clear();
+  unclaimed_targets_.clear();
   reports_after_ = -1.0;
   planned_ = stopped_ = exhausted_ = pursuing_ = false;
   avoid_.reset();
@@ -415,6 +443,14 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     const scenario::TargetDescription& target = *targets.front();
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
     const bool parked = parkedAt(p);
+    // A track phase's target not claimed yet, seen away from the pursued vehicle: kept in the
+    // group view until the scored camera holds it too.
+    if (pursuing_ && track_phase_ && track_camera_ && !parked && !track_claimed_.count(target.id) &&
+        (predictor_->predict(t).position - p).head<2>().norm() > kSameVehicle) {
+      auto& seen = unclaimed_targets_[target.id];
+      if (!seen) seen = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
+      seen->observe(t, p, e.yaw);
+    }
     for (const auto& h : parked ? std::vector<clients::VehicleState>{} : predicted) {
       const double d = (p - h.position).head<2>().norm();
       if (d < nearest) {
@@ -465,7 +501,10 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     ROS_INFO("%s: claim: %s at (%.1f, %.1f), confidence %.2f (%s)", kClientName,
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
   }
-  if (associated) predictor_->observe(t, associated->first, associated->second);
+  // Once the ADK's target state feeds the predictor, the sightings no longer do.
+  if (associated && state_target_.empty()) {
+    predictor_->observe(t, associated->first, associated->second);
+  }
   if (defer_claims && !pursuing_ && associated) {
     char buf[160];
     std::snprintf(buf, sizeof(buf), "first sighting at (%.1f, %.1f) from the %s camera",
@@ -475,6 +514,42 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
   if (track_phase_ && pursuing_ && tracks_pub_ && !boxes_from_detector_ && reportsDue(*msg)) {
     publishTracks(*msg,
                   associated ? std::optional<geometry::Vec3>(associated->first) : std::nullopt);
+  }
+}
+
+void CoverageSearchClientRos::onTargetState(const hameritt::EntityStateArray::ConstPtr& msg) {
+  if (!mission_ || !predictor_ || stopped_ || msg->entities.empty()) return;
+  const double t = msg->header.stamp.toSec() - mission_start_;
+  // The pursued target: the one fed before, else the found target nearest the prediction (the
+  // first one while nothing is predicted).
+  const hameritt::EntityState* pick = nullptr;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& e : msg->entities) {
+    if (!state_target_.empty()) {
+      if (e.id == state_target_) pick = &e;
+      continue;
+    }
+    const geometry::Vec3 p(e.pose.position.x, e.pose.position.y, e.pose.position.z);
+    const double d =
+        predictor_->tracking() ? (predictor_->predict(t).position - p).head<2>().norm() : 0.0;
+    if (d < best) best = d, pick = &e;
+  }
+  if (!pick) return;
+  for (const auto& e : msg->entities) {
+    if (&e == pick) continue;
+    auto& other = other_targets_[e.id];
+    if (!other) other = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
+    const clients::VehicleState s = toVehicleState(e, t);
+    other->observe(s.t, s.position, s.yaw, s.speed);
+  }
+  const clients::VehicleState v = toVehicleState(*pick, t);
+  // (A sighting of the same stamp may have come first: this state is dropped, the next one is
+  // taken, since from now on only the state feeds the predictor.)
+  predictor_->observe(v.t, v.position, v.yaw, v.speed);
+  if (state_target_.empty()) {
+    state_target_ = pick->id;
+    ROS_INFO("%s: the ADK's target state feeds the pursuit from t %.1f: (%.1f, %.1f), %.1f m/s",
+             kClientName, t, v.position.x(), v.position.y(), v.speed);
   }
 }
 
@@ -564,10 +639,30 @@ void CoverageSearchClientRos::onPursuitTick() {
     ROS_INFO("%s: pursuit: reacquired the target after loss %d", kClientName, losses_);
   }
   // Lost: climb (up to 15 m) for a wider view around the prediction.
-  const double climb = lost_ ? std::min(15.0, 2.0 * (unseen - kLostAfter)) : 0.0;
+  double climb = lost_ ? std::min(15.0, 2.0 * (unseen - kLostAfter)) : 0.0;
   // Lost, it flies to where the vehicle must pass: the next intersection with a choice.
-  const clients::VehicleState v = lost_ ? predictor_->predictToJunction(t + pursuit_.lead)
-                                        : predictor_->predict(t + pursuit_.lead);
+  clients::VehicleState v = lost_ ? predictor_->predictToJunction(t + pursuit_.lead)
+                                  : predictor_->predict(t + pursuit_.lead);
+  // A track phase with several targets in the ADK's state: all of them in the scored camera,
+  // from above their midpoint, high enough to hold them across the image.
+  if (track_phase_ && !lost_ && track_camera_) {
+    std::vector<clients::VehicleState> group{v};
+    for (const auto& kv : other_targets_) {
+      const clients::StreetPredictor& other = *kv.second;
+      if (t - other.last().t <= kLostAfter) group.push_back(other.predict(t + pursuit_.lead));
+    }
+    for (const auto& kv : unclaimed_targets_) {
+      const clients::StreetPredictor& other = *kv.second;
+      if (!track_claimed_.count(kv.first) && t - other.last().t <= kLostAfter) {
+        group.push_back(other.predict(t + pursuit_.lead));
+      }
+    }
+    if (group.size() > 1) {
+      const clients::GroupView g = clients::groupView(group, *track_camera_, kGroupMargin);
+      v = g.centre;
+      climb = std::max(climb, g.height - pursuit_.height);
+    }
+  }
   const clients::PursuitView view = chooser_->choose(v, uav, t, climb);
   const ros::Time now = ros::Time::now();
   ROS_INFO_THROTTLE(10.0,

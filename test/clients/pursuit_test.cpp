@@ -11,6 +11,7 @@
 
 #include "hameritt/clients/public_config.h"
 #include "hameritt/geometry/segment.h"
+#include "hameritt/planning/look_at.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/sim_config_io.h"
 
@@ -338,6 +339,131 @@ TEST(Pursuit, ViewpointStaysOutOfActiveKeepOutZones) {
   const Vec3 far(c.x() - 30 * u.x(), c.y() - 30 * u.y(), 25.0);
   EXPECT_TRUE(chooser.kozClear(far, before.position, 50.0));
   EXPECT_FALSE(chooser.kozClear(far, Vec3(p.x(), p.y(), 25.0), 150.0));
+}
+
+TEST(Pursuit, AGivenSpeedIsTakenNotEstimated) {
+  // One state with its speed (the ADK's ground truth): the prediction moves at once. Negative
+  // control: the same single sighting without a speed has none to estimate and stands still.
+  const Corner c = findCorner();
+  ASSERT_GE(c.node, 0);
+  const auto& w = world();
+  const Vec2 corner = w.nodes()[static_cast<std::size_t>(c.node)].position;
+  const Vec2 from = w.nodes()[static_cast<std::size_t>(c.from)].position;
+  const Vec2 in = (corner - from).normalized();
+  const double yaw = std::atan2(in.y(), in.x());
+  const Vec2 p = corner - in * 20.0;
+  PursuitSettings settings;
+  StreetPredictor told(w, settings), guessed(w, settings);
+  ASSERT_TRUE(told.observe(5.0, Vec3(p.x(), p.y(), 0), yaw, 8.0));
+  ASSERT_TRUE(guessed.observe(5.0, Vec3(p.x(), p.y(), 0), yaw));
+  EXPECT_NEAR(told.last().speed, 8.0, 1e-12);
+  EXPECT_NEAR((told.predict(6.0).position.head<2>() - (corner - in * 12.0)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR(guessed.last().speed, 0.0, 1e-12);
+  EXPECT_NEAR((guessed.predict(6.0).position.head<2>() - p).norm(), 0.0, 1e-9);
+  // The next state's speed is its own, whatever the displacement says (a stop: 0 m/s).
+  const Vec2 q = corner - in * 12.0;
+  ASSERT_TRUE(told.observe(6.0, Vec3(q.x(), q.y(), 0), yaw, 0.0));
+  EXPECT_NEAR(told.last().speed, 0.0, 1e-12);
+  ASSERT_TRUE(guessed.observe(6.0, Vec3(q.x(), q.y(), 0), yaw));
+  EXPECT_NEAR(guessed.last().speed, 8.0, 1e-9);
+  // A bad speed is no sighting.
+  EXPECT_FALSE(told.observe(7.0, Vec3(q.x(), q.y(), 0), yaw, -1.0));
+  EXPECT_FALSE(told.observe(7.0, Vec3(q.x(), q.y(), 0), yaw, std::nan("")));
+  EXPECT_NEAR(told.last().t, 6.0, 1e-12);
+}
+
+TEST(Pursuit, ViewpointsForOneCameraAreSeenByIt) {
+  // A track phase scores the down camera: with PursuitSettings::camera "down" (straight above
+  // the vehicle), every viewpoint that sees a vehicle on the streets sees it in the down
+  // camera. Negative control: views that only the front camera has (30 m behind) count for the
+  // unrestricted chooser and not for the restricted one.
+  const auto& w = world();
+  PursuitSettings any;
+  PursuitSettings down;
+  down.camera = "down";
+  down.standoff = 0.0;
+  const ViewpointChooser any_chooser(w, sim().uav, {}, any);
+  const ViewpointChooser down_chooser(w, sim().uav, {}, down);
+  int tested = 0, any_front = 0, down_seen = 0, down_front = 0;
+  for (const auto& e : w.edges()) {
+    const Vec2 a = w.nodes()[static_cast<std::size_t>(e.a)].position;
+    const Vec2 b = w.nodes()[static_cast<std::size_t>(e.b)].position;
+    const double len = (b - a).norm();
+    for (double s = 10.0; s < len - 10.0; s += 10.0) {
+      const Vec2 u = (b - a) / len;
+      const Vec2 p = a + u * s + Vec2(u.y(), -u.x()) * 2.0;
+      VehicleState v;
+      v.position = Vec3(p.x(), p.y(), 0.0);
+      v.yaw = std::atan2(u.y(), u.x());
+      const Vec3 centre = v.position + Vec3(0, 0, 0.8);
+      const Vec3 uav = v.position + Vec3(0, 0, 30);
+      ++tested;
+      // From 30 m behind and 20 m above, facing the car, the front camera sees it, the down
+      // one cannot: the unrestricted chooser counts that view, the restricted one does not.
+      const Vec3 far(p.x() - 30.0 * u.x(), p.y() - 30.0 * u.y(), 20.0);
+      if (any_chooser.seenBy(far, v.yaw, centre).value_or("") == "front") {
+        ++any_front;
+        EXPECT_FALSE(down_chooser.seenBy(far, v.yaw, centre).has_value());
+      }
+      const PursuitView vd = down_chooser.choose(v, uav, 0.0);
+      if (!vd.visible) continue;
+      ++down_seen;
+      down_front += vd.camera != "down";
+      // Checked again with the unrestricted chooser: the down camera does see it from there.
+      EXPECT_TRUE(any_chooser.seenBy(vd.position, vd.yaw, centre).has_value());
+      EXPECT_EQ(down_chooser.seenBy(vd.position, vd.yaw, centre).value_or(""), "down");
+    }
+  }
+  std::printf("%d street positions: %d seen by the front camera alone from 30 m; down camera %d\n",
+              tested, any_front, down_seen);
+  EXPECT_GT(tested, 100);
+  EXPECT_GT(any_front, 0);
+  EXPECT_EQ(down_front, 0);
+  EXPECT_GT(down_seen, tested * 9 / 10);
+}
+
+TEST(Pursuit, AGroupViewHoldsEveryVehicleInTheDownCamera) {
+  // Two cars 25 m apart on a street line: from the group view's height above their midpoint,
+  // yawed across their line, the down camera sees both body centres. Negative controls: yawed
+  // along their line (the image's narrow axis), or at the single-vehicle height above the first
+  // car, it does not.
+  const scenario::CameraSpec* down = nullptr;
+  for (const auto& c : sim().uav.cameras) {
+    if (c.name == "down") down = &c;
+  }
+  ASSERT_NE(down, nullptr);
+  int tested = 0;
+  for (double heading : {0.0, 0.7, 2.0, -2.5}) {
+    const Vec2 u(std::cos(heading), std::sin(heading));
+    VehicleState lead, second;
+    lead.position = Vec3(40.0, -10.0, 0.2);
+    lead.yaw = heading;
+    second = lead;
+    second.position = lead.position - Vec3(u.x(), u.y(), 0.0) * 25.0;
+    const GroupView g = groupView({lead, second}, *down, 3.0);
+    EXPECT_NEAR((g.centre.position - 0.5 * (lead.position + second.position)).norm(), 0.0, 1e-9);
+    const Vec3 uav = g.centre.position + Vec3(0, 0, g.height);
+    const Vec3 up(0, 0, 0.8);
+    for (const VehicleState* v : {&lead, &second}) {
+      EXPECT_TRUE(planning::projectToImage(*down, uav, g.centre.yaw, v->position + up))
+          << "heading " << heading;
+    }
+    const bool along =
+        planning::projectToImage(*down, uav, heading, lead.position + up).has_value() &&
+        planning::projectToImage(*down, uav, heading, second.position + up).has_value();
+    EXPECT_FALSE(along) << "heading " << heading;
+    const Vec3 single = lead.position + Vec3(0, 0, PursuitSettings().height);
+    EXPECT_FALSE(planning::projectToImage(*down, single, heading, second.position + up));
+    ++tested;
+  }
+  EXPECT_EQ(tested, 4);
+  // One vehicle: itself, no extra height.
+  VehicleState one;
+  one.position = Vec3(1, 2, 0);
+  one.yaw = 0.3;
+  const GroupView g1 = groupView({one}, *down, 3.0);
+  EXPECT_EQ(g1.height, 0.0);
+  EXPECT_EQ(g1.centre.yaw, 0.3);
 }
 
 }  // namespace

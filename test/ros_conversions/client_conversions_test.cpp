@@ -231,5 +231,29 @@ TEST(ClientConversions, MissionStateFromAnyMessageType) {
   EXPECT_TRUE(r->ended);
 }
 
+TEST(ClientConversions, TargetStateBecomesAVehicleState) {
+  hameritt::EntityState e;
+  e.pose.position.x = 3.0;
+  e.pose.position.y = -4.0;
+  e.pose.position.z = 0.1;
+  const double yaw = 2.5;
+  e.pose.orientation.z = std::sin(0.5 * yaw);
+  e.pose.orientation.w = std::cos(0.5 * yaw);
+  // 10 m/s along the heading plus 1 m/s across it: the speed is the component along it.
+  e.velocity.linear.x = 10.0 * std::cos(yaw) - std::sin(yaw);
+  e.velocity.linear.y = 10.0 * std::sin(yaw) + std::cos(yaw);
+  clients::VehicleState v = toVehicleState(e, 12.5);
+  EXPECT_DOUBLE_EQ(v.t, 12.5);
+  EXPECT_DOUBLE_EQ(v.position.x(), 3.0);
+  EXPECT_DOUBLE_EQ(v.position.y(), -4.0);
+  EXPECT_DOUBLE_EQ(v.position.z(), 0.1);
+  EXPECT_NEAR(v.yaw, yaw, 1e-12);
+  EXPECT_NEAR(v.speed, 10.0, 1e-12);
+  // Backwards (a reversing car): no speed along the heading.
+  e.velocity.linear.x = -e.velocity.linear.x;
+  e.velocity.linear.y = -e.velocity.linear.y;
+  EXPECT_DOUBLE_EQ(toVehicleState(e, 0.0).speed, 0.0);
+}
+
 }  // namespace
 }  // namespace hameritt::ros_wrappers

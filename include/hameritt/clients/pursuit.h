@@ -30,6 +30,9 @@ struct PursuitSettings {
   // `height`, the centre when none of them sees the vehicle. 0: any viewpoint that sees it.
   double envelope_radius = 0.0;
   double envelope_height = 0.0;
+  // The camera that must see the vehicle (a track phase scores one camera's frames): only its
+  // view counts for the viewpoint choice. Empty: any payload camera.
+  std::string camera;
   // Throws scenario::ConfigError naming "pursuit.<field>" and the bad value.
   void validate() const;
 };
@@ -50,6 +53,9 @@ class StreetPredictor {
   StreetPredictor(const scenario::World& world, const PursuitSettings& settings);
   // A sighting; sightings at or before the last one are ignored (false).
   bool observe(double t, const geometry::Vec3& position, double yaw);
+  // A sighting with its speed along the heading known (a tracker's or the ADK's ground-truth
+  // target state): the speed is taken as given, not estimated from the sightings.
+  bool observe(double t, const geometry::Vec3& position, double yaw, double speed);
   // A sighting without a heading (a detection claim): the heading of the displacement from the
   // last sighting when it moved more than 2 m, else the last heading.
   bool observe(double t, const geometry::Vec3& position);
@@ -73,6 +79,19 @@ class StreetPredictor {
   std::deque<VehicleState> recent_;
   VehicleState last_;
 };
+
+// Several vehicles held in one camera's image at once (a track phase's convoy): the point to
+// look at and how high.
+struct GroupView {
+  VehicleState centre;  // the vehicles' midpoint; yaw across their line, so that the image's
+                        // wider axis (a level camera's width) lies along it
+  double height = 0.0;  // m above the vehicles that fits them all across the image's width with
+                        // `margin` m to spare at each end
+};
+// The view of `vehicles` (at least one) from straight above with the nadir camera `camera`
+// (pitched down): their midpoint and the height; one vehicle: itself, height 0.
+GroupView groupView(const std::vector<VehicleState>& vehicles, const scenario::CameraSpec& camera,
+                    double margin);
 
 // A place to look from.
 struct PursuitView {
@@ -99,8 +118,8 @@ class ViewpointChooser {
   // candidate sees the vehicle, the nearest one outside the keep-out zones (visible false).
   PursuitView choose(const VehicleState& vehicle, const geometry::Vec3& uav, double t,
                      double climb = 0.0) const;
-  // The camera (by name) that sees the point `target` from a UAV at `position` with `yaw`
-  // with a clear line of sight, or nullopt.
+  // The camera (by name; only PursuitSettings::camera when set) that sees the point `target`
+  // from a UAV at `position` with `yaw` with a clear line of sight, or nullopt.
   std::optional<std::string> seenBy(const geometry::Vec3& position, double yaw,
                                     const geometry::Vec3& target) const;
   // True when the straight flight a -> b at time t stays out of every keep-out zone active then

@@ -12,11 +12,13 @@
 #include <string>
 
 #include "hameritt/Detection.h"
+#include "hameritt/EntityState.h"
 #include "hameritt/Mission.h"
 #include "hameritt/PerceivedEntity.h"
 #include "hameritt/clients/color_detector.h"
 #include "hameritt/clients/context_filter.h"
 #include "hameritt/clients/mission_state.h"
+#include "hameritt/clients/pursuit.h"
 
 namespace hameritt::ros_wrappers {
 
@@ -38,6 +40,12 @@ clients::Observation toObservation(const hameritt::PerceivedEntity& e);
 // attributes (no entity id or role: the detector does not know them).
 hameritt::PerceivedEntity toPerceivedBlob(const scenario::TargetDescription& target,
                                           const clients::CarCandidate& blob);
+
+// A ground-truth entity state (adk/target_state) as the pursuit's vehicle state at mission time
+// `t` (the message's stamp less the mission's start): the bottom-centre position, the pose's
+// yaw, and the speed along that heading (the horizontal velocity's component, 0 when it points
+// backwards).
+clients::VehicleState toVehicleState(const hameritt::EntityState& e, double t);
 
 // A claim: "I see `target` at `position`" from the frame stamped `stamp`.
 hameritt::Detection makeDetection(const std::string& client,

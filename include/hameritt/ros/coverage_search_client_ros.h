@@ -14,6 +14,7 @@
 #include <ros/ros.h>
 #include <topic_tools/shape_shifter.h>
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -40,7 +41,7 @@ namespace hameritt::ros_wrappers {
 // adk/state (any type), perception/detections; pub planner/waypoints (nav_msgs/Path), ~plan
 // (nav_msgs/Path, latched: every waypoint of the current plan), uav/cmd_pose while pursuing
 // (geometry_msgs/PoseStamped); in maneuver-only mode sub adk/perfect_perception and pub
-// perception/detections.
+// perception/detections; while pursuing sub adk/target_state (hameritt/EntityStateArray).
 //
 // Parameters (private): ~sim_config (required; only its public part is read:
 // clients::loadPublicSimConfig), ~camera ("down"), ~altitude (0: highest that keeps a car's width
@@ -57,9 +58,13 @@ namespace hameritt::ros_wrappers {
 // an avoid mission with the pilot), ~avoid_rate_hz (10), ~avoid_speed_fraction (0.6),
 // ~avoid_horizontal_buffer (9 m), ~avoid_vertical_buffer (6 m), ~avoid_horizon (10 s),
 // ~track_claim_camera ("down": on a track phase, each target is claimed once, when this
-// camera sees it, the pursuit starting at the first sighting; "": claims as in the other
-// classes), ~drive_off_speed (13 m/s, the generator's fastest car: once the search goes on past the
-// areas' windows, a sighting that far from its area per second since the window closed still
+// camera sees it, the pursuit starting at the first sighting, and the viewpoints are chosen
+// for this camera alone; "": claims and viewpoints as in the other classes), ~track_standoff
+// (0 m: on a track phase, this far behind the predicted vehicle, ~pursuit_height above it),
+// ~use_target_state (true: while pursuing, the pursued target's state on adk/target_state,
+// published in maneuver_only from its find on, feeds the prediction instead of the
+// sightings), ~drive_off_speed (13 m/s, the generator's fastest car: once the search goes on past
+// the areas' windows, a sighting that far from its area per second since the window closed still
 // passes the context filter). Avoid
 // missions: sub adk/traffic (hameritt/EntityStateArray), pub uav/cmd_pose.
 class CoverageSearchClientRos {
@@ -86,6 +91,10 @@ class CoverageSearchClientRos {
   void publishTracks(const hameritt::PerceptionReport& msg,
                      const std::optional<geometry::Vec3>& near);
   void onPerfectPerception(const hameritt::PerceptionReport::ConstPtr& msg);
+  // adk/target_state (maneuver_only, ~use_target_state): the pursued target's ground-truth
+  // state goes to the predictor as a sighting with its heading and speed; from then on it
+  // alone feeds the predictor.
+  void onTargetState(const hameritt::EntityStateArray::ConstPtr& msg);
   // ~track_boxes detector: the detector's blobs of a frame become the track report, each
   // target's the blob nearest the pursued vehicle's predicted position.
   void onBlobs(const hameritt::PerceptionReport::ConstPtr& msg);
@@ -137,6 +146,20 @@ class CoverageSearchClientRos {
   std::vector<geometry::Vec2> parked_;  // the public map's parked cars
   double planner_sent_at_ = -1e9;
   int losses_ = 0;
+  // ~use_target_state: the ADK's ground-truth state of the found targets feeds the predictor.
+  bool use_target_state_ = true;
+  // The target whose state feeds the predictor (empty until the first adk/target_state), and
+  // the other found targets' predictions (a track phase keeps them all in view).
+  std::string state_target_;
+  std::map<std::string, std::unique_ptr<clients::StreetPredictor>> other_targets_;
+  // A track phase's targets (by description) sighted away from the pursued vehicle and not yet
+  // claimed: the group view brings them into the scored camera.
+  std::map<std::string, std::unique_ptr<clients::StreetPredictor>> unclaimed_targets_;
+  // A track phase's scored camera when it looks straight down (the group view needs that).
+  std::optional<scenario::CameraSpec> track_camera_;
+  // A track phase: metres behind the predicted vehicle (0: straight above it), where the
+  // scored camera (~track_claim_camera) looks down on it.
+  double track_standoff_ = 0.0;
 
   // Avoid.
   bool avoid_enabled_ = true, avoid_planned_ = false, avoid_arrived_ = false;
@@ -155,7 +178,7 @@ class CoverageSearchClientRos {
   std::set<std::string> track_claimed_;
   double reports_after_ = -1.0;  // the stamp of the frame that claimed the last target
   ros::Subscriber mission_sub_, odom_sub_, progress_sub_, state_sub_, detection_sub_, perfect_sub_,
-      traffic_sub_, blobs_sub_;
+      traffic_sub_, blobs_sub_, target_state_sub_;
 };
 
 }  // namespace hameritt::ros_wrappers
