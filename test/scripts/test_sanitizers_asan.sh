@@ -3,8 +3,8 @@
 # builds them in build/asan (clang-14, -O1, only the libraries they link) and runs each through
 # the judge of scripts/sanitizers_common.sh (any report fails), two at a time, the slowest first.
 # Negative control first: test/sanitizers/control.cpp, compiled the same way, must be reported
-# and fail the judge for each fault (heap overflow, use after free, signed overflow, a leak from our code), and pass
-# without one. docs/RELIABILITY.md "Sanitizers" has the cost.
+# and fail the judge for each fault (heap overflow, use after free, signed overflow, a leak from
+# our code), and pass without one. docs/RELIABILITY.md "Sanitizers" has the cost.
 set -euo pipefail
 source "$(dirname "$0")/../../scripts/sanitizers_common.sh"
 work="$(mktemp -d)"
