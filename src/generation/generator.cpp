@@ -2077,6 +2077,7 @@ class ScenarioBuilder {
       f.time_shift = traffic.offset;
       f.length = ep.cars[i].size.x();
       f.width = ep.cars[i].size.y();
+      if (i < traffic.episode->clearance.size()) f.blocks = &traffic.episode->clearance[i];
       ambient.push_back(f);
     }
     const std::vector<std::size_t> held = trafficToWithhold(own, ambient, sc_.mission.time_limit);

@@ -1265,6 +1265,14 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
     auto shared = decodedEpisode(parseTrafficEpisode(*text, trafficEpisodeFileName(index)));
     shared->sha256 = sha256Hex(*text);
     shared->text = std::move(text);
+    shared->clearance.reserve(shared->trajectories.size());
+    for (std::size_t i = 0; i < shared->trajectories.size(); ++i) {
+      MovingFootprint f;
+      f.trajectory = &shared->trajectories[i];
+      f.length = shared->episode.cars[i].size.x();
+      f.width = shared->episode.cars[i].size.y();
+      shared->clearance.push_back(clearanceBlocks(f));
+    }
     slot->value = std::move(shared);
   });
   return slot->value;

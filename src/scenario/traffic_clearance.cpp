@@ -12,11 +12,17 @@ namespace {
 // Fine samples per block of the broad phase: two cars' fine samples are compared only where the
 // boxes that bound their footprints over a block meet.
 constexpr std::size_t kBlock = 20;
+static_assert(kBlock * kClearanceStep == kClearanceBlock);
 
-struct Box {
-  double min_x, min_y, max_x, max_y;
+struct Box : ClearanceBox {
   bool meets(const Box& o) const {
     return min_x <= o.max_x && o.min_x <= max_x && min_y <= o.max_y && o.min_y <= max_y;
+  }
+  void add(const ClearanceBox& o) {
+    min_x = std::min(min_x, o.min_x);
+    min_y = std::min(min_y, o.min_y);
+    max_x = std::max(max_x, o.max_x);
+    max_y = std::max(max_y, o.max_y);
   }
 };
 
@@ -72,6 +78,23 @@ double reach(const MovingFootprint& f, double margin) {
   return 0.5 * std::hypot(f.length + 2 * margin, f.width + 2 * margin);
 }
 
+// The box that holds the footprint over [ta, tb] of scenario time (at(ta) not yet called),
+// grown by r: a trajectory is straight between its points, so its positions over the interval
+// lie in the box of its ends and the points between them.
+Box boxOver(Cursor& c, double ta, double tb, double r) {
+  const TrajectoryPoint a = c.at(ta);
+  Box b;
+  b.min_x = b.max_x = a.x;
+  b.min_y = b.max_y = a.y;
+  c.vertices(ta, tb, &b);
+  const TrajectoryPoint e = c.at(tb);
+  b.min_x = std::min(b.min_x, e.x) - r;
+  b.max_x = std::max(b.max_x, e.x) + r;
+  b.min_y = std::min(b.min_y, e.y) - r;
+  b.max_y = std::max(b.max_y, e.y) + r;
+  return b;
+}
+
 // The boxes that hold the footprint (grown by margin) over each block of fine samples.
 std::vector<Box> blockBoxes(const MovingFootprint& f, std::size_t n, double margin) {
   const double r = reach(f, margin);
@@ -81,14 +104,31 @@ std::vector<Box> blockBoxes(const MovingFootprint& f, std::size_t n, double marg
   for (std::size_t k0 = 0; k0 < n; k0 += kBlock) {
     const double ta = static_cast<double>(k0) * kClearanceStep;
     const double tb = static_cast<double>(std::min(k0 + kBlock, n) - 1) * kClearanceStep;
-    const TrajectoryPoint a = c.at(ta);
-    Box b{a.x, a.y, a.x, a.y};
-    c.vertices(ta, tb, &b);
-    const TrajectoryPoint e = c.at(tb);
-    b.min_x = std::min(b.min_x, e.x) - r;
-    b.max_x = std::max(b.max_x, e.x) + r;
-    b.min_y = std::min(b.min_y, e.y) - r;
-    b.max_y = std::max(b.max_y, e.y) + r;
+    out.push_back(boxOver(c, ta, tb, r));
+  }
+  return out;
+}
+
+// The same blocks from the footprint's precomputed ones: the scenario's block [ta, tb] is
+// [ta, tb] + time_shift of the trajectory's time, which the union of the precomputed blocks
+// from the one that holds its start to the one that holds its end contains (a slightly larger
+// box, never a smaller one: the fine comparison decides).
+std::vector<Box> cachedBlockBoxes(const MovingFootprint& f, std::size_t n) {
+  const std::vector<ClearanceBox>& pre = f.blocks->boxes;
+  const long last = static_cast<long>(pre.size()) - 1;
+  auto index = [&](double t, double nudge) {
+    return std::clamp(static_cast<long>(std::floor(t / kClearanceBlock + nudge)), 0L, last);
+  };
+  std::vector<Box> out;
+  out.reserve((n + kBlock - 1) / kBlock);
+  for (std::size_t k0 = 0; k0 < n; k0 += kBlock) {
+    const double ta = static_cast<double>(k0) * kClearanceStep + f.time_shift;
+    const double tb =
+        static_cast<double>(std::min(k0 + kBlock, n) - 1) * kClearanceStep + f.time_shift;
+    const long e0 = index(ta, -1e-6), e1 = index(tb, 1e-6);
+    Box b;
+    static_cast<ClearanceBox&>(b) = pre[static_cast<std::size_t>(e0)];
+    for (long e = e0 + 1; e <= e1; ++e) b.add(pre[static_cast<std::size_t>(e)]);
     out.push_back(b);
   }
   return out;
@@ -116,6 +156,25 @@ std::optional<double> overlapInBlock(const MovingFootprint& a, const MovingFootp
 }
 
 }  // namespace
+
+ClearanceBlocks clearanceBlocks(const MovingFootprint& f, double margin) {
+  MovingFootprint own = f;
+  own.time_shift = 0.0;
+  const double r = reach(own, margin);
+  ClearanceBlocks out;
+  out.margin = margin;
+  Cursor c(own);
+  // Blocks up to one that starts at or after the last point: from there on the footprint
+  // stands at the last point, which that block holds.
+  const double end = c.moving() ? own.trajectory->back().t : 0.0;
+  const auto count = static_cast<std::size_t>(std::max(0.0, std::floor(end / kClearanceBlock))) + 2;
+  out.boxes.reserve(count);
+  for (std::size_t e = 0; e < count; ++e) {
+    out.boxes.push_back(boxOver(c, static_cast<double>(e) * kClearanceBlock,
+                                static_cast<double>(e + 1) * kClearanceBlock, r));
+  }
+  return out;
+}
 
 MovingFootprint footprintOf(const ScenarioEntity& se) {
   MovingFootprint f;
@@ -171,7 +230,11 @@ std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& m
   std::vector<std::size_t> out;
   if (mission.empty()) return out;
   for (std::size_t i = 0; i < traffic.size(); ++i) {
-    const std::vector<Box> boxes = blockBoxes(traffic[i], n, margin);
+    const MovingFootprint& f = traffic[i];
+    const std::vector<Box> boxes =
+        f.blocks && f.blocks->margin == margin && !f.blocks->boxes.empty()
+            ? cachedBlockBoxes(f, n)
+            : blockBoxes(f, n, margin);
     bool near = false;
     for (std::size_t m = 0; m < mission.size() && !near; ++m) {
       for (std::size_t j = 0; j < boxes.size() && !near; ++j) {

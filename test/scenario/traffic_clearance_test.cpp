@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "hameritt/generation/generator.h"
 #include "hameritt/scenario/city_traffic.h"
@@ -129,6 +130,55 @@ TEST(TrafficClearance, GeneratedCityScenariosKeepTheirCarsApart) {
   }
   EXPECT_GT(held_total, 0u);
   EXPECT_GT(held_overlapping, 0u);
+}
+
+// An episode's precomputed blocks (SharedTrafficEpisode::clearance) withhold exactly the cars
+// that walking each trajectory again withholds, at offsets on and off the blocks' 2 s grid:
+// "mission" cars are episode cars seen at other offsets (some pairs near each other, most not).
+// Control: blocks moved 1 km away withhold nothing, so the comparison did read them.
+TEST(TrafficClearance, PrecomputedEpisodeBlocksWithholdTheSameCars) {
+  const auto ep = cityTrafficEpisode(testing::shippedCityWorld(), 0);
+  ASSERT_EQ(ep->clearance.size(), ep->trajectories.size());
+  ASSERT_GT(ep->trajectories.size(), 20u);
+  std::size_t withheld = 0;
+  for (const double offset : {0.0, 1.4, 37.8, 200.0, 611.2}) {
+    for (const double duration : {60.0, 300.0}) {
+      SCOPED_TRACE("offset " + std::to_string(offset) + " duration " + std::to_string(duration));
+      std::vector<MovingFootprint> own, walked, cached, far;
+      std::vector<ClearanceBlocks> moved(ep->clearance.begin(), ep->clearance.end());
+      for (std::size_t i = 0; i < ep->trajectories.size(); ++i) {
+        MovingFootprint f = moving(ep->trajectories[i], offset);
+        f.length = ep->episode.cars[i].size.x();
+        f.width = ep->episode.cars[i].size.y();
+        // Every seventh car, 0.6 s later, as one of the mission's: it follows its own path.
+        if (i % 7 == 0) {
+          MovingFootprint m = f;
+          m.time_shift = offset + 0.6;
+          own.push_back(m);
+        }
+        walked.push_back(f);
+        f.blocks = &ep->clearance[i];
+        cached.push_back(f);
+        for (auto& b : moved[i].boxes) {
+          b.min_x += 1000.0;
+          b.max_x += 1000.0;
+        }
+      }
+      for (std::size_t i = 0; i < cached.size(); ++i) {
+        far.push_back(cached[i]);
+        far.back().blocks = &moved[i];
+      }
+      const auto expected = trafficToWithhold(own, walked, duration);
+      EXPECT_EQ(trafficToWithhold(own, cached, duration), expected);
+      EXPECT_TRUE(trafficToWithhold(own, far, duration).empty());
+      // A margin other than the blocks' walks the trajectories.
+      EXPECT_EQ(trafficToWithhold(own, far, duration, 0.0),
+                trafficToWithhold(own, walked, duration, 0.0));
+      withheld += expected.size();
+    }
+  }
+  EXPECT_GT(withheld, 10u);
+  std::printf("withheld over 10 windows: %zu\n", withheld);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "hameritt/scenario/catalog.h"
 #include "hameritt/scenario/scenario.h"
+#include "hameritt/scenario/traffic_clearance.h"
 #include "hameritt/scenario/world.h"
 
 namespace hameritt::scenario {
@@ -118,6 +119,9 @@ struct SharedTrafficEpisode {
   std::shared_ptr<const std::string> text;  // null for a scenario's own cars (not shared)
   std::string sha256;
   std::vector<Trajectory> trajectories;  // each car's, over the whole episode
+  // Each car's footprint blocks (traffic_clearance.h) over the whole episode, for the scenarios
+  // that withhold the cars that come near their own; empty for a scenario's own cars.
+  std::vector<ClearanceBlocks> clearance;
 };
 std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
                                                                const IdmParams& idm = {});

@@ -18,6 +18,24 @@ namespace hameritt::scenario {
 constexpr double kClearanceStep = 0.1;
 constexpr double kTrafficClearance = 0.5;
 
+// The broad phase compares footprints over blocks of this many seconds (20 samples).
+constexpr double kClearanceBlock = 2.0;
+
+// A box (x and y bounds) that holds a footprint over a stretch of time.
+struct ClearanceBox {
+  double min_x = 0.0, min_y = 0.0, max_x = 0.0, max_y = 0.0;
+};
+
+// The boxes that hold a footprint, grown by `margin` on every side, over consecutive blocks of
+// its trajectory's own time: boxes[e] holds it over [e, e + 1] * kClearanceBlock, and the last
+// one from its start on (the trajectory has ended there). A shared traffic episode computes its
+// cars' once (SharedTrafficEpisode::clearance), so that each scenario that draws the episode
+// compares its own cars with them without walking every ambient trajectory again.
+struct ClearanceBlocks {
+  double margin = kTrafficClearance;
+  std::vector<ClearanceBox> boxes;
+};
+
 // A car's footprint moving along a trajectory: a length x width rectangle centred on the pose,
 // along its yaw. The scenario's t is the trajectory's t - time_shift (an episode car's
 // trajectory runs on episode time, the scenario starting at its offset). A trajectory with a
@@ -28,7 +46,13 @@ struct MovingFootprint {
   double time_shift = 0.0;
   double length = 4.5;
   double width = 1.8;
+  // Optional: this footprint's clearanceBlocks() (on the trajectory's own time, time_shift not
+  // applied); used when its margin is the comparison's.
+  const ClearanceBlocks* blocks = nullptr;
 };
+
+// The blocks of `f`'s trajectory (its time_shift ignored) over [0, its last point's t].
+ClearanceBlocks clearanceBlocks(const MovingFootprint& f, double margin = kTrafficClearance);
 
 // The footprint of a scenario entity: its box's length and width along its trajectory, or at
 // its box when it has none.
