@@ -8,11 +8,24 @@ build
 cmake --build "$BUILD_DIR" --target tests -j "$JOBS"
 source_devel
 
+# The sanitizer tests' instrumented builds, in the background at the lowest priority while ctest
+# runs the other tests (scripts/sanitizers_common.sh: sanitizer_prebuild; its log is
+# build/sanitizer_prebuild.log). ctest runs those two tests last (their COST in CMakeLists.txt);
+# each waits for its tree's build to end. The background build is its own process group,
+# stopped with the run.
+setsid nice -n 19 bash -c "source '$HAMERITT_ROOT/scripts/sanitizers_common.sh' && sanitizer_prebuild" \
+  >"$BUILD_DIR/sanitizer_prebuild.log" 2>&1 </dev/null &
+prebuild=$!
+trap 'kill -- -"$prebuild" 2>/dev/null || true' EXIT
+
 cd "$BUILD_DIR"
+# The order of the COST properties, as on a clean clone: no timings of an earlier run.
+rm -f Testing/Temporary/CTestCostData.txt
 set +e
 ctest --output-on-failure -j "$JOBS" 2>&1 | tee "$BUILD_DIR/ctest.log"
 rc=${PIPESTATUS[0]}
 set -e
+grep -E "^(sanitizer prebuild|asan built|tsan built)" "$BUILD_DIR/sanitizer_prebuild.log" || true
 # Individual test cases from the gtest/rostest result files, for the closing line.
 counts="$(/usr/bin/python3 - "$BUILD_DIR/test_results" <<'PY'
 import sys, pathlib, xml.etree.ElementTree as ET

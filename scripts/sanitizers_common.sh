@@ -30,13 +30,27 @@ sanitizer_configure() {
   local flags dir cc=clang-14 cxx=clang++-14
   flags="$(sanitizer_flags "$1")"
   dir="$(sanitizer_build_dir "$1")"
-  if [[ -f "$dir/CMakeCache.txt" ]] &&
-    ! grep -q "^CMAKE_CXX_COMPILER:[A-Z]*=.*$cxx\$" "$dir/CMakeCache.txt"; then
-    rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
-  fi
-  CC=$cc CXX=$cxx cmake -S "$HAMERITT_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
-    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON \
-    -DHAMERITT_SANITIZE="$flags" "${CCACHE_ARGS[@]}" >/dev/null
+  (
+    sanitizer_lock "$1"
+    if [[ -f "$dir/CMakeCache.txt" ]] &&
+      ! grep -q "^CMAKE_CXX_COMPILER:[A-Z]*=.*$cxx\$" "$dir/CMakeCache.txt"; then
+      rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
+    fi
+    CC=$cc CXX=$cxx cmake -S "$HAMERITT_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
+      -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON \
+      -DHAMERITT_SANITIZE="$flags" "${CCACHE_ARGS[@]}" >/dev/null
+  )
+}
+
+# sanitizer_lock asan|tsan: in a subshell, waits until no other configure or build of that
+# build directory runs (the test command's background build, below), then holds the lock until
+# the subshell ends.
+sanitizer_lock() {
+  local dir
+  dir="$(sanitizer_build_dir "$1")"
+  mkdir -p "$(dirname "$dir")"
+  exec 9>"$dir.lock"
+  flock 9
 }
 
 # sanitizer_gtests asan|tsan: every gtest program of the configured build (catkin_add_gtest), so
@@ -48,10 +62,44 @@ sanitizer_gtests() {
 
 # sanitizer_build asan|tsan TARGET...: builds the targets (and only what they link).
 sanitizer_build() {
-  local dir
+  local dir kind="$1"
   dir="$(sanitizer_build_dir "$1")"
   shift
-  cmake --build "$dir" -j "$JOBS" --target "$@"
+  (
+    sanitizer_lock "$kind"
+    cmake --build "$dir" -j "$JOBS" --target "$@"
+  )
+}
+
+# The targets of the sanitizer tests. asan: the negative control and every gtest program of the
+# configured build (so that a new one is never left out) but test_ros_conversions: its five
+# tests of the ROS message conversions would need the whole instrumented ROS layer and the
+# generated messages (sixteen ROS sources, the heaviest to compile) and do not fit the test
+# command's budget; scripts/run_sanitizers.sh runs it by hand. HAMERITT_ASAN_PROGRAMS names
+# another list. tsan: the control, test_threads and hameritt_generate.
+asan_programs() {
+  if [[ -n "${HAMERITT_ASAN_PROGRAMS:-}" ]]; then
+    tr ' ' '\n' <<<"$HAMERITT_ASAN_PROGRAMS" | grep -v '^$'
+  else
+    sanitizer_gtests asan | grep -vx test_ros_conversions
+  fi
+}
+TSAN_TARGETS=(test_sanitizer_control test_threads hameritt_generate)
+
+# sanitizer_prebuild: the test command (scripts/run_tests.sh) runs this in the background at the
+# lowest priority (nice 19) while ctest runs the other tests: the instrumented builds of both
+# sanitizer tests, which ctest runs last. The tests of the serial phase (whole missions,
+# rostests) leave a core idle much of the time; the builds take that time and little else.
+# Each sanitizer test then configures and builds again under the same lock: it waits for the
+# background build of its tree to end and finds its targets built (or finishes them).
+sanitizer_prebuild() {
+  local programs
+  echo "sanitizer prebuild: start $(date +%T)"
+  sanitizer_configure asan
+  mapfile -t programs < <(asan_programs)
+  sanitizer_build asan test_sanitizer_control "${programs[@]}" && echo "asan built $(date +%T)"
+  sanitizer_configure tsan
+  sanitizer_build tsan "${TSAN_TARGETS[@]}" && echo "tsan built $(date +%T)"
 }
 
 # Runtime options: every report ends the program with a non-zero status (no recovery).

@@ -16,6 +16,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "../sanitized.h"
 #include "hameritt/generation/batch.h"
 #include "hameritt/scenario/scenario_io.h"
 #include "hameritt/scenario/sim_config_io.h"
@@ -269,7 +270,7 @@ TEST(CityTraffic, CarsNeverOverlapAndKeepTheStandstillGap) {
   for (auto& p : late[0].trajectory) p.t += 3.0;
   late[0].trajectory.insert(late[0].trajectory.begin(), late[0].trajectory.front());
   late[0].trajectory.front().t = 0.0;
-  EXPECT_GT(checkCars(late, s.sim.duration, 0.05).overlaps, 0);
+  EXPECT_GT(checkCars(late, s.sim.duration, sanitizedCount(1, 4) * 0.05).overlaps, 0);
 
   // Negative control on a curve: a copy of a turning car 0.4 s behind it, present only over the
   // turn (10 km away otherwise), overlaps it.
@@ -304,11 +305,13 @@ TEST(CityTraffic, CarsNeverOverlapAndKeepTheStandstillGap) {
     }
   }
   ASSERT_TRUE(found_turn);
-  EXPECT_GT(checkCars(turn_copy, s.sim.duration, 0.05).overlaps, 0);
+  // Under a sanitizer every fourth sample (sanitized.h).
+  const double dt = sanitizedCount(1, 4) * 0.05;
+  EXPECT_GT(checkCars(turn_copy, s.sim.duration, dt).overlaps, 0);
 
-  const OverlapReport r = checkCars(traffic, s.sim.duration, 0.05);
+  const OverlapReport r = checkCars(traffic, s.sim.duration, dt);
   EXPECT_EQ(r.overlaps, 0);
-  EXPECT_GT(r.close_pairs, 1000);
+  EXPECT_GT(r.close_pairs, 1000 / sanitizedCount(1, 4));
   // The bumper gap of followers: the model's standstill gap, less the written trajectories'
   // interpolation tolerance (positions within 0.1 m of the simulated ones, for each car).
   EXPECT_GE(r.min_gap, idm.min_gap - 0.25);
@@ -372,7 +375,7 @@ Trajectory withoutWaits(const Trajectory& traj) {
 // as before they obeyed the signals); the validator reports both and accepts the generated file.
 TEST(CityTraffic, MissionVehiclesObeyTheSignals) {
   const std::string schema = defaultConfigDir() + "/schema";
-  constexpr int kSeeds = 15;
+  constexpr int kSeeds = sanitizedCount(15, 3);
   int scenarios = 0, cars = 0, waiting = 0, validator_shifted = 0;
   EntryReport r, shifted, unwaited;
   for (ScenarioClass cls : {ScenarioClass::kRouteSearch, ScenarioClass::kPursuit,

@@ -10,24 +10,19 @@ source "$(dirname "$0")/../../scripts/sanitizers_common.sh"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
+SECONDS=0
 sanitizer_configure asan
-# Every gtest program of the build (so that a new one is never left out) but test_ros_conversions:
-# its five tests of the ROS message conversions would need the whole instrumented ROS layer and
-# the generated messages (sixteen ROS sources, the heaviest to compile) and do not fit the test
-# command's budget; scripts/run_sanitizers.sh runs it by hand. HAMERITT_ASAN_PROGRAMS names
-# another list.
-if [[ -n "${HAMERITT_ASAN_PROGRAMS:-}" ]]; then
-  read -r -a programs <<<"$HAMERITT_ASAN_PROGRAMS"
-else
-  mapfile -t programs < <(sanitizer_gtests asan | grep -vx test_ros_conversions)
+echo "configured: ${SECONDS} s (with the wait for a background build of build/asan)"
+# The gtest programs (sanitizers_common.sh: asan_programs).
+mapfile -t programs < <(asan_programs)
+if [[ -z "${HAMERITT_ASAN_PROGRAMS:-}" ]]; then
   # The list comes from the build; it must hold at least the ten programs known today.
   ((${#programs[@]} >= 10)) || { echo "FAIL: fewer than 10 gtest programs: ${programs[*]}"; exit 1; }
 fi
 echo "gtest programs: ${#programs[@]} (${programs[*]})"
-SECONDS=0
 sanitizer_build asan test_sanitizer_control "${programs[@]}" >"$work/build.log" 2>&1 ||
   { tail -40 "$work/build.log"; exit 1; }
-echo "build: ${SECONDS} s"
+echo "built: ${SECONDS} s"
 sanitizer_source_devel asan
 bin="$(sanitizer_build_dir asan)/devel/lib/hameritt"
 
@@ -42,10 +37,11 @@ sanitizer_run "$work/control_none.log" "$bin/sanitizer_control" none ||
 
 # The gtest programs, HAMERITT_JOBS (default: the number of cores) at a time, the slowest first
 # (longest processing time first), so that no core idles at the end while the last long one
-# runs alone. The list is by the seconds each took (2-core VM, 2026-11-26: render 490-610,
-# scenario 441-472, generation 171, clients 63-72, planning 30, map 21, sim 14, the rest under
-# 11); a program not listed comes after them. Each program's seconds are printed.
-slowest=(test_render test_scenario test_generation test_clients test_planning test_map test_sim)
+# runs alone. The list is by the seconds each took (2-core VM, 2026-11-27, with the slowest
+# tests' fewer repetitions of test/sanitized.h: scenario 285, generation 187, render 84 (479 s
+# more before), clients 71, planning 45, map 26, sim 11, the rest under 10); a program not
+# listed comes after them. Each program's seconds are printed.
+slowest=(test_scenario test_generation test_render test_clients test_planning test_map test_sim)
 order=()
 for p in "${slowest[@]}"; do
   if [[ " ${programs[*]} " == *" $p "* ]]; then order+=("$p"); fi

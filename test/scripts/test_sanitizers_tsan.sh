@@ -16,7 +16,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
 sanitizer_configure tsan
-sanitizer_build tsan test_sanitizer_control test_threads hameritt_generate >"$work/build.log" 2>&1 ||
+sanitizer_build tsan "${TSAN_TARGETS[@]}" >"$work/build.log" 2>&1 ||
   { tail -40 "$work/build.log"; exit 1; }
 sanitizer_source_devel tsan
 bin="$(sanitizer_build_dir tsan)/devel/lib/hameritt"
