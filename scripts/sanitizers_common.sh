@@ -39,6 +39,12 @@ sanitizer_configure() {
     CC=$cc CXX=$cxx cmake -S "$HAMERITT_ROOT" -B "$dir" -DCMAKE_BUILD_TYPE=Release \
       -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON \
       -DHAMERITT_SANITIZE="$flags" "${CCACHE_ARGS[@]}" >/dev/null
+    # A tree's programs carry the suffix _sanitized (CMakeLists.txt: rosrun searches the whole
+    # package directory); a program an older checkout built here under its plain name goes.
+    if [[ -d "$dir/devel/lib/hameritt" ]]; then
+      find "$dir/devel/lib/hameritt" -maxdepth 1 -type f ! -name 'test_*' ! -name '*_sanitized' \
+        ! -name sanitizer_control -delete
+    fi
   )
 }
 

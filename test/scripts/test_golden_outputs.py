@@ -21,6 +21,8 @@ import sys
 import tempfile
 
 BIN = os.environ["HAMERITT_BIN_DIR"]
+# A sanitizer tree names its generator hameritt_generate_sanitized (CMakeLists.txt).
+GENERATE = os.environ.get("HAMERITT_GENERATE", f"{BIN}/hameritt_generate")
 SRC = os.environ["HAMERITT_SOURCE_DIR"]
 GOLDEN = os.path.join(SRC, "test", "data", "golden", "generated.sha256")
 SINGLES = [("area_search", 2044), ("route_search", 14), ("pursuit", 11)]
@@ -28,7 +30,7 @@ BATCH = ["--class", "all", "--count", "6", "--seed", "5"]
 
 
 def generate(out, args):
-    subprocess.run([f"{BIN}/hameritt_generate", *args, "--out", out, "--quiet"], check=True)
+    subprocess.run([GENERATE, *args, "--out", out, "--quiet"], check=True)
 
 
 def digests(root, prefix):

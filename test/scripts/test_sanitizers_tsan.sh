@@ -39,15 +39,27 @@ done
 
 # Compiler independence: clang-14's generator against the golden files of the g++ build (the
 # check has its own negative control: a flipped byte, a missing and an extra file).
-if HAMERITT_BIN_DIR="$bin" HAMERITT_SOURCE_DIR="$HAMERITT_ROOT" /usr/bin/python3 "$HAMERITT_ROOT/test/scripts/test_golden_outputs.py" \
+if HAMERITT_BIN_DIR="$bin" HAMERITT_GENERATE="$bin/hameritt_generate_sanitized" HAMERITT_SOURCE_DIR="$HAMERITT_ROOT" /usr/bin/python3 "$HAMERITT_ROOT/test/scripts/test_golden_outputs.py" \
   >"$work/golden.log" 2>&1 && ! grep -qE "$SANITIZER_REPORT_RE" "$work/golden.log"; then
   echo "clang-14 generation: $(tail -1 "$work/golden.log")"
 else
   echo "FAIL: clang-14 (TSan) generation differs from the golden files or was reported:"
-  grep -E "FAIL|$SANITIZER_REPORT_RE" "$work/golden.log" | head -20
+  { grep -E "FAIL|$SANITIZER_REPORT_RE" "$work/golden.log" || tail -5 "$work/golden.log"; } | head -20
   failed=1
 fi
-# rosrun searches the whole package directory: a second hameritt_generate below build/ would make
-# `rosrun hameritt hameritt_generate` ask which one to run (the docs test failed on it).
-rm -f "$bin/hameritt_generate"
+# rosrun searches the whole package directory, build/tsan included: a second hameritt_generate
+# there makes `rosrun hameritt hameritt_generate` ask which one to run and, with no terminal, run
+# none (the mission tests failed on it while the test command's background build had made the
+# tree). The tree's programs carry the suffix _sanitized; with the tree built, rosrun must still
+# find exactly one program and run it. The devel space is the normal build's again here.
+if [[ -x "$bin/hameritt_generate" ]]; then
+  echo "FAIL: the TSan tree has a program named hameritt_generate"; failed=1
+fi
+if out="$(set +u; source "$HAMERITT_ROOT/build/devel/setup.bash" && cd "$work" &&
+  rosrun hameritt hameritt_generate --help </dev/null 2>&1)"; then
+  echo "rosrun hameritt hameritt_generate with the TSan tree built: one program, --help exit 0"
+else
+  echo "FAIL: rosrun hameritt hameritt_generate with the TSan tree built:"; head -8 <<<"$out"
+  failed=1
+fi
 exit "$failed"
