@@ -2080,7 +2080,8 @@ class ScenarioBuilder {
       if (i < traffic.episode->clearance.size()) f.blocks = &traffic.episode->clearance[i];
       ambient.push_back(f);
     }
-    const std::vector<std::size_t> held = trafficToWithhold(own, ambient, sc_.mission.time_limit);
+    const std::vector<std::size_t> held = trafficToWithhold(
+        own, ambient, traffic.episode->clearance_index, sc_.mission.time_limit);
     for (std::size_t i = 0, h = 0; i < traffic.cars.size(); ++i) {
       const std::string id = nextCarId();
       ref.car_ids.push_back(id);

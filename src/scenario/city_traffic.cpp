@@ -1273,6 +1273,7 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
       f.width = shared->episode.cars[i].size.y();
       shared->clearance.push_back(clearanceBlocks(f));
     }
+    if (!shared->clearance.empty()) shared->clearance_index = clearanceIndex(shared->clearance);
     slot->value = std::move(shared);
   });
   return slot->value;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "hameritt/geometry/types.h"
 
@@ -113,23 +114,36 @@ std::vector<Box> blockBoxes(const MovingFootprint& f, std::size_t n, double marg
 // [ta, tb] + time_shift of the trajectory's time, which the union of the precomputed blocks
 // from the one that holds its start to the one that holds its end contains (a slightly larger
 // box, never a smaller one: the fine comparison decides).
-std::vector<Box> cachedBlockBoxes(const MovingFootprint& f, std::size_t n) {
-  const std::vector<ClearanceBox>& pre = f.blocks->boxes;
+// The precomputed blocks e0 .. e1 (of the trajectory's time) that hold the scenario's block j
+// of fine samples (of n), unclamped: [ta, tb] + time_shift, nudged outwards.
+void episodeBlocks(std::size_t j, std::size_t n, double time_shift, long* e0, long* e1) {
+  const std::size_t k0 = j * kBlock;
+  const double ta = static_cast<double>(k0) * kClearanceStep + time_shift;
+  const double tb =
+      static_cast<double>(std::min(k0 + kBlock, n) - 1) * kClearanceStep + time_shift;
+  *e0 = static_cast<long>(std::floor(ta / kClearanceBlock - 1e-6));
+  *e1 = static_cast<long>(std::floor(tb / kClearanceBlock + 1e-6));
+}
+
+// The union of pre[e0 .. e1], each index clamped to pre's range (a footprint stands at its
+// last point after its last block).
+Box unionOf(const std::vector<ClearanceBox>& pre, long e0, long e1) {
   const long last = static_cast<long>(pre.size()) - 1;
-  auto index = [&](double t, double nudge) {
-    return std::clamp(static_cast<long>(std::floor(t / kClearanceBlock + nudge)), 0L, last);
-  };
+  e0 = std::clamp(e0, 0L, last);
+  e1 = std::clamp(e1, 0L, last);
+  Box b;
+  static_cast<ClearanceBox&>(b) = pre[static_cast<std::size_t>(e0)];
+  for (long e = e0 + 1; e <= e1; ++e) b.add(pre[static_cast<std::size_t>(e)]);
+  return b;
+}
+
+std::vector<Box> cachedBlockBoxes(const MovingFootprint& f, std::size_t n) {
   std::vector<Box> out;
   out.reserve((n + kBlock - 1) / kBlock);
-  for (std::size_t k0 = 0; k0 < n; k0 += kBlock) {
-    const double ta = static_cast<double>(k0) * kClearanceStep + f.time_shift;
-    const double tb =
-        static_cast<double>(std::min(k0 + kBlock, n) - 1) * kClearanceStep + f.time_shift;
-    const long e0 = index(ta, -1e-6), e1 = index(tb, 1e-6);
-    Box b;
-    static_cast<ClearanceBox&>(b) = pre[static_cast<std::size_t>(e0)];
-    for (long e = e0 + 1; e <= e1; ++e) b.add(pre[static_cast<std::size_t>(e)]);
-    out.push_back(b);
+  for (std::size_t j = 0; j * kBlock < n; ++j) {
+    long e0 = 0, e1 = 0;
+    episodeBlocks(j, n, f.time_shift, &e0, &e1);
+    out.push_back(unionOf(f.blocks->boxes, e0, e1));
   }
   return out;
 }
@@ -243,6 +257,131 @@ std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& m
       }
     }
     if (near) out.push_back(i);
+  }
+  return out;
+}
+
+ClearanceIndex clearanceIndex(const std::vector<ClearanceBlocks>& blocks, double cell) {
+  ClearanceIndex ix;
+  ix.cell = cell;
+  ix.source = &blocks;
+  if (blocks.empty()) return ix;
+  ix.margin = blocks.front().margin;
+  double min_x = 0.0, min_y = 0.0, max_x = 0.0, max_y = 0.0;
+  bool first = true;
+  for (const auto& b : blocks) {
+    if (b.boxes.empty() || b.margin != ix.margin) {
+      throw std::invalid_argument("clearanceIndex: a footprint without blocks or of another margin");
+    }
+    ix.blocks = std::max(ix.blocks, b.boxes.size());
+    for (const auto& x : b.boxes) {
+      min_x = first ? x.min_x : std::min(min_x, x.min_x);
+      min_y = first ? x.min_y : std::min(min_y, x.min_y);
+      max_x = first ? x.max_x : std::max(max_x, x.max_x);
+      max_y = first ? x.max_y : std::max(max_y, x.max_y);
+      first = false;
+    }
+  }
+  ix.x0 = min_x;
+  ix.y0 = min_y;
+  ix.nx = std::max(1, static_cast<int>(std::floor((max_x - min_x) / cell)) + 1);
+  ix.ny = std::max(1, static_cast<int>(std::floor((max_y - min_y) / cell)) + 1);
+  const std::size_t cells = static_cast<std::size_t>(ix.nx) * static_cast<std::size_t>(ix.ny);
+  ix.start.assign(ix.blocks * cells + 1, 0);
+  // Two passes: count each (block, cell)'s footprints, then place them (ascending, as i grows).
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<std::uint32_t> fill;
+    if (pass == 1) {
+      for (std::size_t k = 1; k < ix.start.size(); ++k) ix.start[k] += ix.start[k - 1];
+      ix.cars.resize(ix.start.back());
+      fill.assign(ix.start.begin(), ix.start.end() - 1);
+    }
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const auto& boxes = blocks[i].boxes;
+      for (std::size_t e = 0; e < ix.blocks; ++e) {
+        const ClearanceBox& b = boxes[std::min(e, boxes.size() - 1)];
+        int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+        ix.cellRange(b, &x0, &y0, &x1, &y1);
+        for (int y = y0; y <= y1; ++y) {
+          for (int x = x0; x <= x1; ++x) {
+            const std::size_t k = (e * static_cast<std::size_t>(ix.ny) + static_cast<std::size_t>(y)) *
+                                      static_cast<std::size_t>(ix.nx) +
+                                  static_cast<std::size_t>(x);
+            if (pass == 0) {
+              ++ix.start[k + 1];
+            } else {
+              ix.cars[fill[k]++] = static_cast<std::uint32_t>(i);
+            }
+          }
+        }
+      }
+    }
+  }
+  return ix;
+}
+
+void ClearanceIndex::cellRange(const ClearanceBox& b, int* x0, int* y0, int* x1, int* y1) const {
+  auto at = [&](double v, double o, int n) {
+    return std::clamp(static_cast<int>(std::floor((v - o) / cell)), 0, n - 1);
+  };
+  *x0 = at(b.min_x, this->x0, nx);
+  *x1 = at(b.max_x, this->x0, nx);
+  *y0 = at(b.min_y, this->y0, ny);
+  *y1 = at(b.max_y, this->y0, ny);
+}
+
+std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& mission,
+                                           const std::vector<MovingFootprint>& traffic,
+                                           const ClearanceIndex& index, double duration,
+                                           double margin) {
+  bool fits = index.source && index.source->size() == traffic.size() && index.margin == margin &&
+              index.blocks > 0;
+  for (std::size_t i = 0; fits && i < traffic.size(); ++i) {
+    fits = traffic[i].blocks == &(*index.source)[i] &&
+           traffic[i].time_shift == traffic.front().time_shift;
+  }
+  if (!fits) return trafficToWithhold(mission, traffic, duration, margin);
+  std::vector<std::size_t> out;
+  if (mission.empty() || traffic.empty()) return out;
+  const std::size_t n = fineSamples(duration);
+  const double shift = traffic.front().time_shift;
+  const long last = static_cast<long>(index.blocks) - 1;
+  // near[i]: withheld; seen[i]: the query (mission car, block) that last looked at car i.
+  std::vector<char> near(traffic.size(), 0);
+  std::vector<std::size_t> seen(traffic.size(), 0);
+  std::size_t query = 0;
+  for (const auto& m : mission) {
+    const std::vector<Box> own = blockBoxes(m, n, margin);
+    for (std::size_t j = 0; j < own.size(); ++j) {
+      ++query;
+      long e0 = 0, e1 = 0;
+      episodeBlocks(j, n, shift, &e0, &e1);
+      int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+      index.cellRange(own[j], &x0, &y0, &x1, &y1);
+      // A car whose footprint meets the mission car's at a sample of block j has a box at one of
+      // the blocks e0 .. e1 that shares a point, and so a cell, with own[j]: every car the
+      // comparison would withhold is a candidate here; the same tests as there then decide.
+      for (long e = std::clamp(e0, 0L, last); e <= std::clamp(e1, 0L, last); ++e) {
+        for (int y = y0; y <= y1; ++y) {
+          for (int x = x0; x <= x1; ++x) {
+            const std::size_t k =
+                (static_cast<std::size_t>(e) * static_cast<std::size_t>(index.ny) +
+                 static_cast<std::size_t>(y)) * static_cast<std::size_t>(index.nx) +
+                static_cast<std::size_t>(x);
+            for (std::uint32_t c = index.start[k]; c < index.start[k + 1]; ++c) {
+              const std::size_t i = index.cars[c];
+              if (near[i] || seen[i] == query) continue;
+              seen[i] = query;
+              near[i] = unionOf(traffic[i].blocks->boxes, e0, e1).meets(own[j]) &&
+                        overlapInBlock(m, traffic[i], j, n, margin).has_value();
+            }
+          }
+        }
+      }
+    }
+  }
+  for (std::size_t i = 0; i < traffic.size(); ++i) {
+    if (near[i]) out.push_back(i);
   }
   return out;
 }

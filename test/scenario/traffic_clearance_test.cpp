@@ -135,11 +135,16 @@ TEST(TrafficClearance, GeneratedCityScenariosKeepTheirCarsApart) {
 // An episode's precomputed blocks (SharedTrafficEpisode::clearance) withhold exactly the cars
 // that walking each trajectory again withholds, at offsets on and off the blocks' 2 s grid:
 // "mission" cars are episode cars seen at other offsets (some pairs near each other, most not).
-// Control: blocks moved 1 km away withhold nothing, so the comparison did read them.
+// Control: blocks moved 1 km away withhold nothing, so the comparison did read them. The
+// episode's grid (SharedTrafficEpisode::clearance_index) and a grid of 6 m cells find the same
+// cars; a grid built from other blocks than the footprints' is not used.
 TEST(TrafficClearance, PrecomputedEpisodeBlocksWithholdTheSameCars) {
   const auto ep = cityTrafficEpisode(testing::shippedCityWorld(), 0);
   ASSERT_EQ(ep->clearance.size(), ep->trajectories.size());
   ASSERT_GT(ep->trajectories.size(), 20u);
+  // A grid of small cells: a box spans many, a car is looked at once per query.
+  const ClearanceIndex small_cells = clearanceIndex(ep->clearance, 6.0);
+  ASSERT_GT(small_cells.nx, 50);
   std::size_t withheld = 0;
   for (const double offset : {0.0, 1.4, 37.8, 200.0, 611.2}) {
     for (const double duration : {60.0, 300.0}) {
@@ -171,6 +176,14 @@ TEST(TrafficClearance, PrecomputedEpisodeBlocksWithholdTheSameCars) {
       const auto expected = trafficToWithhold(own, walked, duration);
       EXPECT_EQ(trafficToWithhold(own, cached, duration), expected);
       EXPECT_TRUE(trafficToWithhold(own, far, duration).empty());
+      // The episode's grid finds the same cars; a grid of the moved blocks none.
+      EXPECT_EQ(trafficToWithhold(own, cached, ep->clearance_index, duration), expected);
+      const ClearanceIndex far_index = clearanceIndex(moved);
+      EXPECT_TRUE(trafficToWithhold(own, far, far_index, duration).empty());
+      // The grid of other blocks than the footprints' is not used: the comparison decides.
+      EXPECT_EQ(trafficToWithhold(own, far, ep->clearance_index, duration), std::vector<std::size_t>{});
+      EXPECT_EQ(trafficToWithhold(own, cached, far_index, duration), expected);
+      EXPECT_EQ(trafficToWithhold(own, cached, small_cells, duration), expected);
       // A margin other than the blocks' walks the trajectories.
       EXPECT_EQ(trafficToWithhold(own, far, duration, 0.0),
                 trafficToWithhold(own, walked, duration, 0.0));

@@ -122,6 +122,8 @@ struct SharedTrafficEpisode {
   // Each car's footprint blocks (traffic_clearance.h) over the whole episode, for the scenarios
   // that withhold the cars that come near their own; empty for a scenario's own cars.
   std::vector<ClearanceBlocks> clearance;
+  // The grid of `clearance` (traffic_clearance.h): which cars are where in each block.
+  ClearanceIndex clearance_index;
 };
 std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
                                                                const IdmParams& idm = {});

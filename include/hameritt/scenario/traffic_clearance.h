@@ -6,6 +6,7 @@
 // kClearanceStep seconds over the scenario's duration.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -35,6 +36,31 @@ struct ClearanceBlocks {
   double margin = kTrafficClearance;
   std::vector<ClearanceBox> boxes;
 };
+
+// A grid over many footprints' blocks (a shared episode's cars): for each block e and each
+// `cell` x `cell` m square, the footprints whose box at e touches it (a footprint's last box
+// stands for every later block). A scenario then looks up, per block of its own cars, only the
+// ambient cars near them instead of comparing every ambient car's boxes.
+struct ClearanceIndex {
+  double margin = kTrafficClearance;
+  double cell = 64.0;
+  double x0 = 0.0, y0 = 0.0;  // the grid's corner
+  int nx = 0, ny = 0;
+  std::size_t blocks = 0;
+  // The footprints of block e and cell (ix, iy): cars[start[k]] .. cars[start[k + 1] - 1] with
+  // k = (e * ny + iy) * nx + ix, ascending.
+  std::vector<std::uint32_t> start;
+  std::vector<std::uint32_t> cars;
+  // The footprints' blocks the index was built from.
+  const std::vector<ClearanceBlocks>* source = nullptr;
+
+  // The cells (clamped to the grid) that box b touches.
+  void cellRange(const ClearanceBox& b, int* x0, int* y0, int* x1, int* y1) const;
+};
+
+// The grid of `blocks` (every one with at least one box and the same margin; the vector must
+// outlive the index).
+ClearanceIndex clearanceIndex(const std::vector<ClearanceBlocks>& blocks, double cell = 64.0);
 
 // A car's footprint moving along a trajectory: a length x width rectangle centred on the pose,
 // along its yaw. The scenario's t is the trajectory's t - time_shift (an episode car's
@@ -76,5 +102,13 @@ std::optional<double> firstOverlap(const MovingFootprint& a, const MovingFootpri
 std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& mission,
                                            const std::vector<MovingFootprint>& traffic,
                                            double duration, double margin = kTrafficClearance);
+// The same cars, looked up in `index` (built from traffic[i].blocks, in order, every traffic
+// footprint with the same time_shift): the same result as above, in a time that grows with the
+// mission cars' blocks and the cars near them rather than with the number of traffic cars. Falls
+// back to the comparison above when the index does not fit (another margin, other sizes).
+std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& mission,
+                                           const std::vector<MovingFootprint>& traffic,
+                                           const ClearanceIndex& index, double duration,
+                                           double margin = kTrafficClearance);
 
 }  // namespace hameritt::scenario
