@@ -907,8 +907,20 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
 
 // The pose of `tr` at t0 as a one-point trajectory at t = 0: the first point of
 // window(tr, t0, length), without copying the rest.
-Trajectory firstPose(const Trajectory& tr, double t0) {
-  TrajectoryPoint p = sampleTrajectory(tr, t0);
+Trajectory firstPose(const Trajectory& tr, double t0,
+                     const std::vector<std::uint32_t>* seconds = nullptr) {
+  TrajectoryPoint p;
+  const double k = std::floor(t0);
+  if (seconds && k >= 0 && k + 1 < static_cast<double>(seconds->size()) && tr.size() >= 2 &&
+      t0 > tr.front().t && t0 < tr.back().t) {
+    // sampleTrajectory's search, on the points between the first later than floor(t0) and the
+    // first later than floor(t0) + 1 (the one it finds lies there).
+    const auto ki = static_cast<std::size_t>(k);
+    p = sampleTrajectoryIn(tr, t0, std::max<std::size_t>(1, (*seconds)[ki]),
+                           std::min(tr.size(), static_cast<std::size_t>((*seconds)[ki + 1]) + 1));
+  } else {
+    p = sampleTrajectory(tr, t0);
+  }
   p.t = 0.0;
   p.x = roundMilli(p.x);
   p.y = roundMilli(p.y);
@@ -1117,6 +1129,23 @@ Trajectory decodeKnots(const TrafficEpisode& e, const TrafficEpisode::Car& car, 
   return out;
 }
 
+// The index of entity i's seconds, when there is one.
+const std::vector<std::uint32_t>* secondsOf(const std::vector<std::vector<std::uint32_t>>& all,
+                                            std::size_t i) {
+  return i < all.size() ? &all[i] : nullptr;
+}
+
+// Entry k: the index of tr's first point later than k seconds, k = 0 .. until.
+std::vector<std::uint32_t> secondsIndex(const Trajectory& tr, double until) {
+  std::vector<std::uint32_t> out;
+  std::size_t i = 0;
+  for (double k = 0; k <= until; k += 1.0) {
+    while (i < tr.size() && tr[i].t <= k) ++i;
+    out.push_back(static_cast<std::uint32_t>(i));
+  }
+  return out;
+}
+
 std::shared_ptr<SharedTrafficEpisode> decodedEpisode(TrafficEpisode e) {
   auto shared = std::make_shared<SharedTrafficEpisode>();
   shared->episode = std::move(e);
@@ -1274,6 +1303,13 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
       shared->clearance.push_back(clearanceBlocks(f));
     }
     if (!shared->clearance.empty()) shared->clearance_index = clearanceIndex(shared->clearance);
+    const double until = 0.5 * kTrafficEpisodeLength + 1.0;
+    for (const auto& tr : shared->trajectories) {
+      shared->car_seconds.push_back(secondsIndex(tr, until));
+    }
+    for (const auto& p : shared->episode.pedestrians) {
+      shared->pedestrian_seconds.push_back(secondsIndex(p.trajectory, until));
+    }
     slot->value = std::move(shared);
   });
   return slot->value;
@@ -1310,9 +1346,11 @@ CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double d
     out.offset = draw.offset;
     out.plan = shiftedSignalPlan(out.episode->episode.plan, out.offset);
     out.cars.reserve(out.episode->trajectories.size());
-    for (const auto& tr : out.episode->trajectories) {
-      out.cars.push_back(
-          {first_pose_only ? firstPose(tr, out.offset) : window(tr, out.offset, duration)});
+    const auto& ep = *out.episode;
+    for (std::size_t i = 0; i < ep.trajectories.size(); ++i) {
+      const Trajectory& tr = ep.trajectories[i];
+      out.cars.push_back({first_pose_only ? firstPose(tr, out.offset, secondsOf(ep.car_seconds, i))
+                                          : window(tr, out.offset, duration)});
     }
   } else {
     // Longer than an episode's offset range: the scenario's own cars and crowd.
@@ -1333,8 +1371,10 @@ CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double d
     p.height = from.height;
     p.pose = from.pose;
     if (from.trajectory.empty()) continue;
-    p.trajectory = first_only ? firstPose(from.trajectory, out.offset)
-                              : window(from.trajectory, out.offset, duration);
+    p.trajectory =
+        first_only
+            ? firstPose(from.trajectory, out.offset, secondsOf(out.episode->pedestrian_seconds, i))
+            : window(from.trajectory, out.offset, duration);
   }
   return out;
 }

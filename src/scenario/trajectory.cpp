@@ -14,8 +14,15 @@ TrajectoryPoint sampleTrajectory(const Trajectory& traj, double t) {
   if (traj.empty()) return {};
   if (t <= traj.front().t) return traj.front();
   if (t >= traj.back().t) return traj.back();
-  const auto it = std::upper_bound(traj.begin(), traj.end(), t,
-                                   [](double v, const TrajectoryPoint& p) { return v < p.t; });
+  return sampleTrajectoryIn(traj, t, 1, traj.size());
+}
+
+TrajectoryPoint sampleTrajectoryIn(const Trajectory& traj, double t, std::size_t lo,
+                                   std::size_t hi) {
+  const auto it =
+      std::upper_bound(traj.begin() + static_cast<std::ptrdiff_t>(lo),
+                       traj.begin() + static_cast<std::ptrdiff_t>(hi), t,
+                       [](double v, const TrajectoryPoint& p) { return v < p.t; });
   const TrajectoryPoint& b = *it;
   const TrajectoryPoint& a = *(it - 1);
   const double span = b.t - a.t;

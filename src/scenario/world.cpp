@@ -467,13 +467,15 @@ int World::find(const std::string& id) const {
 }
 
 int World::blockAt(const Vec2& p) const {
-  for (const auto& b : blocks_) {
-    if (b.outline.bounds().contains(p) && b.outline.contains(p)) return b.index;
+  for (std::size_t i = 0; i < blocks_.size(); ++i) {
+    if (block_bounds_[i].contains(p) && blocks_[i].outline.contains(p)) return blocks_[i].index;
   }
   return -1;
 }
 
 void World::finish() {
+  block_bounds_.clear();
+  for (const auto& b : blocks_) block_bounds_.push_back(b.outline.bounds());
   entity_occluders_.assign(entities_.size(), {});
   for (int i = 0; i < static_cast<int>(entities_.size()); ++i) {
     const auto& e = entities_[i];

@@ -124,6 +124,10 @@ struct SharedTrafficEpisode {
   std::vector<ClearanceBlocks> clearance;
   // The grid of `clearance` (traffic_clearance.h): which cars are where in each block.
   ClearanceIndex clearance_index;
+  // Per car (trajectories) and per pedestrian (episode.pedestrians): entry k is the index of the
+  // trajectory's first point later than k seconds, for k up to half the episode (where windows
+  // start), so that a window's first pose is found without searching the whole trajectory.
+  std::vector<std::vector<std::uint32_t>> car_seconds, pedestrian_seconds;
 };
 std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
                                                                const IdmParams& idm = {});

@@ -34,6 +34,10 @@ struct TrajectoryPoint {
 using Trajectory = std::vector<TrajectoryPoint>;
 // The pose of a trajectory at time t (clamped to its first and last samples).
 TrajectoryPoint sampleTrajectory(const Trajectory& traj, double t);
+// The same, for a caller that knows that the first point later than t is among points
+// [lo, hi) of the trajectory (front().t < t < back().t): searches only there.
+TrajectoryPoint sampleTrajectoryIn(const Trajectory& traj, double t, std::size_t lo,
+                                   std::size_t hi);
 
 // Soft spatial constraint: where the target is expected, optionally only within a window.
 struct AreaOfInterest {

@@ -192,6 +192,7 @@ class World {
   std::vector<StreetNode> nodes_;
   std::vector<StreetEdge> edges_;
   std::vector<Block> blocks_;
+  std::vector<geometry::Aabb2> block_bounds_;  // each block outline's bounds (finish())
   std::vector<ParkingSlot> slots_;
   std::vector<std::vector<int>> adjacency_;
   geometry::OccluderIndex occluders_{20.0};
