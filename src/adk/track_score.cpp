@@ -39,6 +39,7 @@ TrackScorer::TrackScorer(const scenario::MissionPhase& phase)
                                 scenario::formatNumber(c.max_reacquire_s));
   }
   lost_since_.resize(phase.targets.size());
+  tracked_frames_.assign(phase.targets.size(), 0);
 }
 
 void TrackScorer::start(double t) {
@@ -64,6 +65,16 @@ bool TrackScorer::addFrame(double t, const std::vector<TargetTruth>& targets) {
         !(g.occlusion >= 0.0 && g.occlusion <= 1.0)) {
       throw InputError("tracking frame at t = " + scenario::formatNumber(t) + ": target '" + g.id +
                        "': expected a finite box and fractions in [0, 1]");
+    }
+  }
+  for (std::size_t i = 0; i < phase_.targets.size(); ++i) {
+    const TargetTruth* last = nullptr;
+    for (const auto& g : targets) {
+      if (g.id == phase_.targets[i]) last = &g;
+    }
+    if (last && last->visible_fraction >= settings_.min_visible_fraction &&
+        last->box.area() >= settings_.min_box_area) {
+      ++tracked_frames_[i];
     }
   }
   recorder_.addFrame(t, targets);
@@ -92,7 +103,11 @@ bool TrackScorer::addReport(double stamp, const std::vector<ReportedTrack>& trac
   return true;
 }
 
-TrackPhaseScore TrackScorer::score(bool ended) const {
+TrackPhaseScore TrackScorer::score(bool ended) const { return judged(ended, true); }
+
+TrackPhaseScore TrackScorer::status() const { return judged(false, false); }
+
+TrackPhaseScore TrackScorer::judged(bool ended, bool full) const {
   TrackPhaseScore s;
   s.phase = phase_.id;
   s.targets = phase_.targets;
@@ -109,10 +124,19 @@ TrackPhaseScore TrackScorer::score(bool ended) const {
     return s;
   }
   s.elapsed = s.frames > 0 ? std::min(last_t_ - *start_, s.duration) : 0.0;
-  s.tracking = recorder_.score();
-  s.tracked_fraction = s.tracking.targets.empty() ? 0.0 : 1.0;
-  for (const auto& t : s.tracking.targets) {
-    s.tracked_fraction = std::min(s.tracked_fraction, t.tracked_fraction);
+  if (full) {
+    s.tracking = recorder_.score();
+    s.tracked_fraction = s.tracking.targets.empty() ? 0.0 : 1.0;
+    for (const auto& t : s.tracking.targets) {
+      s.tracked_fraction = std::min(s.tracked_fraction, t.tracked_fraction);
+    }
+  } else {
+    // The same fractions as the recorder's (tracked frames over all frames, per target).
+    s.tracked_fraction = 1.0;
+    for (const std::size_t n : tracked_frames_) {
+      s.tracked_fraction = std::min(
+          s.tracked_fraction, s.frames == 0 ? 0.0 : static_cast<double>(n) / s.frames);
+    }
   }
   for (const auto& l : lost_since_) {
     if (l) s.current_break_s = std::max(s.current_break_s, last_t_ - *l);

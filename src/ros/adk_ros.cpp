@@ -392,7 +392,7 @@ void AdkRos::onOdometry(const nav_msgs::Odometry::ConstPtr& msg) {
     publishConstraints(t);
     if (avoid_) publishAvoid(t, avoid_->score(monitor_->violationDuration()));
     if (follow_ && follow_->started()) publishFollow(t, followScore(false));
-    if (track_ && track_->started()) publishTrack(t, track_->score(false));
+    if (track_ && track_->started()) publishTrack(t, track_->status());
     next_status_t_ = t + status_period_;
   }
   judgeTrackAtLimit(t);

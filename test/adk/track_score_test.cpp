@@ -110,6 +110,49 @@ TEST(TrackScorer, EarlyEndNoFindAndTheLowestTargetDecide) {
   EXPECT_EQ(r.tracking.targets.size(), 2u);
 }
 
+// The live status (published at the ADK's status rate) keeps counters instead of re-scoring
+// every frame so far: at every frame of a two-target phase with losses, boxes under the minimum
+// area, reports and a failure, it equals score(false) in every field but the TrackEval scores it
+// leaves out.
+TEST(TrackScorer, LiveStatusEqualsTheFullScore) {
+  TrackScorer s(trackPhase(30.0, {"car_1", "car_2"}));
+  EXPECT_EQ(s.status().state, PhaseState::kPending);
+  s.start(2.0);
+  int frames = 0, differing_fractions = 0;
+  for (int k = 0; k <= 330; ++k) {
+    const double t = 2.0 + 0.1 * k;
+    std::vector<TargetTruth> in_view;
+    if (k % 7 != 3) in_view.push_back(k % 11 == 0 ? hidden("car_1") : seen("car_1"));
+    if (k > 40 && k % 5 != 0) {
+      TargetTruth small = seen("car_2");
+      small.box.w = k % 3 == 0 ? 10.0 : 40.0;  // 300 px: under the 400 px minimum
+      in_view.push_back(small);
+    }
+    s.addFrame(t, in_view);
+    if (k % 4 == 0) s.addReport(t, {{"car_1", PixelBox{100, 100, 40, 30}}});
+    const TrackPhaseScore full = s.score(false), live = s.status();
+    SCOPED_TRACE("frame " + std::to_string(k));
+    EXPECT_EQ(live.state, full.state);
+    EXPECT_EQ(live.failure, full.failure);
+    EXPECT_EQ(live.tracked_fraction, full.tracked_fraction);
+    EXPECT_EQ(live.current_break_s, full.current_break_s);
+    EXPECT_EQ(live.frames, full.frames);
+    EXPECT_EQ(live.reports, full.reports);
+    EXPECT_EQ(live.elapsed, full.elapsed);
+    EXPECT_EQ(live.errors.total(), full.errors.total());
+    EXPECT_EQ(live.start_time, full.start_time);
+    EXPECT_TRUE(live.tracking.targets.empty());
+    ASSERT_EQ(full.tracking.targets.size(), 2u);
+    if (full.tracking.targets[0].tracked_fraction != full.tracking.targets[1].tracked_fraction) {
+      ++differing_fractions;
+    }
+    ++frames;
+  }
+  EXPECT_GT(differing_fractions, 100);  // the minimum over the targets was exercised
+  EXPECT_EQ(s.status().state, PhaseState::kFailed);  // car_2 lost for the first 4 s, and more
+  EXPECT_GT(frames, 300);
+}
+
 TEST(TrackScorer, MalformedReportsAreCountedAndBadInputRejected) {
   TrackScorer s(trackPhase(20.0));
   EXPECT_FALSE(s.addReport(0.5, {{"car_1", PixelBox{100, 100, 40, 30}}}));  // before the find

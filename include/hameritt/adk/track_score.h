@@ -57,6 +57,10 @@ class TrackScorer {
 
   // The score so far. `ended`: the mission is over, so a phase not complete has failed.
   TrackPhaseScore score(bool ended) const;
+  // The live status while the phase runs: score(false) without `tracking` (the TrackEval
+  // scores, which walk every frame so far), from counters kept frame by frame; every other
+  // field is the same. The ADK publishes it at its status rate.
+  TrackPhaseScore status() const;
 
   const scenario::MissionPhase& phase() const { return phase_; }
 
@@ -68,6 +72,9 @@ class TrackScorer {
   double last_t_ = 0.0;
   std::vector<std::optional<double>> lost_since_;  // per target: the first untracked frame
   bool exceeded_ = false;
+  // Per target: the frames in which it was tracked (as the recorder counts them).
+  std::vector<std::size_t> tracked_frames_;
+  TrackPhaseScore judged(bool ended, bool full) const;
 };
 
 }  // namespace hameritt::adk
