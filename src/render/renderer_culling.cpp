@@ -114,6 +114,10 @@ void Renderer::Impl::setHidden(const std::vector<std::string>& ids) {
           static_cast<std::uint32_t>(instance_record[static_cast<std::size_t>(it->second)]);
       hidden[rec] = 1;
       hidden_list.push_back(rec);
+      for (const int part : part_records[static_cast<std::size_t>(it->second)]) {
+        hidden[static_cast<std::size_t>(part)] = 1;
+        hidden_list.push_back(static_cast<std::uint32_t>(part));
+      }
     }
   }
 }

@@ -290,6 +290,7 @@ struct Renderer::Impl {
   // Labels, boxes, camera effects.
   std::vector<std::uint8_t> interest;  // per instance id
   std::vector<int> instance_record;    // instance id -> record
+  std::vector<std::vector<int>> part_records;  // instance id -> the records of its parts
   std::vector<BoxAcc> box_acc;         // per instance id
   std::vector<int> touched;
   std::vector<std::uint32_t> label_scratch;

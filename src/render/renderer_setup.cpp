@@ -205,8 +205,10 @@ void Renderer::Impl::initGl() {
 
   interest.assign(scene.entityIds().size(), 0);
   instance_record.assign(scene.entityIds().size(), -1);
+  part_records.assign(scene.entityIds().size(), {});
   for (std::size_t i = 0; i < scene.instances().size(); ++i) {
     const SceneInstance& si = scene.instances()[i];
+    if (si.part_of > 0) part_records[static_cast<std::size_t>(si.part_of)].push_back(static_cast<int>(i));
     if (si.instance_id > 0) {
       instance_record[static_cast<std::size_t>(si.instance_id)] = static_cast<int>(i);
       interest[static_cast<std::size_t>(si.instance_id)] = si.interest ? 1 : 0;

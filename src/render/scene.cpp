@@ -131,6 +131,50 @@ std::string attributeError(const scenario::Entity& e, const std::string& key,
 
 }  // namespace
 
+std::vector<geometry::OrientedBox> rooftopEquipment(const scenario::Entity& e) {
+  std::vector<geometry::OrientedBox> out;
+  const double length = e.box.size.x(), width = e.box.size.y(), top = e.box.maxZ();
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : e.id) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  h ^= h >> 29;
+  h *= 0xBF58476D1CE4E5B9ULL;
+  h ^= h >> 32;
+  const double sx = (h & 1) ? 1.0 : -1.0, sy = (h & 2) ? 1.0 : -1.0;
+  const double u = static_cast<double>((h >> 8) & 255) / 255.0;
+  const double v = static_cast<double>((h >> 16) & 255) / 255.0;
+  const double c = std::cos(e.box.yaw), s = std::sin(e.box.yaw);
+  // A box of size (a, b, height) centred at (x, y) in the building's frame, on the roof.
+  auto place = [&](double x, double y, double a, double b, double height) {
+    geometry::OrientedBox box;
+    box.center = Eigen::Vector3d(e.box.center.x() + c * x - s * y, e.box.center.y() + s * x + c * y,
+                      top + 0.5 * height);
+    box.size = Eigen::Vector3d(a, b, height);
+    box.yaw = e.box.yaw;
+    out.push_back(box);
+  };
+  // The offset of a part of half size `half` along a roof side of half length `side`: between
+  // the centre's clearance (0.5 m) and the parapet's (0.8 m), at a fraction t of the room.
+  auto offset = [](double side, double half, double t) {
+    const double lo = half + 0.5, hi = side - half - 0.8;
+    return lo + t * (hi - lo);
+  };
+  if (length >= 8.0 && width >= 6.4) {
+    place(sx * offset(0.5 * length, 1.2, u), sy * offset(0.5 * width, 0.8, v), 2.4, 1.6, 1.3);
+  }
+  const std::int64_t storeys = e.attributes.integer("storeys", 0);
+  if (storeys >= 6 && ((h >> 24) & 1) != 0 && length >= 8.0 && width >= 8.0) {
+    place(-sx * offset(0.5 * length, 1.3, v), -sy * offset(0.5 * width, 1.3, u), 2.6, 2.6, 3.2);
+  }
+  if (e.box.size.z() >= 60.0 && length >= 14.0 && width >= 10.0) {
+    place(-sx * offset(0.5 * length, 1.8, 0.5), sy * offset(0.5 * width, 1.3, 0.5), 3.6, 2.6, 3.0);
+  }
+  return out;
+}
+
+
 bool paintColor(const std::string& name, std::uint32_t* srgb8) {
   struct Named {
     const char* name;
@@ -485,6 +529,42 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     add(aircraft_[k].entity, static_cast<int>(1 + n_world + n_config + k),
         static_cast<int>(n_config + k), true);
   }
+  // The city buildings' rooftop equipment: parts of their building (its label).
+  for (std::size_t i = 0; i < n_world; ++i) {
+    const scenario::Entity& e = world.entities()[i];
+    if (e.cls != EntityClass::kBuilding) continue;
+    const std::vector<geometry::OrientedBox> parts = rooftopEquipment(e);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      SceneInstance si;
+      // The unit in light grey metal, the tank in weathered wood, the bulkhead in the
+      // building's own colour.
+      if (k == 0) {
+        si.model = cityBox("rooftop_unit", MaterialKind::kPlain, srgbToLinear(168, 170, 172));
+      } else if (parts[k].size.z() > 3.1) {
+        si.model = cityBox("water_tank", MaterialKind::kPlain, srgbToLinear(120, 92, 66));
+      } else {
+        si.model = cityBox("roof_bulkhead", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+        if (!paintColor(e.attributes.str("color"), &si.record.color)) {
+          throw RenderError(attributeError(e, "color", "a colour name"));
+        }
+      }
+      si.part_of = static_cast<int>(1 + i);
+      si.semantic = scenario::semanticId(e.cls);
+      si.cls = e.cls;
+      si.convex = true;
+      si.box = parts[k];
+      boxRecordRows(parts[k], 0.0, si.record.row);
+      si.record.label = label(si.semantic, si.part_of);
+      const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
+      si.radius = (0.5f * (mesh.max - mesh.min)).cwiseProduct(parts[k].size.cast<float>()).norm();
+      const Eigen::Vector3f mc = 0.5f * (mesh.min + mesh.max);
+      for (int r = 0; r < 3; ++r) {
+        si.center[r] = si.record.row[r][0] * mc.x() + si.record.row[r][1] * mc.y() +
+                       si.record.row[r][2] * mc.z() + si.record.row[r][3];
+      }
+      instances_.push_back(si);
+    }
+  }
 }
 
 const scenario::ScenarioEntity& Scene::scenarioEntity(int j) const {
@@ -543,7 +623,8 @@ SceneTriangles Scene::triangles(double time, const LodView* lod) const {
         out.indices.push_back(static_cast<std::uint32_t>(out.vertices.size()));
         out.vertices.push_back(w);
       }
-      out.triangle_instance.insert(out.triangle_instance.end(), s.index_count / 3, si.instance_id);
+      out.triangle_instance.insert(out.triangle_instance.end(), s.index_count / 3,
+                                   si.part_of > 0 ? si.part_of : si.instance_id);
     }
   }
   return out;

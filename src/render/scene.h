@@ -28,7 +28,11 @@ struct InstanceRecord {
 // One drawn object.
 struct SceneInstance {
   int model = 0;        // index into Scene::models()
-  int instance_id = 0;  // label instance (0 for ground layers)
+  int instance_id = 0;  // label instance (0 for ground layers and for parts, below)
+  // A part of another instance (a building's rooftop equipment): that instance's label id. Its
+  // pixels carry that instance's label, so its box, mask and visible pixels include the part,
+  // and hiding the entity hides the part; 0 for an instance of its own.
+  int part_of = 0;
   int semantic = 0;
   int scenario_entity = -1;   // index into SimConfig::entities when it comes from the scenario
   bool mover = false;         // posed from its trajectory at the frame time
@@ -67,6 +71,16 @@ struct LodView {
   // The coarsest level of detail allowed for the instance (0: its full mesh).
   int level(const SceneInstance& si, const Eigen::Vector3f& center, float radius) const;
 };
+
+// Rooftop equipment of a city building, solid boxes standing on its roof (the scene draws them as
+// parts of the building: its label): an air-handling unit (2.4 x 1.6 x 1.3 m) on every roof of
+// at least 8 x 6.4 m, a water tank (2.6 x 2.6 x 3.2 m) on about half the buildings of 6 storeys
+// or more, a stair bulkhead (3.6 x 2.6 x 3 m) on every roof of a building 60 m or taller (at
+// least 14 x 10 m). Each stands in its own quarter of the roof, at least 0.5 m clear of the
+// roof's centre lines and 0.8 m inside the parapet, placed by a hash of the building's id (the
+// same in every scene; no seed stream is drawn from). The generator's occluders and the
+// planner's obstacles do not include them (docs/explanation/city.md).
+std::vector<geometry::OrientedBox> rooftopEquipment(const scenario::Entity& building);
 
 // Model indices of the procedural parts.
 struct SceneModels {

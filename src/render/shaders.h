@@ -42,7 +42,7 @@ uniform float u_wet;   // rain darkens surfaces
 // the face from its per-building spacing).
 flat out vec3 v_color;   // lit wall
 flat out vec3 v_glass;   // lit upper-floor glass (the roof: its membrane)
-flat out vec3 v_shop;    // lit storefront glass (the roof: its rooftop units)
+flat out vec3 v_shop;    // lit storefront glass
 flat out uint v_label;
 flat out vec4 v_frame;   // instance origin x, y, base z, storey height (-1: roof, 0: other)
 flat out vec4 v_layout;  // wall: face tangent x, y, window spacing, window width fraction;
@@ -116,10 +116,9 @@ void main() {
     // horizontal, to the viewer's right.
     v_layout = vec4(float(lit + 4u * arrow + 8u * right), i_row2.z, -n.y, n.x);
   } else if (roof) {
-    // The roof: membrane, a parapet cap in the wall colour, a rooftop unit and a water tank.
+    // The roof: membrane and a parapet cap in the wall colour.
     v_layout = vec4(vec2(i_row0.x, i_row1.x) / max(i_normal1.w, 1e-6), i_normal1.w, i_normal2.w);
     v_glass = (1.0 - cover) * keep * light * vec3(0.16, 0.16, 0.17) + snow;
-    v_shop = (1.0 - cover) * keep * light * vec3(0.45, 0.46, 0.48) + snow;
   }
 #elif defined(GROUND_LAYERS)
   v_base = (1.0 - cover) * keep * light * albedo;
@@ -270,18 +269,9 @@ void main() {
     vec2 q = vec2(dot(d, v_layout.xy), dot(d, vec2(-v_layout.y, v_layout.x)));
     vec2 room = 0.5 * v_layout.zw;
     vec2 e = room - abs(q);
-    c = v_glass;
-    if (min(e.x, e.y) < 0.35) {
-      c = v_color;
-    } else {
-      // One rooftop unit and, on some roofs, a water tank, at spots drawn from the label.
-      uint h = (v_label & 65535u) * 2246822519u;
-      vec2 span = max(room - vec2(2.5), vec2(0.0));
-      vec4 r = vec4(uvec4(h, h >> 8, h >> 16, h >> 24) & 255u) / 127.5 - 1.0;
-      vec2 o = abs(q - r.xy * span);
-      if (o.x < 1.3 && o.y < 0.9) c = (o.x > 1.1 || o.y > 0.7) ? 0.6 * v_shop : v_shop;
-      if ((h & 3u) != 0u && length(q - r.zw * span) < 1.4) c = v_shop * vec3(0.75, 0.55, 0.38);
-    }
+    // The membrane and a parapet cap in the wall colour; the rooftop equipment is solid
+    // geometry of its own (scene.cpp, rooftopEquipment).
+    c = min(e.x, e.y) < 0.35 ? v_color : v_glass;
   }
 #else
   vec3 c = v_color;

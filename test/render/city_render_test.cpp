@@ -4,7 +4,7 @@
 // street labels the street furniture classes. The city's classes get 2D boxes and occlusion
 // fractions: an entity drawn alone has the box of its projected geometry and no occlusion, and
 // in a street view a partly hidden one has 0 < occlusion < 1, its total the pixels it covers
-// drawn alone.
+// drawn alone. A building's rooftop equipment is solid and part of it.
 
 #include <gtest/gtest.h>
 
@@ -18,6 +18,7 @@
 
 #include "hameritt/generation/generator.h"
 #include "render_test_util.h"
+#include "scene.h"
 
 namespace hameritt::render {
 namespace {
@@ -87,6 +88,66 @@ TEST(CityRender, DownViewLabelsABuildingAndMeasuresItsRoof) {
   const FrameSet g = cityRenderer().render(r);
   EXPECT_NE(cityRenderer().instanceEntityId(g.instance[mid]), b.id);
   EXPECT_GT(g.depth[mid], 200.0 - h + 1.0);
+}
+
+// The rooftop equipment is solid: seen straight down, the pixels over a building's unit and tank
+// are nearer than its roof by their heights and carry the building's class and instance (they
+// are parts of it); hiding the building hides them too (the negative control: the same pixels
+// then see something lower than the roof); the ray-cast triangles of the building reach the
+// tank's top.
+TEST(CityRender, RooftopEquipmentIsSolidAndPartOfItsBuilding) {
+  const auto& w = cityWorld();
+  std::size_t index = 0;
+  std::vector<geometry::OrientedBox> parts;
+  for (; index < w.entities().size(); ++index) {
+    const auto& e = w.entities()[index];
+    if (e.cls != EntityClass::kBuilding || e.box.size.z() < 20.0) continue;
+    parts = rooftopEquipment(e);
+    if (parts.size() >= 2) break;
+  }
+  ASSERT_LT(index, w.entities().size()) << "no building with a unit and a tank";
+  const auto& b = w.entities()[index];
+  const double roof = b.box.maxZ();
+  int buildings_with_parts = 0;
+  for (const auto& e : w.entities()) {
+    if (e.cls == EntityClass::kBuilding && !rooftopEquipment(e).empty()) ++buildings_with_parts;
+  }
+  EXPECT_GT(buildings_with_parts, 100);
+  const Eigen::Vector3d c(b.box.center.x(), b.box.center.y(), 0.0);
+  const double eye = roof + 60.0;
+  RenderRequest r = request(c + Eigen::Vector3d(0, 0, eye), c + Eigen::Vector3d(0, 1e-3, 0));
+  const FrameSet f = cityRenderer().render(r);
+  std::vector<std::size_t> on_parts;
+  std::array<int, 2> tops{0, 0};  // pixels at the unit's top and at the tank's top
+  for (std::size_t i = 0; i < f.depth.size(); ++i) {
+    if (cityRenderer().instanceEntityId(f.instance[i]) != b.id) continue;
+    ASSERT_EQ(f.semantic[i], scenario::semanticId(EntityClass::kBuilding));
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (std::abs(f.depth[i] - (eye - parts[k].maxZ())) < 0.05) ++tops[k];
+    }
+    if (f.depth[i] < eye - roof - 0.5) on_parts.push_back(i);
+  }
+  EXPECT_GT(tops[0], 50) << "the unit's top";
+  EXPECT_GT(tops[1], 50) << "the tank's top";
+  EXPECT_NEAR(parts[0].maxZ() - roof, 1.3, 1e-9);
+  EXPECT_NEAR(parts[1].maxZ() - roof, 3.2, 1e-9);
+  r.hidden_entities = {b.id};
+  const FrameSet g = cityRenderer().render(r);
+  ASSERT_FALSE(on_parts.empty());
+  for (std::size_t i : on_parts) {
+    ASSERT_NE(cityRenderer().instanceEntityId(g.instance[i]), b.id);
+    ASSERT_GT(g.depth[i], eye - roof + 0.5) << "pixel " << i << " still sees a part";
+  }
+  const SceneTriangles t = cityRenderer().sceneTriangles(0.0);
+  float top = 0.0f;
+  for (std::size_t k = 0; k < t.triangle_instance.size(); ++k) {
+    if (t.triangle_instance[k] != static_cast<int>(1 + index)) continue;
+    for (int j = 0; j < 3; ++j) top = std::max(top, t.vertices[t.indices[3 * k + j]].z());
+  }
+  EXPECT_NEAR(top, parts[1].maxZ(), 1e-3);
+  std::printf("%s: roof %.2f m, %zu parts; %d and %d pixels on the unit's and the tank's tops; "
+              "%d buildings of the city have rooftop equipment\n",
+              b.id.c_str(), roof, parts.size(), tops[0], tops[1], buildings_with_parts);
 }
 
 TEST(CityRender, StreetViewLabelsTheCityClasses) {
