@@ -34,4 +34,31 @@ bool ClaimLedger::claim(const geometry::Vec3& p, double t) {
 
 std::size_t ClaimLedger::locations() const { return places_.size(); }
 
+StandingSightings::StandingSightings(double radius, double hold, double keep)
+    : radius_(radius), hold_(hold), keep_(keep) {
+  if (!(radius >= 0) || !std::isfinite(radius)) {
+    throw scenario::ConfigError("standing.radius: expected metres >= 0, got " +
+                                scenario::formatNumber(radius));
+  }
+  if (!(hold >= 0) || !std::isfinite(hold) || !(keep > hold) || !std::isfinite(keep)) {
+    throw scenario::ConfigError("standing: expected 0 <= hold < keep seconds, got hold " +
+                                scenario::formatNumber(hold) + ", keep " +
+                                scenario::formatNumber(keep));
+  }
+}
+
+bool StandingSightings::observe(const std::string& key, const geometry::Vec3& p, double t) {
+  std::vector<Sighting>& v = seen_[key];
+  std::size_t old = 0;
+  while (old < v.size() && t - v[old].t > keep_) ++old;
+  v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(old));
+  bool standing = false;
+  for (const auto& s : v) {
+    if (t - s.t < hold_) break;  // in time order: the rest are more recent
+    standing |= (s.p - p).head<2>().norm() <= radius_;
+  }
+  v.push_back({p, t});
+  return standing;
+}
+
 }  // namespace hameritt::clients

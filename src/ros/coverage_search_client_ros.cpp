@@ -53,6 +53,11 @@ constexpr double kParkedRadius = 1.5;
 constexpr double kGroupMargin = 4.0;
 // A sighting this close to the pursued vehicle's prediction is that vehicle.
 constexpr double kSameVehicle = 6.0;
+// A prediction this fast (m/s) is of a vehicle driving: a look-alike standing still is not it.
+constexpr double kDriving = 2.0;
+// A track phase's targets drive together ("the ... behind it"): while the pursuit holds one, a
+// look-alike of another target's description farther than this (m) from it is another vehicle.
+constexpr double kConvoyRadius = 80.0;
 // Detection claims come seconds apart: their gate.
 constexpr double kAssociationGate = 15.0;
 
@@ -443,15 +448,19 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     const scenario::TargetDescription& target = *targets.front();
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
     const bool parked = parkedAt(p);
+    const bool standing = standing_.observe(target.id, p, t);
     // A track phase's target not claimed yet, seen away from the pursued vehicle: kept in the
     // group view until the scored camera holds it too.
+    const double from_pursued =
+        tracking ? (predictor_->predict(t).position - p).head<2>().norm() : 0.0;
     if (pursuing_ && track_phase_ && track_camera_ && !parked && !track_claimed_.count(target.id) &&
-        (predictor_->predict(t).position - p).head<2>().norm() > kSameVehicle) {
+        from_pursued > kSameVehicle && from_pursued <= kConvoyRadius) {
       auto& seen = unclaimed_targets_[target.id];
       if (!seen) seen = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
       seen->observe(t, p, e.yaw);
     }
     for (const auto& h : parked ? std::vector<clients::VehicleState>{} : predicted) {
+      if (standing && h.speed > kDriving) continue;
       const double d = (p - h.position).head<2>().norm();
       if (d < nearest) {
         nearest = d;
@@ -483,9 +492,18 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       associated = std::make_pair(p, static_cast<double>(e.yaw));
     }
     if (defer_claims) {
-      // A track target is claimed once, when the tracking camera holds it.
+      // A track target is claimed once, when the tracking camera holds it: the pursued vehicle,
+      // or another vehicle of a description not claimed yet that is not standing (a track target
+      // drives; a parked look-alike, which the public map does not list, is not claimed) and,
+      // while the pursuit holds a vehicle, drives within kConvoyRadius of it.
       const std::string& id = v.target_id.empty() ? target.id : v.target_id;
-      if (msg->camera != track_claim_camera_ || parked || track_claimed_.count(id)) continue;
+      const bool held = tracking && !lost_;
+      const bool pursued = held && from_pursued <= kSameVehicle;
+      const bool apart = held && from_pursued > kConvoyRadius;
+      if (msg->camera != track_claim_camera_ || parked || (standing && !pursued) || apart ||
+          track_claimed_.count(id)) {
+        continue;
+      }
       track_claimed_.insert(id);
       // The phase starts once every target is claimed: reports from the next frame on.
       if (track_claimed_.size() >= mission_->objective.targets.size()) {

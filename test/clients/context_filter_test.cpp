@@ -226,6 +226,40 @@ TEST(ClaimLedger, OneClaimPerPlaceUntilTheHoldExpires) {
   EXPECT_THROW(ClaimLedger(-1.0, 1.0), scenario::ConfigError);
 }
 
+// A look-alike parked beside the road stands from 3 s after its first sighting on; a car of the
+// same description driving past it at 10 m/s, 5 m away, never does. The negative control: the
+// driving car stopping at a light stands once it has waited 3 s, and no longer once it drives on.
+TEST(StandingSightings, AParkedLookAlikeStandsADrivingCarDoesNot) {
+  StandingSightings s(1.0, 3.0, 60.0);
+  int parked_standing = 0, driving_standing = 0;
+  for (int k = 0; k <= 100; ++k) {  // 10 s at 10 Hz
+    const double t = 0.1 * k;
+    parked_standing += s.observe("suv", Vec3(50.0, 5.0, 0.0), t) ? 1 : 0;
+    driving_standing += s.observe("suv", Vec3(-40.0 + 10.0 * t, 0.0, 0.0), t) ? 1 : 0;
+  }
+  EXPECT_EQ(parked_standing, 71);  // every frame from t = 3 s on
+  EXPECT_EQ(driving_standing, 0);
+  // Another description is not compared with this one's sightings.
+  EXPECT_FALSE(s.observe("sedan", Vec3(50.0, 5.0, 0.0), 10.1));
+  // A car stopped at a light: standing once it has waited 3 s, no longer once it drives on.
+  StandingSightings light(1.0, 3.0, 60.0);
+  std::vector<bool> flags;
+  for (int k = 0; k <= 80; ++k) {
+    const double t = 0.1 * k;
+    const double x = t < 2.0 ? 10.0 * t : t < 6.0 ? 20.0 : 20.0 + 10.0 * (t - 6.0);
+    flags.push_back(light.observe("suv", Vec3(x, 0.0, 0.0), t));
+  }
+  EXPECT_FALSE(flags[45]);  // stopped 2.5 s
+  EXPECT_TRUE(flags[55]);   // stopped 3.5 s
+  EXPECT_FALSE(flags[75]);  // 15 m on
+  // Old sightings are forgotten after `keep`.
+  StandingSightings brief(1.0, 3.0, 5.0);
+  brief.observe("suv", Vec3(0, 0, 0), 0.0);
+  EXPECT_FALSE(brief.observe("suv", Vec3(0, 0, 0), 6.0));
+  EXPECT_THROW(StandingSightings(-1.0, 3.0, 60.0), scenario::ConfigError);
+  EXPECT_THROW(StandingSightings(1.0, 3.0, 2.0), scenario::ConfigError);
+}
+
 TEST(PublicSimConfig, HoldsTheMapAndTheUavButNoEntityOrGroundTruthPath) {
   const scenario::SimConfig pub = loadPublicSimConfig(kSimConfig);
   const scenario::SimConfig full = scenario::loadSimConfig(kSimConfig);

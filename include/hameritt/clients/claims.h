@@ -2,6 +2,8 @@
 // At most one claim per candidate location: a client tells the ADK "I see the target here" once,
 // not at every frame. ROS-free.
 
+#include <map>
+#include <string>
 #include <vector>
 
 #include "hameritt/geometry/types.h"
@@ -30,6 +32,29 @@ class ClaimLedger {
   double radius_, hold_;
   std::vector<Claim> claims_;
   std::vector<geometry::Vec3> places_;
+};
+
+// Where vehicles of each description stand: a sighting of a description is standing when a
+// sighting of the same description lay within `radius` metres of it (in the plane) at least
+// `hold` seconds earlier. A track or pursuit target drives, so a look-alike that stands (a parked
+// confuser, which the public map does not list) is not claimed as one while it stands; a target
+// waiting at a red light is claimed once it drives on. Sightings older than `keep` seconds are
+// forgotten.
+class StandingSightings {
+ public:
+  StandingSightings(double radius = 1.0, double hold = 3.0, double keep = 60.0);
+
+  // Records a sighting of description `key` at p, time t (not before the previous sighting's
+  // time); true when it stands.
+  bool observe(const std::string& key, const geometry::Vec3& p, double t);
+
+ private:
+  struct Sighting {
+    geometry::Vec3 p;
+    double t;
+  };
+  double radius_, hold_, keep_;
+  std::map<std::string, std::vector<Sighting>> seen_;
 };
 
 }  // namespace hameritt::clients

@@ -137,6 +137,7 @@ class CoverageSearchClientRos {
   double retry_at_ = 0.0;
   clients::ClaimLedger claims_;
   clients::ClaimLedger detections_;
+  clients::StandingSightings standing_;  // where look-alikes of each description stand
 
   // Pursuit.
   bool pursue_ = true, pursuing_ = false, planner_flying_ = false, lost_ = false;
