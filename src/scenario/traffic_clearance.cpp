@@ -321,8 +321,9 @@ ClearanceIndex clearanceIndex(const std::vector<ClearanceBlocks>& blocks, double
 }
 
 void ClearanceIndex::cellRange(const ClearanceBox& b, int* x0, int* y0, int* x1, int* y1) const {
+  // Clamped as a double first: a box far outside the grid maps to its edge cells.
   auto at = [&](double v, double o, int n) {
-    return std::clamp(static_cast<int>(std::floor((v - o) / cell)), 0, n - 1);
+    return static_cast<int>(std::clamp(std::floor((v - o) / cell), 0.0, n - 1.0));
   };
   *x0 = at(b.min_x, this->x0, nx);
   *x1 = at(b.max_x, this->x0, nx);
