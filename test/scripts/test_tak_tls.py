@@ -86,6 +86,7 @@ class Listener:
         self.close_at_once = close_at_once
         self.lock = threading.Lock()
         self.stop = False
+        self.accepted = self.finished = 0  # connections accepted, and handled to their end
         threading.Thread(target=self.serve, daemon=True).start()
 
     def serve(self):
@@ -97,7 +98,28 @@ class Listener:
                 continue
             except OSError:
                 return
-            threading.Thread(target=self.handle, args=(conn,), daemon=True).start()
+            with self.lock:
+                self.accepted += 1
+            threading.Thread(target=self.handle_counted, args=(conn,), daemon=True).start()
+
+    def handle_counted(self, conn):
+        try:
+            self.handle(conn)
+        finally:
+            with self.lock:
+                self.finished += 1
+
+    def settle(self, timeout=15.0):
+        """Waits until every connection accepted so far has been read to its end (the client
+        has exited: each ends at its close), so that what it sent is all stored; a fixed sleep
+        lost the last event on a loaded machine. Returns whether they all ended in time."""
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            with self.lock:
+                if self.finished == self.accepted:
+                    return True
+            time.sleep(0.02)
+        return False
 
     def handle(self, conn):
         conn.settimeout(5)
@@ -294,7 +316,7 @@ def refused(name, binary, pki, url, listener, args, reason, env=None, server_rea
           1 <= s["attempts"] - 1 <= s["tls_failures"] <= s["attempts"],
           "%s %s" % (s, p.stdout))
     if listener is not None:
-        time.sleep(0.2)
+        listener.settle()
         check(name + ": the server got no event", not listener.events and not listener.frames,
               listener.events[:1])
         if server_reason:
@@ -341,7 +363,7 @@ def main():
               s["tls_failures"] == 0 and s["send_errors"] == 0 and s["dropped"] == 0, p.stdout)
         check("xml: connect logged", "tak_check: connected to ssl://127.0.0.1:%d (TLSv1" % srv.port in p.stdout,
               p.stdout)
-        time.sleep(0.3)
+        check("xml: the server read every connection to its end", srv.settle())
         check_xml_events("xml", srv.events)
         # Negative control of the arrival check: one event less is reported.
         check("control: a lost event is reported",
@@ -356,7 +378,7 @@ def main():
         check("protobuf: summary", s is not None and s["sent"] == EVENTS and
               s["encoding"] == "TAK Protocol Version 1" and s["connects"] == 1 and
               s["dropped"] == 0 and s["send_errors"] == 0, p.stdout)
-        time.sleep(0.3)
+        check("protobuf: the server read every connection to its end", srv.settle())
         check("protobuf: negotiated", srv.negotiated and not srv.events and not srv.errors,
               (srv.negotiated, srv.events[:1], srv.errors))
         stream_frames = list(srv.frames)
