@@ -30,14 +30,34 @@ std::uint32_t packLinearHalf(const Eigen::Vector3f& c) {
   return packRgb8(q(c.x()), q(c.y()), q(c.z()));
 }
 
-// FNV-1a of a string in [0, 1): per-entity variation that does not depend on draw order.
-float hash01(const std::string& s) {
+// FNV-1a (64 bits) of a string: per-entity variation that does not depend on draw order.
+std::uint64_t fnv1a(const std::string& s) {
   std::uint64_t h = 1469598103934665603ULL;
   for (unsigned char c : s) {
     h ^= c;
     h *= 1099511628211ULL;
   }
-  return static_cast<float>((h >> 40) & 0xFFFFFF) / 16777216.0f;
+  return h;
+}
+
+// FNV-1a of a string in [0, 1).
+float hash01(const std::string& s) {
+  return static_cast<float>((fnv1a(s) >> 40) & 0xFFFFFF) / 16777216.0f;
+}
+
+// The centre of a model's bounds placed by an instance record's rows: the bounding sphere's.
+Eigen::Vector3f recordCenter(const InstanceRecord& rec, const Mesh& mesh) {
+  const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
+  Eigen::Vector3f out;
+  for (int r = 0; r < 3; ++r) {
+    out[r] = rec.row[r][0] * c.x() + rec.row[r][1] * c.y() + rec.row[r][2] * c.z() + rec.row[r][3];
+  }
+  return out;
+}
+
+// The radius of a normalized model's bounding sphere scaled to a box of `size`.
+float scaledRadius(const Mesh& mesh, const Eigen::Vector3d& size) {
+  return (0.5f * (mesh.max - mesh.min)).cwiseProduct(size.cast<float>()).norm();
 }
 
 // Layers of the flat ground, above the lawn at z = 0: sidewalks, then streets. Each street gets
@@ -131,14 +151,10 @@ std::string attributeError(const scenario::Entity& e, const std::string& key,
 
 }  // namespace
 
-std::vector<geometry::OrientedBox> rooftopEquipment(const scenario::Entity& e) {
-  std::vector<geometry::OrientedBox> out;
+std::vector<RooftopPart> rooftopEquipment(const scenario::Entity& e) {
+  std::vector<RooftopPart> out;
   const double length = e.box.size.x(), width = e.box.size.y(), top = e.box.maxZ();
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : e.id) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
+  std::uint64_t h = fnv1a(e.id);
   h ^= h >> 29;
   h *= 0xBF58476D1CE4E5B9ULL;
   h ^= h >> 32;
@@ -147,13 +163,14 @@ std::vector<geometry::OrientedBox> rooftopEquipment(const scenario::Entity& e) {
   const double v = static_cast<double>((h >> 16) & 255) / 255.0;
   const double c = std::cos(e.box.yaw), s = std::sin(e.box.yaw);
   // A box of size (a, b, height) centred at (x, y) in the building's frame, on the roof.
-  auto place = [&](double x, double y, double a, double b, double height) {
+  auto place = [&](RooftopPart::Kind kind, double x, double y, double a, double b,
+                   double height) {
     geometry::OrientedBox box;
     box.center = Eigen::Vector3d(e.box.center.x() + c * x - s * y, e.box.center.y() + s * x + c * y,
                       top + 0.5 * height);
     box.size = Eigen::Vector3d(a, b, height);
     box.yaw = e.box.yaw;
-    out.push_back(box);
+    out.push_back({kind, box});
   };
   // The offset of a part of half size `half` along a roof side of half length `side`: between
   // the centre's clearance (0.5 m) and the parapet's (0.8 m), at a fraction t of the room.
@@ -162,14 +179,14 @@ std::vector<geometry::OrientedBox> rooftopEquipment(const scenario::Entity& e) {
     return lo + t * (hi - lo);
   };
   if (length >= 8.0 && width >= 6.4) {
-    place(sx * offset(0.5 * length, 1.2, u), sy * offset(0.5 * width, 0.8, v), 2.4, 1.6, 1.3);
+    place(RooftopPart::Kind::kUnit, sx * offset(0.5 * length, 1.2, u), sy * offset(0.5 * width, 0.8, v), 2.4, 1.6, 1.3);
   }
   const std::int64_t storeys = e.attributes.integer("storeys", 0);
   if (storeys >= 6 && ((h >> 24) & 1) != 0 && length >= 8.0 && width >= 8.0) {
-    place(-sx * offset(0.5 * length, 1.3, v), -sy * offset(0.5 * width, 1.3, u), 2.6, 2.6, 3.2);
+    place(RooftopPart::Kind::kTank, -sx * offset(0.5 * length, 1.3, v), -sy * offset(0.5 * width, 1.3, u), 2.6, 2.6, 3.2);
   }
   if (e.box.size.z() >= 60.0 && length >= 14.0 && width >= 10.0) {
-    place(-sx * offset(0.5 * length, 1.8, 0.5), sy * offset(0.5 * width, 1.3, 0.5), 3.6, 2.6, 3.0);
+    place(RooftopPart::Kind::kBulkhead, -sx * offset(0.5 * length, 1.8, 0.5), sy * offset(0.5 * width, 1.3, 0.5), 3.6, 2.6, 3.0);
   }
   return out;
 }
@@ -502,18 +519,13 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
     boxRecordRows(e.box, lift, si.record.row);
     si.record.label = label(si.semantic, instance_id);
     const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
-    const Eigen::Vector3f half = 0.5f * (mesh.max - mesh.min);
-    si.radius = half.cwiseProduct(e.box.size.cast<float>()).norm();
+    si.radius = scaledRadius(mesh, e.box.size);
     const auto& levels = lods_[static_cast<std::size_t>(si.model)];
     si.lod_levels = static_cast<int>(levels.size());
     for (std::size_t l = 0; l < levels.size(); ++l) {
       si.lod_deviation[l] = levels[l].axis_error.cwiseProduct(e.box.size.cast<float>()).maxCoeff();
     }
-    const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
-    for (int r = 0; r < 3; ++r) {
-      si.center[r] = si.record.row[r][0] * c.x() + si.record.row[r][1] * c.y() +
-                     si.record.row[r][2] * c.z() + si.record.row[r][3];
-    }
+    si.center = recordCenter(si.record, mesh);
     entity_ids_[static_cast<std::size_t>(instance_id)] = e.id;
     instances_.push_back(si);
   };
@@ -533,14 +545,13 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
   for (std::size_t i = 0; i < n_world; ++i) {
     const scenario::Entity& e = world.entities()[i];
     if (e.cls != EntityClass::kBuilding) continue;
-    const std::vector<geometry::OrientedBox> parts = rooftopEquipment(e);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
+    for (const RooftopPart& part : rooftopEquipment(e)) {
       SceneInstance si;
       // The unit in light grey metal, the tank in weathered wood, the bulkhead in the
       // building's own colour.
-      if (k == 0) {
+      if (part.kind == RooftopPart::Kind::kUnit) {
         si.model = cityBox("rooftop_unit", MaterialKind::kPlain, srgbToLinear(168, 170, 172));
-      } else if (parts[k].size.z() > 3.1) {
+      } else if (part.kind == RooftopPart::Kind::kTank) {
         si.model = cityBox("water_tank", MaterialKind::kPlain, srgbToLinear(120, 92, 66));
       } else {
         si.model = cityBox("roof_bulkhead", MaterialKind::kPaint, Eigen::Vector3f(0.5f, 0.5f, 0.5f));
@@ -552,16 +563,12 @@ Scene::Scene(const scenario::World& world, const scenario::SimConfig& config,
       si.semantic = scenario::semanticId(e.cls);
       si.cls = e.cls;
       si.convex = true;
-      si.box = parts[k];
-      boxRecordRows(parts[k], 0.0, si.record.row);
+      si.box = part.box;
+      boxRecordRows(part.box, 0.0, si.record.row);
       si.record.label = label(si.semantic, si.part_of);
       const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
-      si.radius = (0.5f * (mesh.max - mesh.min)).cwiseProduct(parts[k].size.cast<float>()).norm();
-      const Eigen::Vector3f mc = 0.5f * (mesh.min + mesh.max);
-      for (int r = 0; r < 3; ++r) {
-        si.center[r] = si.record.row[r][0] * mc.x() + si.record.row[r][1] * mc.y() +
-                       si.record.row[r][2] * mc.z() + si.record.row[r][3];
-      }
+      si.radius = scaledRadius(mesh, part.box.size);
+      si.center = recordCenter(si.record, mesh);
       instances_.push_back(si);
     }
   }
@@ -583,12 +590,7 @@ void Scene::pose(std::size_t i, double time, InstanceRecord* record, Eigen::Vect
   const geometry::OrientedBox box =
       scenario::poseBox(se.entity.box, scenario::sampleTrajectory(se.trajectory, time));
   boxRecordRows(box, 0.0, record->row);
-  const Mesh& mesh = models_[static_cast<std::size_t>(si.model)];
-  const Eigen::Vector3f c = 0.5f * (mesh.min + mesh.max);
-  for (int r = 0; r < 3; ++r) {
-    (*center)[r] = record->row[r][0] * c.x() + record->row[r][1] * c.y() +
-                   record->row[r][2] * c.z() + record->row[r][3];
-  }
+  *center = recordCenter(*record, models_[static_cast<std::size_t>(si.model)]);
 }
 
 InstanceRecord Scene::uavRecord(const Eigen::Isometry3d& world_T_uav) const {

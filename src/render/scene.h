@@ -80,7 +80,11 @@ struct LodView {
 // roof's centre lines and 0.8 m inside the parapet, placed by a hash of the building's id (the
 // same in every scene; no seed stream is drawn from). The generator's occluders and the
 // planner's obstacles do not include them (docs/explanation/city.md).
-std::vector<geometry::OrientedBox> rooftopEquipment(const scenario::Entity& building);
+struct RooftopPart {
+  enum class Kind { kUnit, kTank, kBulkhead } kind;
+  geometry::OrientedBox box;
+};
+std::vector<RooftopPart> rooftopEquipment(const scenario::Entity& building);
 
 // Model indices of the procedural parts.
 struct SceneModels {

@@ -98,7 +98,7 @@ TEST(CityRender, DownViewLabelsABuildingAndMeasuresItsRoof) {
 TEST(CityRender, RooftopEquipmentIsSolidAndPartOfItsBuilding) {
   const auto& w = cityWorld();
   std::size_t index = 0;
-  std::vector<geometry::OrientedBox> parts;
+  std::vector<RooftopPart> parts;
   for (; index < w.entities().size(); ++index) {
     const auto& e = w.entities()[index];
     if (e.cls != EntityClass::kBuilding || e.box.size.z() < 20.0) continue;
@@ -123,14 +123,16 @@ TEST(CityRender, RooftopEquipmentIsSolidAndPartOfItsBuilding) {
     if (cityRenderer().instanceEntityId(f.instance[i]) != b.id) continue;
     ASSERT_EQ(f.semantic[i], scenario::semanticId(EntityClass::kBuilding));
     for (std::size_t k = 0; k < 2; ++k) {
-      if (std::abs(f.depth[i] - (eye - parts[k].maxZ())) < 0.05) ++tops[k];
+      if (std::abs(f.depth[i] - (eye - parts[k].box.maxZ())) < 0.05) ++tops[k];
     }
     if (f.depth[i] < eye - roof - 0.5) on_parts.push_back(i);
   }
   EXPECT_GT(tops[0], 50) << "the unit's top";
   EXPECT_GT(tops[1], 50) << "the tank's top";
-  EXPECT_NEAR(parts[0].maxZ() - roof, 1.3, 1e-9);
-  EXPECT_NEAR(parts[1].maxZ() - roof, 3.2, 1e-9);
+  EXPECT_EQ(parts[0].kind, RooftopPart::Kind::kUnit);
+  EXPECT_EQ(parts[1].kind, RooftopPart::Kind::kTank);
+  EXPECT_NEAR(parts[0].box.maxZ() - roof, 1.3, 1e-9);
+  EXPECT_NEAR(parts[1].box.maxZ() - roof, 3.2, 1e-9);
   r.hidden_entities = {b.id};
   const FrameSet g = cityRenderer().render(r);
   ASSERT_FALSE(on_parts.empty());
@@ -144,7 +146,7 @@ TEST(CityRender, RooftopEquipmentIsSolidAndPartOfItsBuilding) {
     if (t.triangle_instance[k] != static_cast<int>(1 + index)) continue;
     for (int j = 0; j < 3; ++j) top = std::max(top, t.vertices[t.indices[3 * k + j]].z());
   }
-  EXPECT_NEAR(top, parts[1].maxZ(), 1e-3);
+  EXPECT_NEAR(top, parts[1].box.maxZ(), 1e-3);
   std::printf("%s: roof %.2f m, %zu parts; %d and %d pixels on the unit's and the tank's tops; "
               "%d buildings of the city have rooftop equipment\n",
               b.id.c_str(), roof, parts.size(), tops[0], tops[1], buildings_with_parts);
