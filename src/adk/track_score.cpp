@@ -67,16 +67,6 @@ bool TrackScorer::addFrame(double t, const std::vector<TargetTruth>& targets) {
                        "': expected a finite box and fractions in [0, 1]");
     }
   }
-  for (std::size_t i = 0; i < phase_.targets.size(); ++i) {
-    const TargetTruth* last = nullptr;
-    for (const auto& g : targets) {
-      if (g.id == phase_.targets[i]) last = &g;
-    }
-    if (last && last->visible_fraction >= settings_.min_visible_fraction &&
-        last->box.area() >= settings_.min_box_area) {
-      ++tracked_frames_[i];
-    }
-  }
   recorder_.addFrame(t, targets);
   last_t_ = t;
   for (std::size_t i = 0; i < phase_.targets.size(); ++i) {
@@ -87,6 +77,7 @@ bool TrackScorer::addFrame(double t, const std::vector<TargetTruth>& targets) {
                  g.box.area() >= settings_.min_box_area;
     }
     if (tracked) {
+      ++tracked_frames_[i];
       lost_since_[i].reset();
     } else if (!lost_since_[i]) {
       lost_since_[i] = t;

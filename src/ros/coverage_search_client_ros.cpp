@@ -434,8 +434,10 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
   const bool defer_claims = track_phase_ && pursue_ && predictor_ && !track_claim_camera_.empty();
   std::vector<clients::VehicleState> predicted;
   double nearest = 0.0;
+  geometry::Vec3 pursued_at(0, 0, 0);  // where the pursued vehicle is predicted now
   if (tracking) {
     const double unseen = t - predictor_->last().t;
+    pursued_at = predictor_->predict(t).position;
     predicted = unseen > kBranchAfter ? predictor_->hypotheses(t)
                                       : std::vector<clients::VehicleState>{predictor_->predict(t)};
     nearest = associationGate(unseen);
@@ -451,8 +453,7 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     const bool standing = standing_.observe(target.id, p, t);
     // A track phase's target not claimed yet, seen away from the pursued vehicle: kept in the
     // group view until the scored camera holds it too.
-    const double from_pursued =
-        tracking ? (predictor_->predict(t).position - p).head<2>().norm() : 0.0;
+    const double from_pursued = tracking ? (pursued_at - p).head<2>().norm() : 0.0;
     if (pursuing_ && track_phase_ && track_camera_ && !parked && !track_claimed_.count(target.id) &&
         from_pursued > kSameVehicle && from_pursued <= kConvoyRadius) {
       auto& seen = unclaimed_targets_[target.id];

@@ -72,7 +72,8 @@ class TrackScorer {
   double last_t_ = 0.0;
   std::vector<std::optional<double>> lost_since_;  // per target: the first untracked frame
   bool exceeded_ = false;
-  // Per target: the frames in which it was tracked (as the recorder counts them).
+  // Per target: the frames in which it was tracked (as the recorder counts them: a frame lists
+  // each target once).
   std::vector<std::size_t> tracked_frames_;
   TrackPhaseScore judged(bool ended, bool full) const;
 };
