@@ -126,7 +126,31 @@ std::vector<ManifestEntry> generateBatch(const World& world, const GeneratorConf
     if (!fs::exists(path)) episodes_created.push_back(path);
     writeFileAtomic(path, *ref.text);
   };
+  // The city's traffic episodes that the batch's scenarios draw, simulated first by every job
+  // side by side: each is simulated once per process, and a scenario that draws one still being
+  // simulated waits for it, which left the other job idle at a batch's start. (A scenario longer
+  // than half an episode draws one and simulates its own cars instead.)
+  std::vector<int> episodes;
+  if (world.params().type == WorldType::kCity) {
+    std::vector<char> drawn(static_cast<std::size_t>(world.params().city.traffic_episodes), 0);
+    for (int i = 0; i < req.count; ++i) {
+      const std::uint64_t seed =
+          req.exact_seed ? req.seed : batchSeed(req.seed, static_cast<std::uint64_t>(req.first + i));
+      drawn.at(static_cast<std::size_t>(cityScenarioEpisode(world, seed))) = 1;
+    }
+    for (std::size_t k = 0; k < drawn.size(); ++k) {
+      if (drawn[k]) episodes.push_back(static_cast<int>(k));
+    }
+  }
+  std::atomic<std::size_t> next_episode{0};
   auto work = [&]() {
+    for (std::size_t k; (k = next_episode.fetch_add(1)) < episodes.size();) {
+      try {
+        cityTrafficEpisode(world, episodes[k]);
+      } catch (...) {
+        // Not simulated: the first scenario that draws it tries again and reports the error.
+      }
+    }
     for (;;) {
       const int i = next.fetch_add(1);
       if (i >= req.count || failed.load()) return;

@@ -41,6 +41,19 @@ std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index) {
   return deriveSeed(seed, 0x5343454E00000000ULL + index);
 }
 
+namespace {
+
+// The seed of a city scenario's traffic draw (drawCityTraffic).
+std::uint64_t cityTrafficSeed(std::uint64_t seed) {
+  return deriveSeed(seed, 0x4349545954524146ULL);
+}
+
+}  // namespace
+
+int cityScenarioEpisode(const World& world, std::uint64_t seed) {
+  return drawCityTrafficEpisode(world, cityTrafficSeed(seed));
+}
+
 // Draw order: every random draw is its own statement. C++ leaves the order in which a call's
 // arguments (or an expression's operands) are evaluated to the compiler, so two draws in one call
 // give g++ and clang different scenarios from one seed. Where draws once shared a call they are
@@ -2030,7 +2043,7 @@ class ScenarioBuilder {
     return std::move(r.trajectory);
   }
 
-  std::uint64_t citySeed() const { return deriveSeed(seed_, 0x4349545954524146ULL); }
+  std::uint64_t citySeed() const { return cityTrafficSeed(seed_); }
 
   // A mission vehicle's trajectory (car length `length`), in the city retimed to wait at the stop
   // lines of the signal plan that the scenario's traffic carries (drawn before the traffic is
@@ -2050,7 +2063,7 @@ class ScenarioBuilder {
   // (SimConfig::traffic) and a reader appends them again, pedestrians first.
   void addCityTraffic() {
     CityTraffic traffic =
-        simulateCityTraffic(world_, citySeed(), sc_.mission.time_limit, {}, traffic_by_reference_);
+        simulateCityTraffic(world_, citySeed(), sc_.mission.time_limit, {}, !traffic_by_reference_);
     if (city_signals_ && !sameSignalPlan(*city_signals_, traffic.plan)) {
       // The mission's vehicles were retimed for a plan drawn with a time limit on the other side
       // of half an episode's length.
@@ -2058,13 +2071,21 @@ class ScenarioBuilder {
           "the city's signal plan changed after the mission's vehicles obeyed it");
     }
     TrafficEpisodeRef ref;
-    for (auto& ped : traffic.pedestrians) {
-      ScenarioEntity se = cityPedestrianEntity(ped, std::move(ped.trajectory), nextPedId());
-      se.entity.block = world_.blockAt(se.entity.box.center2());
-      ref.pedestrian_ids.push_back(se.entity.id);
-      add(std::move(se.entity), "pedestrian", std::move(se.trajectory));
-    }
     const TrafficEpisode& ep = traffic.episode->episode;
+    // Written by reference, the episode's cars and walking pedestrians are only named (nothing
+    // of the scene reads them); those who stand are occluders and members of their block.
+    const bool lean = traffic_by_reference_ && traffic.episode->text;
+    if (lean) ref.lean = 0;
+    for (std::size_t i = 0; i < traffic.pedestrians.size(); ++i) {
+      CityPedestrian& ped = traffic.pedestrians[i];
+      ref.pedestrian_ids.push_back(nextPedId());
+      if (lean && !ep.pedestrians[i].trajectory.empty()) continue;
+      ScenarioEntity se =
+          cityPedestrianEntity(ped, std::move(ped.trajectory), ref.pedestrian_ids.back());
+      se.entity.block = world_.blockAt(se.entity.box.center2());
+      add(std::move(se.entity), "pedestrian", std::move(se.trajectory));
+      if (lean) ++*ref.lean;
+    }
     // The episode's cars never see the mission's own: those that would come near one are
     // withheld from this scenario (each still takes its id, so that the others keep theirs).
     std::vector<MovingFootprint> own, ambient;
@@ -2090,6 +2111,7 @@ class ScenarioBuilder {
         ++h;
         continue;
       }
+      if (lean) continue;
       ScenarioEntity se = episodeCarEntity(ep, i, std::move(traffic.cars[i].trajectory), id);
       se.entity.block = world_.blockAt(se.entity.box.center2());
       sc_.sim.entities.push_back(std::move(se));

@@ -95,6 +95,7 @@ bool targetSlotAllowed(const World& world, int slot, ScenarioClass cls) {
     case ScenarioClass::kTrack:
       return !s.driveway && pursuitSlotFits(world, s);
     case ScenarioClass::kRouteSearch:
+    case ScenarioClass::kAvoid:
       return false;
   }
   return false;

@@ -905,29 +905,6 @@ Trajectory window(const Trajectory& tr, double t0, double length) {
   return out;
 }
 
-// The pose of `tr` at t0 as a one-point trajectory at t = 0: the first point of
-// window(tr, t0, length), without copying the rest.
-Trajectory firstPose(const Trajectory& tr, double t0,
-                     const std::vector<std::uint32_t>* seconds = nullptr) {
-  TrajectoryPoint p;
-  const double k = std::floor(t0);
-  if (seconds && k >= 0 && k + 1 < static_cast<double>(seconds->size()) && tr.size() >= 2 &&
-      t0 > tr.front().t && t0 < tr.back().t) {
-    // sampleTrajectory's search, on the points between the first later than floor(t0) and the
-    // first later than floor(t0) + 1 (the one it finds lies there).
-    const auto ki = static_cast<std::size_t>(k);
-    p = sampleTrajectoryIn(tr, t0, std::max<std::size_t>(1, (*seconds)[ki]),
-                           std::min(tr.size(), static_cast<std::size_t>((*seconds)[ki + 1]) + 1));
-  } else {
-    p = sampleTrajectory(tr, t0);
-  }
-  p.t = 0.0;
-  p.x = roundMilli(p.x);
-  p.y = roundMilli(p.y);
-  p.yaw = roundMilli(p.yaw);
-  return {p};
-}
-
 // Holds the last pose of `tr` until `horizon` (a pedestrian pausing at the end).
 void holdUntil(Trajectory* tr, double horizon) {
   if (tr->empty() || tr->back().t >= horizon) return;
@@ -1129,21 +1106,50 @@ Trajectory decodeKnots(const TrafficEpisode& e, const TrafficEpisode::Car& car, 
   return out;
 }
 
-// The index of entity i's seconds, when there is one.
-const std::vector<std::uint32_t>* secondsOf(const std::vector<std::vector<std::uint32_t>>& all,
-                                            std::size_t i) {
-  return i < all.size() ? &all[i] : nullptr;
-}
-
-// Entry k: the index of tr's first point later than k seconds, k = 0 .. until.
-std::vector<std::uint32_t> secondsIndex(const Trajectory& tr, double until) {
-  std::vector<std::uint32_t> out;
-  std::size_t i = 0;
-  for (double k = 0; k <= until; k += 1.0) {
-    while (i < tr.size() && tr[i].t <= k) ++i;
-    out.push_back(static_cast<std::uint32_t>(i));
+// The episode as its file reads back (trafficEpisodeJson, parseTrafficEpisode): every number
+// is written in its shortest round-trip form, so only what the file does not carry changes:
+// -0 is written as 0 (atan2 of a lane's direction tells them apart), and a pedestrian's pose
+// and keyframes carry no z (nor the pose a time). gtest
+// CityTrafficEpisode.TheEpisodeInMemoryIsTheOneItsFileReadsBack.
+void asItsFileReadsBack(TrafficEpisode* e) {
+  auto fix = [](double& d) {
+    if (d == 0.0) d = 0.0;
+  };
+  fix(e->length);
+  for (double* d : {&e->plan.left, &e->plan.green, &e->plan.yellow, &e->plan.all_red,
+                    &e->plan.sidewalk}) {
+    fix(*d);
   }
-  return out;
+  for (auto& i : e->plan.intersections) {
+    for (double* d : {&i.position.x(), &i.position.y(), &i.offset, &i.heading[0], &i.heading[1],
+                      &i.width[0], &i.width[1]}) {
+      fix(*d);
+    }
+  }
+  for (auto& l : e->lanes) {
+    for (auto& p : l.points) {
+      fix(p.x());
+      fix(p.y());
+    }
+  }
+  for (auto& c : e->cars) {
+    for (double& k : c.knots) fix(k);
+    for (int k = 0; k < 3; ++k) fix(c.size[k]);
+  }
+  for (auto& p : e->pedestrians) {
+    fix(p.height);
+    p.pose = {0.0, p.pose.x, p.pose.y, 0.0, p.pose.yaw};
+    for (auto& q : p.trajectory) q.z = 0.0;
+    fix(p.pose.x);
+    fix(p.pose.y);
+    fix(p.pose.yaw);
+    for (auto& q : p.trajectory) {
+      fix(q.t);
+      fix(q.x);
+      fix(q.y);
+      fix(q.yaw);
+    }
+  }
 }
 
 std::shared_ptr<SharedTrafficEpisode> decodedEpisode(TrafficEpisode e) {
@@ -1290,8 +1296,10 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
     e.pedestrians = runPedestrians(world, e.plan, seed, kTrafficEpisodeLength);
     e.index = index;
     auto text = std::make_shared<const std::string>(trafficEpisodeJson(e));
-    // Read back from its bytes: a reader of the file decodes exactly these trajectories.
-    auto shared = decodedEpisode(parseTrafficEpisode(*text, trafficEpisodeFileName(index)));
+    // Not parsed back from its bytes (that cost a third of an episode): made what a reader of
+    // the file gets, so that it decodes exactly these trajectories.
+    asItsFileReadsBack(&e);
+    auto shared = decodedEpisode(std::move(e));
     shared->sha256 = sha256Hex(*text);
     shared->text = std::move(text);
     shared->clearance.reserve(shared->trajectories.size());
@@ -1303,16 +1311,23 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
       shared->clearance.push_back(clearanceBlocks(f));
     }
     if (!shared->clearance.empty()) shared->clearance_index = clearanceIndex(shared->clearance);
-    const double until = 0.5 * kTrafficEpisodeLength + 1.0;
-    for (const auto& tr : shared->trajectories) {
-      shared->car_seconds.push_back(secondsIndex(tr, until));
-    }
-    for (const auto& p : shared->episode.pedestrians) {
-      shared->pedestrian_seconds.push_back(secondsIndex(p.trajectory, until));
-    }
     slot->value = std::move(shared);
   });
   return slot->value;
+}
+
+namespace {
+
+// The first draw of a scenario's traffic: its episode.
+int episodeDraw(Rng& rng, const CityParams& cp) {
+  return static_cast<int>(rng.uniformInt(0, static_cast<long>(cp.traffic_episodes) - 1));
+}
+
+}  // namespace
+
+int drawCityTrafficEpisode(const World& world, std::uint64_t seed) {
+  Rng rng(deriveSeed(seed, 0x5045444553ULL));
+  return episodeDraw(rng, world.params().city);
 }
 
 CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double duration,
@@ -1327,7 +1342,7 @@ CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double d
     // A window of one of the world's episodes, starting at a time drawn for this scenario (in
     // the first half of the episode, whatever the duration); the signal offsets move with it.
     Rng rng(deriveSeed(seed, 0x5045444553ULL));
-    d.episode = static_cast<int>(rng.uniformInt(0, static_cast<long>(cp.traffic_episodes) - 1));
+    d.episode = episodeDraw(rng, cp);
     d.offset =
         roundMilli(idm.step * std::floor(rng.uniform(0.0, 0.5 * kTrafficEpisodeLength) / idm.step));
     d.plan = shiftedSignalPlan(citySignalPlan(world, episodeSeed(world, d.episode)), d.offset);
@@ -1338,19 +1353,17 @@ CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double d
 }
 
 CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
-                                const IdmParams& idm, bool first_pose_only) {
+                                const IdmParams& idm, bool trajectories) {
   const CityTrafficDraw draw = drawCityTraffic(world, seed, duration, idm);
   CityTraffic out;
   if (draw.episode >= 0) {
     out.episode = cityTrafficEpisode(world, draw.episode, idm);
     out.offset = draw.offset;
     out.plan = shiftedSignalPlan(out.episode->episode.plan, out.offset);
-    out.cars.reserve(out.episode->trajectories.size());
     const auto& ep = *out.episode;
-    for (std::size_t i = 0; i < ep.trajectories.size(); ++i) {
-      const Trajectory& tr = ep.trajectories[i];
-      out.cars.push_back({first_pose_only ? firstPose(tr, out.offset, secondsOf(ep.car_seconds, i))
-                                          : window(tr, out.offset, duration)});
+    out.cars.resize(ep.trajectories.size());
+    for (std::size_t i = 0; trajectories && i < ep.trajectories.size(); ++i) {
+      out.cars[i].trajectory = window(ep.trajectories[i], out.offset, duration);
     }
   } else {
     // Longer than an episode's offset range: the scenario's own cars and crowd.
@@ -1361,7 +1374,7 @@ CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double d
     for (const auto& tr : out.episode->trajectories) out.cars.push_back({tr});
   }
   const TrafficEpisode& e = out.episode->episode;
-  const bool first_only = first_pose_only && out.episode->text;
+  const bool windows = trajectories || !out.episode->text;
   out.pedestrians.resize(e.pedestrians.size());
   for (std::size_t i = 0; i < e.pedestrians.size(); ++i) {
     const CityPedestrian& from = e.pedestrians[i];
@@ -1370,11 +1383,9 @@ CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double d
     p.clothing_color = from.clothing_color;
     p.height = from.height;
     p.pose = from.pose;
-    if (from.trajectory.empty()) continue;
-    p.trajectory =
-        first_only
-            ? firstPose(from.trajectory, out.offset, secondsOf(out.episode->pedestrian_seconds, i))
-            : window(from.trajectory, out.offset, duration);
+    if (windows && !from.trajectory.empty()) {
+      p.trajectory = window(from.trajectory, out.offset, duration);
+    }
   }
   return out;
 }

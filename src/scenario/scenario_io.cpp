@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <stdexcept>
 
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/json_writer.h"
@@ -289,6 +290,10 @@ namespace {
 // sim_config.json into w (emptied first). traffic_by_reference: a city scenario's episode cars
 // and pedestrians are left out of "entities" and named by the "traffic" reference instead.
 void writeSimConfig(JsonWriter& w, const SimConfig& s, bool traffic_by_reference = false) {
+  if (s.traffic && s.traffic->lean && !traffic_by_reference) {
+    throw std::logic_error(s.scenario_id +
+                           ": a scenario generated to be written by reference written inline");
+  }
   // Room for the whole document up front (a trajectory point takes about 60 characters):
   // growing a 100 KB buffer by doubling would copy it several times.
   std::size_t points = s.uav.perception_path ? s.uav.perception_path->trajectory.size() : 0;

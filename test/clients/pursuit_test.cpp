@@ -176,7 +176,7 @@ TEST(Pursuit, ViewpointSeesTheVehiclePastOccluders) {
   PursuitSettings settings;
   const ViewpointChooser chooser(w, sim().uav, {}, settings);
   // Vehicles on every street: along each edge every 10 m, both directions.
-  int tested = 0, preferred_used = 0, occluded_preferred = 0;
+  int tested = 0, preferred_used = 0;
   for (const auto& e : w.edges()) {
     const Vec2 a = w.nodes()[static_cast<std::size_t>(e.a)].position;
     const Vec2 b = w.nodes()[static_cast<std::size_t>(e.b)].position;

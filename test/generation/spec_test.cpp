@@ -455,7 +455,9 @@ TEST(SpecRelated, ACarOrPedestrianIsPlacedBesideTheTargetAndChecked) {
       }
       if (!rel) continue;  // a world entity meets it
       ++placed;
-      if (k.role == "pedestrian") EXPECT_EQ(rel->entity.attributes.str("activity"), "standing");
+      if (k.role == "pedestrian") {
+        EXPECT_EQ(rel->entity.attributes.str("activity"), "standing");
+      }
       // Negative control: without the placed entity the requirement fails.
       const auto f = checkOf(s, sc, withoutEntity(sc.sim, rel->entity.id));
       ASSERT_FALSE(f.empty()) << k.text;

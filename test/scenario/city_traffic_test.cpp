@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -641,44 +642,138 @@ std::map<std::string, std::string> treeOf(const std::string& dir) {
   return out;
 }
 
-// A batch's scenario keeps only each episode car's and pedestrian's first pose (the episode's
-// per-second index finds it): the same point, bit for bit, as the first of the whole window, at
-// offsets on and off whole seconds.
-TEST(CityTrafficEpisode, FirstPosesAreTheWindowsFirstPoints) {
+// A batch's scenario (generated to be written by reference) builds none of the episode's cars
+// and walking pedestrians, only their ids: it writes the same files as the whole scenario, keeps
+// the pedestrians who stand (occluders, members of their block's group), and refuses to be
+// written inline.
+TEST(CityTrafficEpisode, ALeanScenarioWritesWhatTheWholeOneWrites) {
   const World& world = testing::shippedCityWorld();
-  int whole_seconds = 0, compared = 0;
-  // Under a sanitizer 6 seeds (sanitized.h).
-  const auto seeds = static_cast<std::uint64_t>(sanitizedCount(24, 6));
-  for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
-    const CityTraffic first = simulateCityTraffic(world, seed, 120.0, {}, true);
-    const CityTraffic whole = simulateCityTraffic(world, seed, 120.0, {}, false);
-    ASSERT_TRUE(first.episode && first.episode->text) << "seed " << seed;
-    if (first.offset == std::floor(first.offset)) ++whole_seconds;
-    ASSERT_EQ(first.cars.size(), whole.cars.size());
-    ASSERT_EQ(first.pedestrians.size(), whole.pedestrians.size());
-    auto same = [&](const Trajectory& a, const Trajectory& b, const std::string& what) {
-      ASSERT_EQ(a.size(), b.empty() ? 0u : 1u) << what;
-      if (a.empty()) return;
-      EXPECT_EQ(a[0].t, b[0].t) << what;
-      EXPECT_EQ(a[0].x, b[0].x) << what;
-      EXPECT_EQ(a[0].y, b[0].y) << what;
-      EXPECT_EQ(a[0].yaw, b[0].yaw) << what;
-      ++compared;
-    };
-    for (std::size_t i = 0; i < first.cars.size(); ++i) {
-      same(first.cars[i].trajectory, whole.cars[i].trajectory,
-           "seed " + std::to_string(seed) + " car " + std::to_string(i));
+  const std::vector<ScenarioClass> classes = {
+      ScenarioClass::kAreaSearch, ScenarioClass::kRouteSearch, ScenarioClass::kPursuit,
+      ScenarioClass::kAvoid,      ScenarioClass::kFollow,      ScenarioClass::kTrack};
+  std::size_t left_out = 0, standing = 0;
+  const int seeds = sanitizedCount(12, 6);
+  for (int k = 0; k < seeds; ++k) {
+    const ScenarioClass cls = classes[static_cast<std::size_t>(k) % classes.size()];
+    const std::uint64_t seed = batchSeed(11, static_cast<std::uint64_t>(k));
+    const Scenario lean = generateScenario(world, quickConfig(), cls, seed, nullptr, true);
+    const Scenario whole = generateScenario(world, quickConfig(), cls, seed, nullptr, false);
+    ASSERT_TRUE(lean.sim.traffic && lean.sim.traffic->lean) << seed;
+    ASSERT_TRUE(whole.sim.traffic && !whole.sim.traffic->lean) << seed;
+    EXPECT_EQ(missionJson(lean.mission), missionJson(whole.mission)) << seed;
+    EXPECT_EQ(simConfigJson(lean.sim, true), simConfigJson(whole.sim, true)) << seed;
+    // What the lean scenario keeps: the whole one's entities but the walking crowd and the cars.
+    std::vector<std::string> kept;
+    for (const auto& se : whole.sim.entities) {
+      const bool moving_traffic =
+          se.role == "traffic" || (se.role == "pedestrian" && !se.trajectory.empty());
+      if (!moving_traffic) kept.push_back(se.entity.id);
     }
-    for (std::size_t i = 0; i < first.pedestrians.size(); ++i) {
-      same(first.pedestrians[i].trajectory, whole.pedestrians[i].trajectory,
-           "seed " + std::to_string(seed) + " pedestrian " + std::to_string(i));
+    std::vector<std::string> ids;
+    for (const auto& se : lean.sim.entities) ids.push_back(se.entity.id);
+    EXPECT_EQ(ids, kept) << seed;
+    left_out += whole.sim.entities.size() - lean.sim.entities.size();
+    standing += *lean.sim.traffic->lean;
+    EXPECT_EQ(lean.sim.groups.size(), whole.sim.groups.size()) << seed;
+    std::string inline_error = "(no error)";
+    try {
+      simConfigJson(lean.sim);
+    } catch (const std::logic_error& e) {
+      inline_error = e.what();
+    }
+    EXPECT_NE(inline_error.find("written by reference written inline"), std::string::npos)
+        << inline_error;
+  }
+  EXPECT_GT(left_out, 400u * static_cast<std::size_t>(seeds));
+  EXPECT_GT(standing, 0u);
+  std::printf("entities not built: %zu over %d scenarios (standing pedestrians kept: %zu)\n",
+              left_out, seeds, standing);
+}
+
+// A batch's episode is not parsed back from its file: in memory it is what the file reads back
+// to, every number bit for bit (the sign of zero included), so that the scenarios it generates
+// are the ones a reader of the file gets.
+TEST(CityTrafficEpisode, TheEpisodeInMemoryIsTheOneItsFileReadsBack) {
+  const World& world = testing::shippedCityWorld();
+  std::size_t numbers = 0, differ = 0;
+  std::string first_difference;
+  auto same = [&](double a, double b, const std::string& what) {
+    ++numbers;
+    if (std::memcmp(&a, &b, sizeof(double)) == 0) return;
+    if (differ++ == 0) first_difference = what;
+  };
+  const int episodes = sanitizedCount(3, 1);
+  for (int index = 0; index < episodes; ++index) {
+    const auto shared = cityTrafficEpisode(world, index);
+    ASSERT_TRUE(shared && shared->text);
+    const TrafficEpisode& m = shared->episode;
+    const TrafficEpisode f = parseTrafficEpisode(*shared->text, trafficEpisodeFileName(index));
+    const std::string ep = "episode " + std::to_string(index) + " ";
+    EXPECT_EQ(m.index, f.index);
+    EXPECT_EQ(m.world_fingerprint, f.world_fingerprint);
+    same(m.length, f.length, ep + "length");
+    for (auto [a, b] : {std::pair{m.plan.left, f.plan.left}, {m.plan.green, f.plan.green},
+                        {m.plan.yellow, f.plan.yellow}, {m.plan.all_red, f.plan.all_red},
+                        {m.plan.sidewalk, f.plan.sidewalk}}) {
+      same(a, b, ep + "signal timing");
+    }
+    ASSERT_EQ(m.plan.intersections.size(), f.plan.intersections.size());
+    for (std::size_t i = 0; i < m.plan.intersections.size(); ++i) {
+      const auto &a = m.plan.intersections[i], &b = f.plan.intersections[i];
+      EXPECT_EQ(a.id, b.id);
+      const std::string w = ep + "intersection " + a.id;
+      same(a.position.x(), b.position.x(), w);
+      same(a.position.y(), b.position.y(), w);
+      same(a.offset, b.offset, w);
+      for (int k = 0; k < 2; ++k) {
+        same(a.heading[k], b.heading[k], w);
+        same(a.width[k], b.width[k], w);
+      }
+    }
+    ASSERT_EQ(m.lanes.size(), f.lanes.size());
+    for (std::size_t i = 0; i < m.lanes.size(); ++i) {
+      EXPECT_EQ(m.lanes[i].name, f.lanes[i].name);
+      ASSERT_EQ(m.lanes[i].points.size(), f.lanes[i].points.size());
+      for (std::size_t k = 0; k < m.lanes[i].points.size(); ++k) {
+        same(m.lanes[i].points[k].x(), f.lanes[i].points[k].x(), ep + "lane " + m.lanes[i].name);
+        same(m.lanes[i].points[k].y(), f.lanes[i].points[k].y(), ep + "lane " + m.lanes[i].name);
+      }
+    }
+    ASSERT_EQ(m.cars.size(), f.cars.size());
+    for (std::size_t i = 0; i < m.cars.size(); ++i) {
+      const auto &a = m.cars[i], &b = f.cars[i];
+      const std::string w = ep + "car " + std::to_string(i);
+      EXPECT_EQ(a.path, b.path) << w;
+      EXPECT_EQ(a.vehicle_class + a.make + a.model + a.color,
+                b.vehicle_class + b.make + b.model + b.color)
+          << w;
+      for (int k = 0; k < 3; ++k) same(a.size[k], b.size[k], w + " size");
+      ASSERT_EQ(a.knots.size(), b.knots.size()) << w;
+      for (std::size_t k = 0; k < a.knots.size(); ++k) same(a.knots[k], b.knots[k], w + " knots");
+    }
+    ASSERT_EQ(m.pedestrians.size(), f.pedestrians.size());
+    for (std::size_t i = 0; i < m.pedestrians.size(); ++i) {
+      const auto &a = m.pedestrians[i], &b = f.pedestrians[i];
+      const std::string w = ep + "pedestrian " + std::to_string(i);
+      EXPECT_EQ(a.activity + a.clothing_color, b.activity + b.clothing_color) << w;
+      same(a.height, b.height, w + " height");
+      ASSERT_EQ(a.trajectory.size(), b.trajectory.size()) << w;
+      std::vector<std::pair<const TrajectoryPoint*, const TrajectoryPoint*>> points = {
+          {&a.pose, &b.pose}};
+      for (std::size_t k = 0; k < a.trajectory.size(); ++k) {
+        points.emplace_back(&a.trajectory[k], &b.trajectory[k]);
+      }
+      for (const auto& [p, q] : points) {
+        for (auto [u, v] : {std::pair{p->t, q->t}, {p->x, q->x}, {p->y, q->y}, {p->z, q->z},
+                            {p->yaw, q->yaw}}) {
+          same(u, v, w + " pose or keyframe");
+        }
+      }
     }
   }
-  EXPECT_GT(compared, 250 * static_cast<int>(seeds));
-  // Offsets on whole seconds (the index's boundary) were among them (7 of the 24 seeds).
-  if (!kSanitized) EXPECT_GT(whole_seconds, 0);
-  std::printf("first poses compared: %d (offsets on whole seconds: %d of %d)\n", compared,
-              whole_seconds, static_cast<int>(seeds));
+  EXPECT_EQ(differ, 0u) << "first: " << first_difference;
+  EXPECT_GT(numbers, 100000u);
+  std::printf("numbers compared: %zu over %d episodes, %zu differ\n", numbers, episodes, differ);
 }
 
 TEST(CityTrafficEpisode, Sha256KnownAnswers) {

@@ -97,11 +97,17 @@ std::vector<geometry::Polygon> specKozPolygons(const World& world, const Scenari
 // Generates one scenario. Deterministic: the same world, config, class and seed (and plan) give
 // the same scenario. Throws GenerationError when no placement satisfies the constraints.
 // traffic_by_reference: the caller writes a city scenario's shared traffic episode as a
-// reference (simConfigJson(..., true)), so the episode's cars and pedestrians keep only their
-// pose at t = 0 in memory (simulateCityTraffic's first_pose_only); everything written is the same.
+// reference (simConfigJson(..., true)), so the episode's cars and walking pedestrians are not
+// built in memory, only named by the reference (TrafficEpisodeRef::lean); everything written is
+// the same, and the scenario cannot be written inline.
 Scenario generateScenario(const World& world, const GeneratorConfig& config, ScenarioClass cls,
                           std::uint64_t seed, const ScenarioPlan* plan = nullptr,
                           bool traffic_by_reference = false);
+
+// The traffic episode (scenario/city_traffic.h) that a city scenario of seed `seed` draws when
+// it lasts at most half an episode (a longer one simulates its own cars): a batch simulates the
+// episodes its scenarios draw first, side by side.
+int cityScenarioEpisode(const World& world, std::uint64_t seed);
 
 // Seed of the i-th scenario of a batch with base seed `seed`.
 std::uint64_t batchSeed(std::uint64_t seed, std::uint64_t index);

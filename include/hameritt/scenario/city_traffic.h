@@ -124,10 +124,6 @@ struct SharedTrafficEpisode {
   std::vector<ClearanceBlocks> clearance;
   // The grid of `clearance` (traffic_clearance.h): which cars are where in each block.
   ClearanceIndex clearance_index;
-  // Per car (trajectories) and per pedestrian (episode.pedestrians): entry k is the index of the
-  // trajectory's first point later than k seconds, for k up to half the episode (where windows
-  // start), so that a window's first pose is found without searching the whole trajectory.
-  std::vector<std::vector<std::uint32_t>> car_seconds, pedestrian_seconds;
 };
 std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& world, int index,
                                                                const IdmParams& idm = {});
@@ -143,6 +139,8 @@ struct CityTrafficDraw {
 };
 CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double duration,
                                 const IdmParams& idm = {});
+// The episode of drawCityTraffic(world, seed, d) for any d up to half an episode.
+int drawCityTrafficEpisode(const World& world, std::uint64_t seed);
 
 struct CityTraffic {
   SignalPlan plan;
@@ -160,12 +158,12 @@ SignalPlan citySignalPlan(const World& world, std::uint64_t seed);
 
 // The traffic and crowd of a city scenario of `duration` seconds (world.params().city holds the
 // densities and signal timing). Throws GenerationError when the world is not a city.
-// first_pose_only: when the traffic is a window of a shared episode, each car's and moving
-// pedestrian's trajectory is only its first point (its pose at t = 0), for a caller that writes
-// the episode reference instead of the trajectories (a batch); a scenario of its own cars is
-// returned whole.
+// trajectories false: when the traffic is a window of a shared episode, the cars and the
+// pedestrians come without trajectories (each pedestrian with its attributes and first pose),
+// for a caller that writes the episode reference instead of them (a batch); a scenario of its
+// own cars is returned whole.
 CityTraffic simulateCityTraffic(const World& world, std::uint64_t seed, double duration,
-                                const IdmParams& idm = {}, bool first_pose_only = false);
+                                const IdmParams& idm = {}, bool trajectories = true);
 
 // Upper bounds on the number of cars and pedestrians simulateCityTraffic() returns for `world`
 // (the generator sizes its id pools with them).

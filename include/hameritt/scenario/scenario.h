@@ -349,10 +349,14 @@ struct TrafficEpisodeRef {
   std::vector<std::string> pedestrian_ids;  // and of each of its pedestrians
   std::vector<std::string> withheld;        // car ids left out of the scenario, in car order
   std::shared_ptr<const std::string> text;  // the file's bytes (set by the generator)
+  // Set by generateScenario(..., traffic_by_reference): only the pedestrians who stand (in order)
+  // are in memory, as the last `lean` entities (the scene's groups and occluders count them);
+  // the others are only named here, so the scenario is written by reference only.
+  std::optional<std::size_t> lean;
 
   // How many of the last entities the reference stands for.
   std::size_t entityCount() const {
-    return pedestrian_ids.size() + car_ids.size() - withheld.size();
+    return lean ? *lean : pedestrian_ids.size() + car_ids.size() - withheld.size();
   }
 };
 
