@@ -68,16 +68,23 @@ void sortUnique(std::vector<int>* v) {
   v->erase(std::unique(v->begin(), v->end()), v->end());
 }
 
-// Candidate boxes for the 2D segment [a, b]: walks the grid column by column and, in each,
-// looks up only the cells spanned by the part of the segment inside that column (padded by a
-// rounding margin; boxes are padded by their own tolerance when filed). Falls back to every box
-// for a segment crossing too many cells or reaching past the clamped grid. The result is
-// written into *out_vec (emptied first), which callers keep per thread: its storage is reused.
-const std::vector<int>& segmentCandidates(const std::vector<Entry>& cells, double cell,
-                                          std::size_t boxes, const Vec2& a, const Vec2& b,
-                                          std::vector<int>* out_vec) {
-  std::vector<int>& out = *out_vec;
-  out.clear();
+// Per-thread marks of the boxes a segment query has met: a box filed under several cells is
+// visited once. A box's mark is the number of the last query that met it.
+struct Marks {
+  std::vector<std::uint32_t> mark;
+  std::uint32_t query = 0;
+};
+thread_local Marks t_marks;
+
+// Calls visit(i) once for each candidate box of the 2D segment [a, b] until one call returns
+// true, and returns whether one did. Walks the grid column by column and, in each, looks up only
+// the cells spanned by the part of the segment inside that column (padded by a rounding margin;
+// boxes are padded by their own tolerance when filed), visiting each box as it is found, so a
+// blocked segment stops at its first blocker. Every box, for a segment crossing too many cells or
+// reaching past the clamped grid.
+template <class Visit>
+bool anySegmentCandidate(const std::vector<Entry>& cells, double cell, std::size_t boxes,
+                         const Vec2& a, const Vec2& b, Visit visit) {
   const double m = kEpsilon * std::max({1.0, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
   const Vec2 lo = a.cwiseMin(b) - Vec2::Constant(m);
   const Vec2 hi = a.cwiseMax(b) + Vec2::Constant(m);
@@ -89,10 +96,26 @@ const std::vector<int>& segmentCandidates(const std::vector<Entry>& cells, doubl
   const std::int64_t visits =
       (static_cast<std::int64_t>(ix1) - ix0 + 1) + (static_cast<std::int64_t>(iy1) - iy0 + 1);
   if (clamped || visits > scanLimit(boxes)) {
-    collectAll(boxes, &out);
-    return out;
+    for (std::size_t i = 0; i < boxes; ++i) {
+      if (visit(static_cast<int>(i))) return true;
+    }
+    return false;
   }
-  collectGlobal(cells, &out);
+  Marks& marks = t_marks;
+  if (marks.mark.size() < boxes) marks.mark.resize(boxes, 0);
+  if (++marks.query == 0) {  // wrapped: forget every mark
+    std::fill(marks.mark.begin(), marks.mark.end(), 0);
+    marks.query = 1;
+  }
+  auto once = [&](int i) {
+    std::uint32_t& mk = marks.mark[static_cast<std::size_t>(i)];
+    if (mk == marks.query) return false;
+    mk = marks.query;
+    return visit(i);
+  };
+  for (auto it = cells.begin(); it != cells.end() && it->first == kGlobalKey; ++it) {
+    if (once(it->second)) return true;
+  }
   const Vec2 d = b - a;
   for (int ix = ix0; ix <= ix1; ++ix) {
     double ylo = lo.y();
@@ -109,15 +132,20 @@ const std::vector<int>& segmentCandidates(const std::vector<Entry>& cells, doubl
     }
     const int jy0 = std::max(iy0, cellIndex(ylo, cell));
     const int jy1 = std::min(iy1, cellIndex(yhi, cell));
-    if (jy0 <= jy1) collectColumn(cells, ix, jy0, jy1, &out);
+    if (jy0 > jy1) continue;
+    auto it = std::lower_bound(cells.begin(), cells.end(),
+                               Entry{packKey(ix, jy0), std::numeric_limits<int>::min()});
+    const std::int64_t last = packKey(ix, jy1);
+    for (; it != cells.end() && it->first <= last; ++it) {
+      if (once(it->second)) return true;
+    }
   }
-  sortUnique(&out);
-  return out;
+  return false;
 }
 
 // Candidate boxes filed under any cell that the (non-NaN) rectangle overlaps, ascending;
-// every box when that is more cells than boxes are worth. Written into *out_vec like
-// segmentCandidates().
+// every box when that is more cells than boxes are worth. The result is written into *out_vec
+// (emptied first), which callers keep per thread: its storage is reused.
 const std::vector<int>& areaCandidates(const std::vector<Entry>& cells, double cell,
                                        std::size_t boxes, const Aabb2& area,
                                        std::vector<int>* out_vec) {
@@ -210,12 +238,10 @@ void OccluderIndex::requireBuilt() const {
 bool OccluderIndex::clear(const Vec3& a, const Vec3& b, const std::vector<int>& ignore) const {
   requireBuilt();
   if (!a.allFinite() || !b.allFinite()) throw GeometryError("OccluderIndex::clear: non-finite");
-  for (int i :
-       segmentCandidates(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>(), &t_candidates)) {
+  return !anySegmentCandidate(cells_, cell_, boxes_.size(), a.head<2>(), b.head<2>(), [&](int i) {
     const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
-    if (!ignored(ignore, i) && boxes_[i].intersectsSegment(a, b, c, s)) return false;
-  }
-  return true;
+    return !ignored(ignore, i) && boxes_[i].intersectsSegment(a, b, c, s);
+  });
 }
 
 // The 2D segment meets a footprint exactly when, lifted to the box's mid-height, it meets the
@@ -223,15 +249,12 @@ bool OccluderIndex::clear(const Vec3& a, const Vec3& b, const std::vector<int>& 
 bool OccluderIndex::clear2(const Vec2& a, const Vec2& b, const std::vector<int>& ignore) const {
   requireBuilt();
   if (!a.allFinite() || !b.allFinite()) throw GeometryError("OccluderIndex::clear2: non-finite");
-  for (int i : segmentCandidates(cells_, cell_, boxes_.size(), a, b, &t_candidates)) {
-    if (ignored(ignore, i)) continue;
+  return !anySegmentCandidate(cells_, cell_, boxes_.size(), a, b, [&](int i) {
+    if (ignored(ignore, i)) return false;
     const double z = boxes_[i].center.z();
     const auto& [c, s] = trig_[static_cast<std::size_t>(i)];
-    if (boxes_[i].intersectsSegment(Vec3(a.x(), a.y(), z), Vec3(b.x(), b.y(), z), c, s)) {
-      return false;
-    }
-  }
-  return true;
+    return boxes_[i].intersectsSegment(Vec3(a.x(), a.y(), z), Vec3(b.x(), b.y(), z), c, s);
+  });
 }
 
 // Exact footprint distances over the boxes filed near the query square, which is padded by
