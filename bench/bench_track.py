@@ -10,7 +10,11 @@ the time flown, the tracked fraction (the lowest of the targets'), the breaks, t
 wall time, and the success count with the failures grouped by cause.
 
   /usr/bin/python3 bench/bench_track.py [--seeds 1-10] [--pursue true|false]
-      [--use-target-state true|false] [--out DIR] [--jobs 1]
+      [--use-target-state true|false] [--track-boxes perfect_perception|detector]
+      [--out DIR] [--jobs 1]
+
+--track-boxes detector: the reported boxes come from the colour/shape detector's blobs in the
+down camera's rendered frames instead of the perfect-perception report.
 
 --jobs runs that many missions at once, each on its own ROS master.
 """
@@ -57,7 +61,11 @@ def fly(scenario, seed, out, args, port):
               "start": t.get("start_time"), "elapsed": t.get("elapsed", 0),
               "duration": t.get("duration", 0), "tracked_fraction": t.get("tracked_fraction", 0),
               "targets": len(t.get("per_target", [])),
-              "breaks": sum(p["breaks"] for p in t.get("per_target", []))})
+              "breaks": sum(p["breaks"] for p in t.get("per_target", [])),
+              "precision": min((p.get("precision", 0) for p in t.get("per_target", [])),
+                               default=0),
+              "mota": t.get("clear_mot", {}).get("mota"),
+              "tp": t.get("clear_mot", {}).get("tp"), "fn": t.get("clear_mot", {}).get("fn")})
     return r
 
 
@@ -66,6 +74,8 @@ def main():
     ap.add_argument("--seeds", type=seed_list, default=seed_list("1-10"))
     ap.add_argument("--pursue", default="true", choices=["true", "false"])
     ap.add_argument("--use-target-state", default="true", choices=["true", "false"])
+    ap.add_argument("--track-boxes", default="perfect_perception",
+                    choices=["perfect_perception", "detector"])
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
@@ -75,15 +85,16 @@ def main():
         [d] = generate("track", 1, s, os.path.join(out, "seed_%02d" % s))
         jobs.append((d, s))
     args = ["found_by_sighting:=false", "pursue:=" + a.pursue,
-            "use_target_state:=" + a.use_target_state]
+            "use_target_state:=" + a.use_target_state, "track_boxes:=" + a.track_boxes]
 
     def report(r):
         start = r.get("start")
         print("seed %2d %-24s %-8s %d target(s), start %s, %5.1f of %3.0f s: tracked %5.1f %%, "
-              "%d breaks; %s; wall %.0f s"
+              "%d breaks, reported boxes: precision %.3f, CLEAR-MOT TP %s FN %s; %s; wall %.0f s"
               % (r["seed"], r["scenario"], r["outcome"], r.get("targets", 0),
                  "%.1f s" % start if start is not None else "none", r.get("elapsed", 0),
                  r.get("duration", 0), 100 * r.get("tracked_fraction", 0), r.get("breaks", 0),
+                 r.get("precision", 0), r.get("tp"), r.get("fn"),
                  r.get("failure") or "-", r["wall_s"]), flush=True)
 
     seed_of = dict(jobs)
@@ -96,6 +107,7 @@ def main():
         ", ".join("%s %d" % kv for kv in sorted(causes.items())) or "none"))
     with open(os.path.join(out, "summary.json"), "w") as f:
         json.dump({"seeds": a.seeds, "pursue": a.pursue, "use_target_state": a.use_target_state,
+                   "track_boxes": a.track_boxes,
                    "succeeded": ok, "failures": dict(causes), "runs": results}, f, indent=1)
     print("results in", out)
     return 0

@@ -140,6 +140,9 @@ void DetectorSettings::validate() const {
   need(size_tolerance > 0 && size_tolerance < 1, "size_tolerance", "a fraction in (0, 1)",
        fmt(size_tolerance));
   need(max_range > 0, "max_range", "metres > 0", fmt(max_range));
+  need(snow >= 0 && snow <= 1, "snow", "a cover in [0, 1]", fmt(snow));
+  need(snow_whitening >= 0 && std::isfinite(snow_whitening), "snow_whitening",
+       "a finite factor >= 0", fmt(snow_whitening));
 }
 
 DetectorSettings defaultDetectorSettings() {
@@ -174,10 +177,29 @@ cv::Mat ColorShapeDetector::colorMask(const cv::Mat& rgb, const std::string& col
   }
   cv::Mat hsv;
   cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV);
+  // The snow's white taken out for the chromatic ranges: each channel less k x the least one.
+  constexpr int kChromaticSaturation = 60;
+  const double k = std::min(0.9, settings_.snow_whitening * settings_.snow);
+  cv::Mat unsnowed;
+  const bool chromatic = std::any_of(it->second.begin(), it->second.end(), [](const HsvRange& r) {
+    return r.s_min >= kChromaticSaturation;
+  });
+  if (k > 0 && chromatic) {
+    std::vector<cv::Mat> ch;
+    cv::split(rgb, ch);
+    cv::Mat least;
+    cv::min(ch[0], ch[1], least);
+    cv::min(least, ch[2], least);
+    for (cv::Mat& c : ch) cv::addWeighted(c, 1.0, least, -k, 0.0, c);
+    cv::Mat rgb2;
+    cv::merge(ch, rgb2);
+    cv::cvtColor(rgb2, unsnowed, cv::COLOR_RGB2HSV);
+  }
   cv::Mat mask = cv::Mat::zeros(rgb.size(), CV_8U), part;
   for (const HsvRange& r : it->second) {
+    const cv::Mat& in = !unsnowed.empty() && r.s_min >= kChromaticSaturation ? unsnowed : hsv;
     auto add = [&](int h0, int h1) {
-      cv::inRange(hsv, cv::Scalar(h0, r.s_min, r.v_min), cv::Scalar(h1, r.s_max, r.v_max), part);
+      cv::inRange(in, cv::Scalar(h0, r.s_min, r.v_min), cv::Scalar(h1, r.s_max, r.v_max), part);
       mask |= part;
     };
     if (r.h_min <= r.h_max) {

@@ -91,7 +91,8 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
   pnh.param("size_tolerance", ds.size_tolerance, ds.size_tolerance);
   pnh.param("max_range", ds.max_range, ds.max_range);
   pnh.param("reject_border", ds.reject_border, ds.reject_border);
-  detector_ = std::make_unique<clients::ColorShapeDetector>(ds);  // validates
+  pnh.param("snow_whitening", ds.snow_whitening, ds.snow_whitening);
+  ds.validate();
   pnh.param("region_tolerance", context_settings_.region_tolerance,
             context_settings_.region_tolerance);
   pnh.param("distance_tolerance", context_settings_.distance_tolerance,
@@ -115,6 +116,9 @@ ColorShapeDetectorRos::ColorShapeDetectorRos(ros::NodeHandle& nh, ros::NodeHandl
   // The honesty rule: the public map and the UAV's own cameras, never the scenario's entities.
   sim_ = clients::loadPublicSimConfig(sim_path);
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
+  // The weather any pilot sees: snow whitens the roofs a down camera sees.
+  ds.snow = sim_.environment.snow;
+  detector_ = std::make_unique<clients::ColorShapeDetector>(ds);  // validates
 
   // Both payload cameras: the front camera (oblique) sees targets the down camera cannot reach
   // (under vantage-denial keep-out zones).

@@ -53,6 +53,11 @@ struct DetectorSettings {
   double size_tolerance = 0.3;  // relative, on length and width
   double max_range = 150.0;     // m, farther blobs are too coarse to measure
   bool reject_border = true;    // blobs touching the image border are cut: not measurable
+  // The scene's snow (sim_config environment.snow, public weather, [0, 1]) and how strongly the
+  // chromatic colours are tested after taking the snow's white out of each pixel (colorMask):
+  // snow cover whitens a car's roof, the surface a down camera sees.
+  double snow = 0.0;
+  double snow_whitening = 3.0;
   void validate() const;
 };
 
@@ -78,7 +83,10 @@ class ColorShapeDetector {
   explicit ColorShapeDetector(DetectorSettings settings = defaultDetectorSettings());
 
   // Pixels of `color` (CV_8U, 255 where set) in an RGB image (CV_8UC3, R first). Throws
-  // scenario::ConfigError for a colour without HSV ranges.
+  // scenario::ConfigError for a colour without HSV ranges. With snow, a chromatic range (one
+  // that asks for saturation of at least 60) is tested on the image less k times each pixel's
+  // least channel, k = min(0.9, snow_whitening * snow): snow cover blends white into a surface
+  // (more of every channel alike), which lowers its saturation but keeps its hue and chroma.
   cv::Mat colorMask(const cv::Mat& rgb, const std::string& color) const;
 
   // Blobs of `color` at car height in one frame. rgb: CV_8UC3 (R first); depth: CV_32FC1,
