@@ -1,5 +1,6 @@
 #include "hameritt/clients/claims.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "hameritt/scenario/error.h"
@@ -59,6 +60,27 @@ bool StandingSightings::observe(const std::string& key, const geometry::Vec3& p,
   }
   v.push_back({p, t});
   return standing;
+}
+
+ConvoySightings::ConvoySightings(double radius, double window)
+    : radius_(radius), window_(window) {
+  if (!(radius >= 0) || !std::isfinite(radius) || !(window > 0) || !std::isfinite(window)) {
+    throw scenario::ConfigError("convoy: expected radius >= 0 m and window > 0 s, got " +
+                                scenario::formatNumber(radius) + " m, " +
+                                scenario::formatNumber(window) + " s");
+  }
+}
+
+void ConvoySightings::observe(const std::string& key, const geometry::Vec3& p, double t) {
+  while (!seen_.empty() && seen_.front().t < t - window_) seen_.pop_front();
+  seen_.push_back({key, p.head<2>(), t});
+}
+
+bool ConvoySightings::besideAnother(const std::string& key, const geometry::Vec3& p,
+                                    double t) const {
+  return std::any_of(seen_.begin(), seen_.end(), [&](const Sighting& s) {
+    return s.key != key && s.t >= t - window_ && (s.p - p.head<2>()).norm() <= radius_;
+  });
 }
 
 }  // namespace hameritt::clients

@@ -58,12 +58,16 @@ constexpr double kDriving = 2.0;
 // A track phase's targets drive together ("the ... behind it"): while the pursuit holds one, a
 // look-alike of another target's description farther than this (m) from it is another vehicle.
 constexpr double kConvoyRadius = 80.0;
+// And one of a target's description is claimed only beside a sighting of another target's
+// description (within kConvoyRadius) of the last this many seconds.
+constexpr double kConvoyWindow = 20.0;
 // Detection claims come seconds apart: their gate.
 constexpr double kAssociationGate = 15.0;
 
 }  // namespace
 
-CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh)
+    : convoy_(kConvoyRadius, kConvoyWindow) {
   gate_ = std::make_unique<LockstepGate>(nh, pnh);
   std::string sim_path, camera = "down";
   if (!pnh.getParam("sim_config", sim_path)) {
@@ -232,6 +236,8 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   covered_.clear();
   track_claimed_.clear();
   state_target_.clear();
+  pursued_description_.clear();
+  convoy_.clear();
   other_targets_.clear();
   unclaimed_targets_.clear();
   reports_after_ = -1.0;
@@ -443,6 +449,8 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     nearest = associationGate(unseen);
   }
   std::optional<std::pair<geometry::Vec3, double>> associated;
+  std::string associated_description;
+  bool restarted = false;
   for (const auto& e : msg->entities) {
     // Class and attributes only: the entity's id and role are ground truth a client never uses.
     const auto targets = filter_->targetsMatching(toObservation(e));
@@ -451,6 +459,7 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     const geometry::Vec3 p(e.position.x, e.position.y, e.position.z);
     const bool parked = parkedAt(p);
     const bool standing = standing_.observe(target.id, p, t);
+    if (!parked) convoy_.observe(target.id, p, t);
     // A track phase's target not claimed yet, seen away from the pursued vehicle: kept in the
     // group view until the scored camera holds it too.
     const double from_pursued = tracking ? (pursued_at - p).head<2>().norm() : 0.0;
@@ -460,12 +469,18 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       if (!seen) seen = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
       seen->observe(t, p, e.yaw);
     }
-    for (const auto& h : parked ? std::vector<clients::VehicleState>{} : predicted) {
+    const bool pursued_look =
+        pursued_description_.empty() ||
+        std::any_of(targets.begin(), targets.end(),
+                    [&](const auto* d) { return d->id == pursued_description_; });
+    for (const auto& h : parked || !pursued_look ? std::vector<clients::VehicleState>{}
+                                                 : predicted) {
       if (standing && h.speed > kDriving) continue;
       const double d = (p - h.position).head<2>().norm();
       if (d < nearest) {
         nearest = d;
         associated = std::make_pair(p, static_cast<double>(e.yaw));
+        associated_description = target.id;
       }
     }
     if (pursuing_ && !defer_claims) continue;
@@ -491,6 +506,8 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
                          t - predictor_->last().t > kLostAfter;
     if (pursue_ && predictor_ && (!tracking || restart) && !associated) {
       associated = std::make_pair(p, static_cast<double>(e.yaw));
+      associated_description = target.id;
+      restarted = true;
     }
     if (defer_claims) {
       // A track target is claimed once, when the tracking camera holds it: the pursued vehicle,
@@ -501,8 +518,11 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       const bool held = tracking && !lost_;
       const bool pursued = held && from_pursued <= kSameVehicle;
       const bool apart = held && from_pursued > kConvoyRadius;
+      // With several targets (a convoy), one of another description sighted near it lately.
+      const bool in_convoy =
+          mission_->objective.targets.size() < 2 || convoy_.besideAnother(target.id, p, t);
       if (msg->camera != track_claim_camera_ || parked || (standing && !pursued) || apart ||
-          track_claimed_.count(id)) {
+          !in_convoy || track_claimed_.count(id)) {
         continue;
       }
       track_claimed_.insert(id);
@@ -519,6 +539,9 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
                    makeDetection(kClientName, target, p, confidence, msg->header.stamp));
     ROS_INFO("%s: claim: %s at (%.1f, %.1f), confidence %.2f (%s)", kClientName,
              clients::describe(target).c_str(), p.x(), p.y(), confidence, v.reason.c_str());
+  }
+  if (associated && (restarted || pursued_description_.empty())) {
+    pursued_description_ = associated_description;
   }
   // Once the ADK's target state feeds the predictor, the sightings no longer do.
   if (associated && state_target_.empty()) {

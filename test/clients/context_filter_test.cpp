@@ -260,6 +260,36 @@ TEST(StandingSightings, AParkedLookAlikeStandsADrivingCarDoesNot) {
   EXPECT_THROW(StandingSightings(1.0, 3.0, 2.0), scenario::ConfigError);
 }
 
+// A convoy (seed 2's track mission): a red sedan with a yellow pickup 12 m behind it, both
+// driving at 10 m/s, and a red sedan look-alike driving alone 190 m away. The sedan of the convoy
+// is beside a sighting of the pickup; the look-alike is not, nor the convoy's sedan once the
+// pickup was last seen more than the window ago, nor a sedan beside another sedan only.
+TEST(ConvoySightings, AConvoysCarIsBesideTheOtherTargetALookAlikeAloneIsNot) {
+  ConvoySightings c(80.0, 20.0);
+  int convoy = 0, alone = 0;
+  for (int k = 0; k <= 100; ++k) {  // 10 s at 10 Hz
+    const double t = 0.1 * k;
+    const Vec3 sedan(10.0 * t, 0.0, 0.0), pickup(10.0 * t - 12.0, 0.0, 0.0);
+    const Vec3 look_alike(-190.0, 10.0 * t, 0.0);
+    if (k % 3 == 0) c.observe("pickup", pickup, t);  // the front camera's sightings
+    convoy += c.besideAnother("sedan", sedan, t) ? 1 : 0;
+    alone += c.besideAnother("sedan", look_alike, t) ? 1 : 0;
+    c.observe("sedan", sedan, t);
+    c.observe("sedan", look_alike, t);
+  }
+  EXPECT_EQ(convoy, 101);
+  EXPECT_EQ(alone, 0);
+  // The pickup last sighted at 9.9 s: 20 s later it no longer vouches for the sedan.
+  EXPECT_TRUE(c.besideAnother("sedan", Vec3(100.0, 0.0, 0.0), 29.9));
+  EXPECT_FALSE(c.besideAnother("sedan", Vec3(100.0, 0.0, 0.0), 30.0));
+  // The pickup is beside the sedans' sightings in turn.
+  EXPECT_TRUE(c.besideAnother("pickup", Vec3(88.0, 0.0, 0.0), 10.0));
+  c.clear();
+  EXPECT_FALSE(c.besideAnother("pickup", Vec3(88.0, 0.0, 0.0), 10.0));
+  EXPECT_THROW(ConvoySightings(-1.0, 20.0), scenario::ConfigError);
+  EXPECT_THROW(ConvoySightings(80.0, 0.0), scenario::ConfigError);
+}
+
 TEST(PublicSimConfig, HoldsTheMapAndTheUavButNoEntityOrGroundTruthPath) {
   const scenario::SimConfig pub = loadPublicSimConfig(kSimConfig);
   const scenario::SimConfig full = scenario::loadSimConfig(kSimConfig);

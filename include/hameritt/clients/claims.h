@@ -2,6 +2,7 @@
 // At most one claim per candidate location: a client tells the ADK "I see the target here" once,
 // not at every frame. ROS-free.
 
+#include <deque>
 #include <map>
 #include <string>
 #include <vector>
@@ -55,6 +56,31 @@ class StandingSightings {
   };
   double radius_, hold_, keep_;
   std::map<std::string, std::vector<Sighting>> seen_;
+};
+
+// Where the targets of a convoy were sighted lately: the generator's track phase of several
+// targets drives them together (the second "behind" the first), so a vehicle of one target's
+// description is one of them only where a vehicle of another target's description was sighted
+// within `radius` metres in the last `window` seconds; a look-alike driving alone is not.
+class ConvoySightings {
+ public:
+  ConvoySightings(double radius = 80.0, double window = 20.0);
+
+  // Records a sighting of description `key` at p, time t (not before the previous one's time).
+  void observe(const std::string& key, const geometry::Vec3& p, double t);
+  // Whether a sighting of a description other than `key` lies within the radius of p among
+  // those of the window before t (the sightings already recorded).
+  bool besideAnother(const std::string& key, const geometry::Vec3& p, double t) const;
+  void clear() { seen_.clear(); }
+
+ private:
+  struct Sighting {
+    std::string key;
+    geometry::Vec2 p;
+    double t;
+  };
+  double radius_, window_;
+  std::deque<Sighting> seen_;
 };
 
 }  // namespace hameritt::clients

@@ -152,6 +152,13 @@ class CoverageSearchClientRos {
   // The target whose state feeds the predictor (empty until the first adk/target_state), and
   // the other found targets' predictions (a track phase keeps them all in view).
   std::string state_target_;
+  // The target description the pursuit follows (its first sighting's, or a restart's): only its
+  // sightings are associated with the prediction, so a look-alike of another target's
+  // description driving by does not take the pursuit over.
+  std::string pursued_description_;
+  // The sightings of the targets' descriptions (not parked) lately: a track phase's targets
+  // drive as a convoy, so one is claimed only beside another's sighting.
+  clients::ConvoySightings convoy_;
   std::map<std::string, std::unique_ptr<clients::StreetPredictor>> other_targets_;
   // A track phase's targets (by description) sighted away from the pursued vehicle and not yet
   // claimed: the group view brings them into the scored camera.
