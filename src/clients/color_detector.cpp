@@ -167,6 +167,13 @@ ColorShapeDetector::ColorShapeDetector(DetectorSettings settings) : settings_(st
   settings_.validate();
 }
 
+bool ColorShapeDetector::trackable(const CarCandidate& c, const Vec3& expected) const {
+  if (c.reject.empty()) return true;
+  const double grow = 1.0 + settings_.size_tolerance;
+  return c.cut && c.range <= settings_.max_range && c.length <= grow * expected.x() &&
+         c.width <= grow * expected.y();
+}
+
 cv::Mat ColorShapeDetector::colorMask(const cv::Mat& rgb, const std::string& color) const {
   const auto it = settings_.colors.find(color);
   if (it == settings_.colors.end()) {
@@ -329,6 +336,7 @@ std::vector<CarCandidate> ColorShapeDetector::detect(const cv::Mat& rgb, const c
     const double ew = std::abs(c.width - expected.y()) / (tol * expected.y());
     c.size_score = std::clamp(1.0 - std::max(el, ew), 0.0, 1.0);
     char buf[160];
+    c.cut = g.border;
     if (g.border && s.reject_border) {
       c.reject = "touches the image border";
     } else if (c.range > s.max_range) {

@@ -200,6 +200,13 @@ GroupView groupView(const std::vector<VehicleState>& vehicles, const scenario::C
   return g;
 }
 
+double levelReach(const scenario::CameraSpec& camera, double height) {
+  const double th = std::tan(0.5 * camera.hfov_deg * geometry::kPi / 180.0);
+  // The vertical half-angle's tangent from the horizontal one and the aspect (square pixels).
+  const double tv = th * camera.height / std::max(1, camera.width);
+  return std::max(0.0, height) * std::hypot(th, tv);
+}
+
 ViewpointChooser::ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
                                    const std::vector<scenario::KeepOutZone>& kozs,
                                    const PursuitSettings& settings)

@@ -280,12 +280,15 @@ void ColorShapeDetectorRos::onFrame(Camera* camera, const sensor_msgs::Image::Co
       }
       const geometry::Vec3 size = clients::nominalSize(target);
       for (const auto& c : detector_->detect(rgb, range, intrinsics, *pose, target.color, size)) {
+        // A track's box may be a vehicle's part the image border cuts; a claim needs its size.
+        if (publish_blobs_ && detector_->trackable(c, size)) {
+          blobs.entities.push_back(toPerceivedBlob(target, c));
+        }
         if (!c.reject.empty()) {
           ROS_DEBUG("%s: %s blob at (%.1f, %.1f): %s", kClientName, target.color.c_str(),
                     c.position.x(), c.position.y(), c.reject.c_str());
           continue;
         }
-        if (publish_blobs_) blobs.entities.push_back(toPerceivedBlob(target, c));
         if (!claim_) continue;
         clients::CandidatePose p;
         p.position = c.position;

@@ -61,6 +61,9 @@ constexpr double kConvoyRadius = 80.0;
 // And one of a target's description is claimed only beside a sighting of another target's
 // description (within kConvoyRadius) of the last this many seconds.
 constexpr double kConvoyWindow = 20.0;
+// A claim's sighting lies within this many times a level camera's reach of the UAV (a little
+// tilt is the flight's own).
+constexpr double kLevelMargin = 1.25;
 // Detection claims come seconds apart: their gate.
 constexpr double kAssociationGate = 15.0;
 
@@ -521,8 +524,15 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       // With several targets (a convoy), one of another description sighted near it lately.
       const bool in_convoy =
           mission_->objective.targets.size() < 2 || convoy_.besideAnother(target.id, p, t);
+      // Held by the camera, not glimpsed while the UAV was tilted: within a level camera's reach.
+      bool held_in_view = true;
+      if (track_camera_ && odom_) {
+        const auto& o = odom_->pose.pose.position;
+        held_in_view = std::hypot(o.x - p.x(), o.y - p.y()) <=
+                       kLevelMargin * clients::levelReach(*track_camera_, o.z - p.z());
+      }
       if (msg->camera != track_claim_camera_ || parked || (standing && !pursued) || apart ||
-          !in_convoy || track_claimed_.count(id)) {
+          !in_convoy || !held_in_view || track_claimed_.count(id)) {
         continue;
       }
       track_claimed_.insert(id);

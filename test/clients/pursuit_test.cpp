@@ -422,6 +422,44 @@ TEST(Pursuit, ViewpointsForOneCameraAreSeenByIt) {
   EXPECT_GT(down_seen, tested * 9 / 10);
 }
 
+// A level down camera sees nothing farther (horizontally) than levelReach: no point beyond it
+// projects into the image at any bearing or yaw, while points just inside it, towards the
+// image's corners, do (so the bound is tight). The track client's claims use it to tell a
+// glimpse during a manoeuvre from a camera that holds the target.
+TEST(Pursuit, NothingBeyondALevelCamerasReachIsInItsImage) {
+  const scenario::CameraSpec* down = nullptr;
+  for (const auto& c : sim().uav.cameras) {
+    if (c.name == "down") down = &c;
+  }
+  ASSERT_NE(down, nullptr);
+  int beyond_seen = 0, inside_seen = 0, inside = 0;
+  for (double h : {10.0, 20.0, 45.0}) {
+    const double reach = levelReach(*down, h);
+    EXPECT_GT(reach, h * std::tan(0.5 * down->hfov_deg * geometry::kPi / 180.0));
+    const Vec3 uav(5.0, -3.0, h);
+    for (int y = 0; y < 12; ++y) {
+      const double yaw = y * geometry::kPi / 6.0;
+      for (int b = 0; b < 720; ++b) {
+        const double bearing = b * geometry::kPi / 360.0;
+        const Vec3 dir(std::cos(bearing), std::sin(bearing), 0.0);
+        beyond_seen +=
+            planning::projectToImage(*down, uav, yaw, Vec3(5.0, -3.0, 0.0) + dir * (1.01 * reach))
+                .has_value();
+        ++inside;
+        inside_seen +=
+            planning::projectToImage(*down, uav, yaw, Vec3(5.0, -3.0, 0.0) + dir * (0.97 * reach))
+                .has_value();
+      }
+    }
+  }
+  EXPECT_EQ(beyond_seen, 0);
+  EXPECT_GT(inside_seen, 0);  // towards the corners
+  EXPECT_LT(inside_seen, inside / 10);
+  EXPECT_EQ(levelReach(*down, -5.0), 0.0);
+  std::printf("level reach: %d of %d points beyond it seen, %d of %d at 0.97 of it\n",
+              beyond_seen, inside, inside_seen, inside);
+}
+
 TEST(Pursuit, AGroupViewHoldsEveryVehicleInTheDownCamera) {
   // Two cars 25 m apart on a street line: from the group view's height above their midpoint,
   // yawed across their line, the down camera sees both body centres. Negative controls: yawed

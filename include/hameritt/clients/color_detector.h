@@ -75,12 +75,18 @@ struct CarCandidate {
   int pixels = 0;                    // pixels of colour at car height
   cv::Rect box;                      // image bounding box
   double size_score = 0.0;           // 1: exact size, 0: at the tolerance
+  bool cut = false;                  // touches the image border (part of the vehicle may be out)
   std::string reject;                // "" for a candidate; else why not
 };
 
 class ColorShapeDetector {
  public:
   explicit ColorShapeDetector(DetectorSettings settings = defaultDetectorSettings());
+
+  // Whether blob `c` (of detect() with `expected`) can stand for a vehicle's box in a track:
+  // a candidate, or a blob cut by the image border (a vehicle partly out of the image, whose
+  // size is not measurable) no larger than `expected` within the tolerance and in range.
+  bool trackable(const CarCandidate& c, const geometry::Vec3& expected) const;
 
   // Pixels of `color` (CV_8U, 255 where set) in an RGB image (CV_8UC3, R first). Throws
   // scenario::ConfigError for a colour without HSV ranges. With snow, a chromatic range (one

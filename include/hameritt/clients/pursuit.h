@@ -93,6 +93,11 @@ struct GroupView {
 GroupView groupView(const std::vector<VehicleState>& vehicles, const scenario::CameraSpec& camera,
                     double margin);
 
+// The farthest a point `height` m below a level nadir camera `camera` can lie, horizontally, and
+// still be in its image: half the image's diagonal on the ground. A sighting farther than this
+// came while the UAV was tilted (a manoeuvre's glimpse), not from a camera that holds it.
+double levelReach(const scenario::CameraSpec& camera, double height);
+
 // A place to look from.
 struct PursuitView {
   geometry::Vec3 position{0, 0, 0};
