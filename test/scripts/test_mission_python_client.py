@@ -49,7 +49,18 @@ def nodes():
 
 
 def run(out, mode, limit, lockstep=False):
-    """mission.launch plus the example client; returns (metrics, client exit code, launch log)."""
+    """mission.launch plus the example client, on a master of its own; returns (metrics, client
+    exit code, launch log). A master shared by the runs kept the last run's registrations: a
+    node that registers a name the master knows makes it tell the old node's URI to shut down,
+    and that port may now be a new node's (a loaded run's planner took the call and ended)."""
+    core = start_master(PORT)
+    try:
+        return run_on_master(out, mode, limit, lockstep)
+    finally:
+        stop_master(core)
+
+
+def run_on_master(out, mode, limit, lockstep):
     os.makedirs(out)
     env = dict(os.environ, ROS_LOG_DIR=os.path.join(out, "log"), ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
     rec = None
@@ -110,7 +121,6 @@ def differences(a, b):
 
 def main():
     base = tempfile.mkdtemp(prefix="hameritt_pyclient.")
-    core = start_master(PORT)
     fails = []
     try:
         started = time.time()
@@ -162,8 +172,6 @@ def main():
             fails.append("negative control: expected /uav/odom and /planner/waypoints, got %s" % caught)
     except Exception as e:  # a timeout or a missing file: report it with the runs kept
         fails.append("%s: %s" % (type(e).__name__, e))
-    finally:
-        stop_master(core)
     if fails:
         print("FAIL (runs kept in %s):\n  " % base + "\n  ".join(fails))
         return 1
