@@ -1139,11 +1139,11 @@ void asItsFileReadsBack(TrafficEpisode* e) {
   for (auto& p : e->pedestrians) {
     fix(p.height);
     p.pose = {0.0, p.pose.x, p.pose.y, 0.0, p.pose.yaw};
-    for (auto& q : p.trajectory) q.z = 0.0;
     fix(p.pose.x);
     fix(p.pose.y);
     fix(p.pose.yaw);
     for (auto& q : p.trajectory) {
+      q.z = 0.0;
       fix(q.t);
       fix(q.x);
       fix(q.y);
@@ -1318,6 +1318,9 @@ std::shared_ptr<const SharedTrafficEpisode> cityTrafficEpisode(const World& worl
 
 namespace {
 
+// The random stream of a scenario's traffic draw (drawCityTraffic).
+Rng trafficDrawRng(std::uint64_t seed) { return Rng(deriveSeed(seed, 0x5045444553ULL)); }
+
 // The first draw of a scenario's traffic: its episode.
 int episodeDraw(Rng& rng, const CityParams& cp) {
   return static_cast<int>(rng.uniformInt(0, static_cast<long>(cp.traffic_episodes) - 1));
@@ -1326,7 +1329,7 @@ int episodeDraw(Rng& rng, const CityParams& cp) {
 }  // namespace
 
 int drawCityTrafficEpisode(const World& world, std::uint64_t seed) {
-  Rng rng(deriveSeed(seed, 0x5045444553ULL));
+  Rng rng = trafficDrawRng(seed);
   return episodeDraw(rng, world.params().city);
 }
 
@@ -1341,7 +1344,7 @@ CityTrafficDraw drawCityTraffic(const World& world, std::uint64_t seed, double d
   if (duration <= 0.5 * kTrafficEpisodeLength) {
     // A window of one of the world's episodes, starting at a time drawn for this scenario (in
     // the first half of the episode, whatever the duration); the signal offsets move with it.
-    Rng rng(deriveSeed(seed, 0x5045444553ULL));
+    Rng rng = trafficDrawRng(seed);
     d.episode = episodeDraw(rng, cp);
     d.offset =
         roundMilli(idm.step * std::floor(rng.uniform(0.0, 0.5 * kTrafficEpisodeLength) / idm.step));
