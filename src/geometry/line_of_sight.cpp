@@ -40,19 +40,42 @@ double boxTolerance(const OrientedBox& b) {
   return kEpsilon * std::max({1.0, b.center.cwiseAbs().maxCoeff(), b.size.cwiseAbs().maxCoeff()});
 }
 
-// Appends the boxes filed under cells (ix, iy0..iy1).
-void collectColumn(const std::vector<Entry>& cells, int ix, int iy0, int iy1,
-                   std::vector<int>* out) {
+// Calls f(box) for each box filed under cells (ix, iy0..iy1), in order, until f returns true;
+// returns whether it did.
+template <class F>
+bool anyInColumn(const std::vector<Entry>& cells, int ix, int iy0, int iy1, F f) {
   auto it = std::lower_bound(cells.begin(), cells.end(),
                              Entry{packKey(ix, iy0), std::numeric_limits<int>::min()});
   const std::int64_t last = packKey(ix, iy1);
-  for (; it != cells.end() && it->first <= last; ++it) out->push_back(it->second);
+  for (; it != cells.end() && it->first <= last; ++it) {
+    if (f(it->second)) return true;
+  }
+  return false;
+}
+
+// The same for the boxes filed under kGlobalKey.
+template <class F>
+bool anyGlobal(const std::vector<Entry>& cells, F f) {
+  for (auto it = cells.begin(); it != cells.end() && it->first == kGlobalKey; ++it) {
+    if (f(it->second)) return true;
+  }
+  return false;
+}
+
+// Appends the boxes filed under cells (ix, iy0..iy1).
+void collectColumn(const std::vector<Entry>& cells, int ix, int iy0, int iy1,
+                   std::vector<int>* out) {
+  anyInColumn(cells, ix, iy0, iy1, [&](int i) {
+    out->push_back(i);
+    return false;
+  });
 }
 
 void collectGlobal(const std::vector<Entry>& cells, std::vector<int>* out) {
-  for (auto it = cells.begin(); it != cells.end() && it->first == kGlobalKey; ++it) {
-    out->push_back(it->second);
-  }
+  anyGlobal(cells, [&](int i) {
+    out->push_back(i);
+    return false;
+  });
 }
 
 void collectAll(std::size_t count, std::vector<int>* out) {
@@ -113,9 +136,7 @@ bool anySegmentCandidate(const std::vector<Entry>& cells, double cell, std::size
     mk = marks.query;
     return visit(i);
   };
-  for (auto it = cells.begin(); it != cells.end() && it->first == kGlobalKey; ++it) {
-    if (once(it->second)) return true;
-  }
+  if (anyGlobal(cells, once)) return true;
   const Vec2 d = b - a;
   for (int ix = ix0; ix <= ix1; ++ix) {
     double ylo = lo.y();
@@ -132,13 +153,7 @@ bool anySegmentCandidate(const std::vector<Entry>& cells, double cell, std::size
     }
     const int jy0 = std::max(iy0, cellIndex(ylo, cell));
     const int jy1 = std::min(iy1, cellIndex(yhi, cell));
-    if (jy0 > jy1) continue;
-    auto it = std::lower_bound(cells.begin(), cells.end(),
-                               Entry{packKey(ix, jy0), std::numeric_limits<int>::min()});
-    const std::int64_t last = packKey(ix, jy1);
-    for (; it != cells.end() && it->first <= last; ++it) {
-      if (once(it->second)) return true;
-    }
+    if (jy0 <= jy1 && anyInColumn(cells, ix, jy0, jy1, once)) return true;
   }
   return false;
 }
