@@ -130,6 +130,10 @@ LookAtResult planLookAtPath(const WorldValidity& validity, const scenario::Camer
   double t = t0;
   Vec3 from = start;
   using scenario::roundMilli;
+  // Each viewpoint's arrival, turn and dwell samples; whether each leg starts where the path
+  // before it ends (see 4).
+  std::vector<scenario::Trajectory> stops;
+  bool legsJoin = true;
   for (std::size_t j = 0; j < order.size(); ++j) {
     const PlanResult leg = planUavPath(validity, from, order[j].pos, t, settings,
                                        scenario::deriveSeed(seed, 1000 + j));
@@ -142,6 +146,11 @@ LookAtResult planLookAtPath(const WorldValidity& validity, const scenario::Camer
       f.path.clear();
       return r;
     }
+    if (!f.path.empty()) {
+      const auto &end = f.path.back(), &first = leg.path.front();
+      legsJoin = legsJoin && first.t == end.t && first.x == end.x && first.y == end.y &&
+                 first.z == end.z;
+    }
     for (std::size_t k = f.path.empty() ? 0 : 1; k < leg.path.size(); ++k)
       f.path.push_back(leg.path[k]);
     f.length += leg.length;
@@ -152,6 +161,7 @@ LookAtResult planLookAtPath(const WorldValidity& validity, const scenario::Camer
     f.path.push_back(last);
     last.t = roundMilli(last.t + look.dwell);
     f.path.push_back(last);
+    stops.emplace_back(f.path.end() - 3, f.path.end());
     t = last.t;
     from = Vec3(last.x, last.y, last.z);
   }
@@ -159,7 +169,14 @@ LookAtResult planLookAtPath(const WorldValidity& validity, const scenario::Camer
     f.path.push_back(
         {roundMilli(t0), roundMilli(start.x()), roundMilli(start.y()), roundMilli(start.z()), 0.0});
   // 4. Verify on the final path: whole path valid; each dwell sample sees its target.
-  const std::string err = validity.checkTrajectory(f.path, 0.25, 2e-3);
+  // planUavPath checked each leg's segments with the same test and slack (checkTrajectory is
+  // exact per segment and depends on the samples' positions and times only), so where every
+  // leg starts at the sample before it the turns and dwells are the only segments left; a
+  // failure there (or a leg that does not join) re-checks the whole path for its message.
+  bool stopsValid = legsJoin && !stops.empty();
+  for (std::size_t j = 0; j < stops.size() && stopsValid; ++j)
+    stopsValid = validity.checkTrajectory(stops[j], 0.25, 2e-3).empty();
+  const std::string err = stopsValid ? std::string() : validity.checkTrajectory(f.path, 0.25, 2e-3);
   if (!err.empty()) {
     r.status = f.status = PlanStatus::kNoSolution;
     r.message = "final path rejected: " + err;

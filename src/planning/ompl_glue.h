@@ -55,8 +55,10 @@ class RngRealVectorSampler : public ompl::base::StateSampler {
 };
 
 // Allocator handing out samplers seeded deterministically (seed, 0), (seed, 1), ...
-inline ompl::base::StateSamplerAllocator rngSamplerAllocator(std::uint64_t seed) {
-  auto counter = std::make_shared<std::uint64_t>(0);
+// Samplers seeded deriveSeed(seed, k) for k = first, first + 1, ... in the order allocated.
+inline ompl::base::StateSamplerAllocator rngSamplerAllocator(std::uint64_t seed,
+                                                             std::uint64_t first = 0) {
+  auto counter = std::make_shared<std::uint64_t>(first);
   return [seed, counter](const ompl::base::StateSpace* space) {
     return std::make_shared<RngRealVectorSampler>(space, scenario::deriveSeed(seed, (*counter)++));
   };

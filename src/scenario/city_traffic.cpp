@@ -317,13 +317,6 @@ bool turnOpen(const SignalPlan& plan, const SignalizedIntersection& si, int axis
   return false;
 }
 
-// Whether an arrow that lets a turn of `kind` from `axis` go shows at t.
-bool turnArrow(const SignalPlan& plan, const SignalizedIntersection& si, int axis, PieceKind kind,
-               double t) {
-  return plan.state(si, axis, t) == SignalState::kLeftArrow ||
-         (kind == PieceKind::kRight && plan.state(si, 1 - axis, t) == SignalState::kLeftArrow);
-}
-
 // The open polyline of a car's path: its pieces' points joined end to start.
 LaneRing pathLine(const std::vector<TrafficEpisode::Lane>& lanes, const std::vector<int>& path) {
   LaneRing r;
@@ -687,6 +680,11 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
   };
   for (auto& c : cars) extend(c, kLookAhead + 50.0);
   std::vector<std::vector<double>> track(nc);
+  for (auto& tr : track) tr.reserve(steps + 1);
+  // The signals at t and at t + step, asked for by many cars in a step: each intersection's
+  // state per axis and whether a turn may start, computed once per step (-1: not yet).
+  const std::size_t ni = plan.intersections.size();
+  std::vector<signed char> state_now(2 * ni), state_next(2 * ni), turn_now(4 * ni);
   struct Occupant {
     std::size_t car;
     double rel;  // the car's centre from the piece's start (m)
@@ -703,6 +701,14 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
       for (std::size_t i = 0; i < nc; ++i) track[i].push_back(cars[i].s);
     }
     if (k == static_cast<std::size_t>(steps_warm) + steps) break;
+    std::fill(state_now.begin(), state_now.end(), -1);
+    std::fill(state_next.begin(), state_next.end(), -1);
+    std::fill(turn_now.begin(), turn_now.end(), -1);
+    auto stateAt = [&](std::vector<signed char>& memo, double when, int si, int axis) {
+      signed char& m = memo[2 * static_cast<std::size_t>(si) + static_cast<std::size_t>(axis)];
+      if (m < 0) m = static_cast<signed char>(plan.state(plan.intersections[si], axis, when));
+      return static_cast<SignalState>(m);
+    };
     for (auto& o : occupants) o.clear();
     for (std::size_t i = 0; i < nc; ++i) {
       const Car& c = cars[i];
@@ -755,7 +761,7 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
         const Piece& conn = pieces[c.path[stop_q + 1]];
         const auto& si = plan.intersections[conn.intersection];
         if (conn.kind == PieceKind::kThrough) {
-          const SignalState state = plan.state(si, conn.axis, t);
+          const SignalState state = stateAt(state_now, t, conn.intersection, conn.axis);
           if (state == SignalState::kRed || state == SignalState::kLeftArrow) {
             blocked = true;
           } else if (state == SignalState::kYellow && commit != static_cast<long>(stop_q)) {
@@ -765,8 +771,12 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
               commit = static_cast<long>(stop_q);
             }
           }
-        } else if (!turnOpen(plan, si, conn.axis, conn.kind, t)) {
-          blocked = true;
+        } else {
+          signed char& open = turn_now[4 * static_cast<std::size_t>(conn.intersection) +
+                                       2 * static_cast<std::size_t>(conn.axis) +
+                                       (conn.kind == PieceKind::kRight ? 1 : 0)];
+          if (open < 0) open = turnOpen(plan, si, conn.axis, conn.kind, t) ? 1 : 0;
+          if (!open) blocked = true;
         }
         // Do not enter the box without room behind the leader beyond it.
         if (!blocked && commit != static_cast<long>(stop_q) && has_lead && gap > dist &&
@@ -812,13 +822,17 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
         if (conn.intersection < 0) continue;
         const double entry = c.base[q + 1], stop = entry - kStopBack, guard = entry - kGuard;
         if (front <= stop || front > entry || front + ds <= guard) continue;
-        const auto& si = plan.intersections[conn.intersection];
         bool closed = false;
+        const double te = t + idm.step;
+        const SignalState end_state = stateAt(state_next, te, conn.intersection, conn.axis);
         if (conn.kind == PieceKind::kThrough) {
-          const SignalState end_state = plan.state(si, conn.axis, t + idm.step);
           closed = end_state == SignalState::kRed || end_state == SignalState::kLeftArrow;
         } else {
-          closed = !turnArrow(plan, si, conn.axis, conn.kind, t + idm.step);
+          // An arrow that lets the turn go shows at t + step.
+          closed = !(end_state == SignalState::kLeftArrow ||
+                     (conn.kind == PieceKind::kRight &&
+                      stateAt(state_next, te, conn.intersection, 1 - conn.axis) ==
+                          SignalState::kLeftArrow));
         }
         if (closed) {
           ds = std::max(0.0, guard - front);

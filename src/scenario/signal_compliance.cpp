@@ -218,6 +218,10 @@ Trajectory obeySignals(const Trajectory& traj, double length, const SignalPlan& 
   const double half = 0.5 * length;
   const double need = 0.5 * (length + lead_length) + kMinGap;
   std::vector<char> was_in(plan.intersections.size(), 0);
+  // The intersections' positions side by side: most scan steps find every one far.
+  std::vector<Vec2> at;
+  at.reserve(plan.intersections.size());
+  for (const auto& si : plan.intersections) at.push_back(si.position);
   const double horizon = 2.0 * plan.cycle() + 1.0;
   double t = tr.front().t;
   for (int guard = 0; t <= tr.back().t + 1e-9 && guard < 200000; ++guard) {
@@ -236,8 +240,7 @@ Trajectory obeySignals(const Trajectory& traj, double length, const SignalPlan& 
     if (!lead) {
       // Far from every intersection: on to the first step at which the front may be near one.
       double nearest = 1e18;
-      for (const auto& si : plan.intersections)
-        nearest = std::min(nearest, (front - si.position).squaredNorm());
+      for (const Vec2& p : at) nearest = std::min(nearest, (front - p).squaredNorm());
       nearest = std::sqrt(nearest);
       if (nearest > kNear + kMaxSpeed * kScanStep) {
         std::fill(was_in.begin(), was_in.end(), 0);
@@ -247,6 +250,10 @@ Trajectory obeySignals(const Trajectory& traj, double length, const SignalPlan& 
     }
     bool waited = false;
     for (std::size_t i = 0; i < plan.intersections.size() && !waited; ++i) {
+      if ((front - at[i]).squaredNorm() > kNear * kNear) {
+        was_in[i] = 0;  // entering()'s answer for a far front
+        continue;
+      }
       const auto& si = plan.intersections[i];
       const int axis = entering(si, plan, front, q.yaw, &was_in[i]);
       if (axis < 0) continue;

@@ -148,21 +148,75 @@ std::vector<Box> cachedBlockBoxes(const MovingFootprint& f, std::size_t n) {
   return out;
 }
 
-TrajectoryPoint poseAt(const MovingFootprint& f, double t) {
-  if (!f.trajectory || f.trajectory->size() < 2) return f.pose;
-  return sampleTrajectory(*f.trajectory, t + f.time_shift);
-}
+// sampleTrajectory(*f.trajectory, t + f.time_shift) (or the standing pose) at times that never
+// decrease between calls: the segment is searched once and then walked on, and the position
+// comes first, the yaw (two wrapPi) only when asked for; both are the same operations as
+// sampleTrajectory's, so the same numbers.
+class Walker {
+ public:
+  explicit Walker(const MovingFootprint& f)
+      : tr_(f.trajectory && f.trajectory->size() >= 2 ? f.trajectory : nullptr), f_(f) {}
+
+  // The position at t; yaw() then gives the yaw there.
+  void at(double t, double* x, double* y) {
+    if (!tr_) {
+      pose_ = &f_.pose;
+      *x = pose_->x;
+      *y = pose_->y;
+      return;
+    }
+    const Trajectory& tr = *tr_;
+    const double te = t + f_.time_shift;
+    if (te <= tr.front().t || te >= tr.back().t) {
+      pose_ = te <= tr.front().t ? &tr.front() : &tr.back();
+      *x = pose_->x;
+      *y = pose_->y;
+      return;
+    }
+    pose_ = nullptr;
+    if (i_ == 0) {
+      i_ = static_cast<std::size_t>(
+          std::upper_bound(tr.begin() + 1, tr.end(), te,
+                           [](double v, const TrajectoryPoint& p) { return v < p.t; }) -
+          tr.begin());
+    }
+    while (tr[i_].t <= te) ++i_;  // te < back().t: stops inside
+    const TrajectoryPoint &a = tr[i_ - 1], &b = tr[i_];
+    const double span = b.t - a.t;
+    u_ = span > 0 ? (te - a.t) / span : 1.0;
+    *x = a.x + u_ * (b.x - a.x);
+    *y = a.y + u_ * (b.y - a.y);
+  }
+
+  double yaw() const {
+    if (pose_) return pose_->yaw;
+    const TrajectoryPoint &a = (*tr_)[i_ - 1], &b = (*tr_)[i_];
+    return geometry::wrapPi(a.yaw + u_ * geometry::wrapPi(b.yaw - a.yaw));
+  }
+
+ private:
+  const Trajectory* tr_;
+  const MovingFootprint& f_;
+  std::size_t i_ = 0;
+  double u_ = 0.0;
+  const TrajectoryPoint* pose_ = nullptr;
+};
 
 // The first fine sample of block `j` at which a and b overlap (grown by margin).
 std::optional<double> overlapInBlock(const MovingFootprint& a, const MovingFootprint& b,
                                      std::size_t j, std::size_t n, double margin) {
   const double rr = reach(a, margin) + reach(b, margin);
+  Walker wa(a), wb(b);
   for (std::size_t k = j * kBlock; k < std::min((j + 1) * kBlock, n); ++k) {
     const double t = static_cast<double>(k) * kClearanceStep;
-    const TrajectoryPoint p = poseAt(a, t), q = poseAt(b, t);
-    if (std::hypot(p.x - q.x, p.y - q.y) > rr) continue;
-    if (rectanglesOverlap(p.x, p.y, p.yaw, 0.5 * a.length + margin, 0.5 * a.width + margin, q.x,
-                          q.y, q.yaw, 0.5 * b.length + margin, 0.5 * b.width + margin)) {
+    double px = 0, py = 0, qx = 0, qy = 0;
+    wa.at(t, &px, &py);
+    wb.at(t, &qx, &qy);
+    // std::hypot(dx, dy) > rr, decided by the squares where they are clearly apart or near.
+    const double dx = px - qx, dy = py - qy, d2 = dx * dx + dy * dy, r2 = rr * rr;
+    if (d2 > r2 * (1 + 1e-9) || (d2 >= r2 * (1 - 1e-9) && std::hypot(dx, dy) > rr)) continue;
+    if (rectanglesOverlap(px, py, wa.yaw(), 0.5 * a.length + margin, 0.5 * a.width + margin, qx,
+                          qy, wb.yaw(), 0.5 * b.length + margin, 0.5 * b.width + margin)) {
       return t;
     }
   }
