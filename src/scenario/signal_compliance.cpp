@@ -123,27 +123,27 @@ TrajectoryPoint rounded(TrajectoryPoint q) {
   return q;
 }
 
-// `tr` with the car standing still at its pose of time `at` for `wait` seconds.
-Trajectory withWait(const Trajectory& tr, double at, double wait) {
-  TrajectoryPoint p = rounded(sampleTrajectory(tr, at));
+// Makes the car stand still in `tr` at its pose of time `at` for `wait` seconds: the samples
+// before `at` stay, those at it give way to the standing pair, and the later ones move `wait`
+// later (in place: a wait costs a pass over the samples after it, not a copy of all of them).
+void addWait(Trajectory* tr, double at, double wait) {
+  TrajectoryPoint p = rounded(sampleTrajectory(*tr, at));
   p.t = roundMilli(at);
-  Trajectory out;
-  out.reserve(tr.size() + 2);
-  for (const auto& q : tr) {
-    if (q.t < p.t - 1e-9) out.push_back(q);
-  }
-  out.push_back(p);
   TrajectoryPoint held = p;
   held.t = roundMilli(p.t + wait);
-  out.push_back(held);
-  for (const auto& q : tr) {
-    if (q.t > p.t + 1e-9) {
-      TrajectoryPoint s = q;
-      s.t = roundMilli(q.t + wait);
-      out.push_back(s);
-    }
+  const auto by_t = [](const TrajectoryPoint& q, double t) { return q.t < t; };
+  const auto t_by = [](double t, const TrajectoryPoint& q) { return t < q.t; };
+  // [i0, i1): the samples within 1e-9 s of the wait's start (the times are increasing).
+  const auto i0 = std::lower_bound(tr->begin(), tr->end(), p.t - 1e-9, by_t) - tr->begin();
+  const auto i1 = std::upper_bound(tr->begin() + i0, tr->end(), p.t + 1e-9, t_by) - tr->begin();
+  for (auto it = tr->begin() + i1; it != tr->end(); ++it) it->t = roundMilli(it->t + wait);
+  if (i1 - i0 >= 2) {
+    tr->erase(tr->begin() + i0 + 2, tr->begin() + i1);
+  } else {
+    tr->insert(tr->begin() + i0, static_cast<std::size_t>(2 - (i1 - i0)), p);
   }
-  return out;
+  (*tr)[static_cast<std::size_t>(i0)] = p;
+  (*tr)[static_cast<std::size_t>(i0) + 1] = held;
 }
 
 // The latest time before `t` at which the car's centre stood `back` metres (along its path)
@@ -232,7 +232,7 @@ Trajectory obeySignals(const Trajectory& traj, double length, const SignalPlan& 
       const TrajectoryPoint p = sampleTrajectory(tr, at);
       double wait = kWaitStep;
       while (wait < 600.0 && blockedBy(p, *lead, at + wait, need + 0.5)) wait += kWaitStep;
-      tr = withWait(tr, at, wait);
+      addWait(&tr, at, wait);
       t = roundMilli(at + wait) + kScanStep;
       continue;
     }
@@ -270,7 +270,7 @@ Trajectory obeySignals(const Trajectory& traj, double length, const SignalPlan& 
       while (wait <= horizon && !fine(wait)) wait += kWaitStep;
       if (wait > horizon) continue;  // no time lets it go (no arrow long enough to turn)
       const double at = timeBack(tr, t - kScanStep, kStopBack);
-      tr = withWait(tr, at, wait);
+      addWait(&tr, at, wait);
       t = roundMilli(at + wait);  // rescanned from the wait's end: the front is outside
       waited = true;
     }

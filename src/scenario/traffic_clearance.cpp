@@ -358,9 +358,7 @@ ClearanceIndex clearanceIndex(const std::vector<ClearanceBlocks>& blocks, double
         ix.cellRange(b, &x0, &y0, &x1, &y1);
         for (int y = y0; y <= y1; ++y) {
           for (int x = x0; x <= x1; ++x) {
-            const std::size_t k = (e * static_cast<std::size_t>(ix.ny) + static_cast<std::size_t>(y)) *
-                                      static_cast<std::size_t>(ix.nx) +
-                                  static_cast<std::size_t>(x);
+            const std::size_t k = ix.slot(e, x, y);
             if (pass == 0) {
               ++ix.start[k + 1];
             } else {
@@ -419,10 +417,7 @@ std::vector<std::size_t> trafficToWithhold(const std::vector<MovingFootprint>& m
       for (long e = std::clamp(e0, 0L, last); e <= std::clamp(e1, 0L, last); ++e) {
         for (int y = y0; y <= y1; ++y) {
           for (int x = x0; x <= x1; ++x) {
-            const std::size_t k =
-                (static_cast<std::size_t>(e) * static_cast<std::size_t>(index.ny) +
-                 static_cast<std::size_t>(y)) * static_cast<std::size_t>(index.nx) +
-                static_cast<std::size_t>(x);
+            const std::size_t k = index.slot(static_cast<std::size_t>(e), x, y);
             for (std::uint32_t c = index.start[k]; c < index.start[k + 1]; ++c) {
               const std::size_t i = index.cars[c];
               if (near[i] || seen[i] == query) continue;

@@ -48,11 +48,17 @@ struct ClearanceIndex {
   int nx = 0, ny = 0;
   std::size_t blocks = 0;
   // The footprints of block e and cell (ix, iy): cars[start[k]] .. cars[start[k + 1] - 1] with
-  // k = (e * ny + iy) * nx + ix, ascending.
+  // k = slot(e, ix, iy), ascending.
   std::vector<std::uint32_t> start;
   std::vector<std::uint32_t> cars;
   // The footprints' blocks the index was built from.
   const std::vector<ClearanceBlocks>* source = nullptr;
+
+  // A cell's blocks lie side by side: a query walks a few cells over consecutive blocks.
+  std::size_t slot(std::size_t e, int ix, int iy) const {
+    return (static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx) +
+            static_cast<std::size_t>(ix)) * blocks + e;
+  }
 
   // The cells (clamped to the grid) that box b touches.
   void cellRange(const ClearanceBox& b, int* x0, int* y0, int* x1, int* y1) const;
