@@ -72,12 +72,21 @@ RelationEvaluator::RelationEvaluator(const World& world, const RelationConfig& c
     : world_(world), config_(config) {}
 
 void RelationEvaluator::addOccluder(const std::string& id, const OrientedBox& box) {
-  extra_occluders_.emplace_back(id, box);
+  ExtraOccluder o;
+  o.id = id;
+  o.box = box;
+  o.cos_yaw = std::cos(box.yaw);
+  o.sin_yaw = std::sin(box.yaw);
+  const double r = 0.5 * box.size.head<2>().norm() + 0.01;
+  const geometry::Vec3 half(r, r, 0.5 * std::abs(box.size.z()) + 0.01);
+  o.lo = box.center - half;
+  o.hi = box.center + half;
+  extra_occluders_.push_back(std::move(o));
 }
 
 void RelationEvaluator::removeOccluder(const std::string& id) {
   extra_occluders_.erase(std::remove_if(extra_occluders_.begin(), extra_occluders_.end(),
-                                        [&](const auto& o) { return o.first == id; }),
+                                        [&](const auto& o) { return o.id == id; }),
                          extra_occluders_.end());
 }
 
@@ -90,9 +99,12 @@ bool RelationEvaluator::lineOfSight(const Subject& a, const Subject& b) const {
     }
   }
   if (!world_.occluders().clear(a.box.center, b.box.center, ignore)) return false;
-  for (const auto& [id, box] : extra_occluders_) {
-    if (id == a.id || id == b.id) continue;
-    if (box.intersectsSegment(a.box.center, b.box.center)) return false;
+  const Vec3 &p = a.box.center, &q = b.box.center;
+  const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+  for (const ExtraOccluder& o : extra_occluders_) {
+    if ((lo.array() > o.hi.array()).any() || (hi.array() < o.lo.array()).any()) continue;
+    if (o.id == a.id || o.id == b.id) continue;
+    if (o.box.intersectsSegment(p, q, o.cos_yaw, o.sin_yaw)) return false;
   }
   return true;
 }

@@ -93,7 +93,15 @@ class RelationEvaluator {
  private:
   const World& world_;
   RelationConfig config_;
-  std::vector<std::pair<std::string, geometry::OrientedBox>> extra_occluders_;
+  // An occluder added by addOccluder(): its box's yaw cosine and sine, and bounds that hold the
+  // box with a centimetre to spare (a sight line that misses them misses the box).
+  struct ExtraOccluder {
+    std::string id;
+    geometry::OrientedBox box;
+    double cos_yaw = 1.0, sin_yaw = 0.0;
+    geometry::Vec3 lo, hi;
+  };
+  std::vector<ExtraOccluder> extra_occluders_;
 };
 
 // The classes that each operator considers as related entities.
