@@ -7,7 +7,7 @@ the outcome and the follow phase's figures from metrics.json (the ADK's ground t
 find, the approach to the envelope, the inside fraction, the longest stretch outside and the
 failure, the wall time, and the success count with the failures grouped by cause.
 
-  /usr/bin/python3 bench/bench_follow.py [--count 10] [--seed 1] [--pursue true|false]
+  /usr/bin/python3 bench/bench_follow.py [--count 10] [--seed 1] [--first 0] [--pursue true|false]
       [--out DIR] [--jobs 1]
 
 --jobs runs that many missions at once, each on its own ROS master.
@@ -53,7 +53,7 @@ def main():
     ap = pursuit_arguments()
     a = ap.parse_args()
     out = a.out or tempfile.mkdtemp(prefix="hameritt_bench_follow.")
-    dirs = generate("follow", a.count, a.seed, out)
+    dirs = generate("follow", a.count, a.seed, out, ["--first", str(a.first)])
 
     def report(r):
         find = r.get("find")

@@ -6,7 +6,7 @@ mission.launch (mode maneuver_only, lock-step, as fast as it goes, the mission's
 unless --time-limit), then prints per scenario the outcome, the target's in-view time and
 fraction (from metrics.json, the ADK's ground truth) and the wall time, and the success count.
 
-  /usr/bin/python3 bench/bench_pursuit.py [--count 10] [--seed 1] [--pursue true|false]
+  /usr/bin/python3 bench/bench_pursuit.py [--count 10] [--seed 1] [--first 0] [--pursue true|false]
       [--time-limit 0] [--out DIR] [--jobs 1]
 
 --jobs runs that many missions at once, each on its own ROS master.
@@ -40,7 +40,7 @@ def main():
     ap.add_argument("--time-limit", type=float, default=0.0, help="0: the mission's")
     a = ap.parse_args()
     out = a.out or tempfile.mkdtemp(prefix="hameritt_bench_pursuit.")
-    dirs = generate("pursuit", a.count, a.seed, out)
+    dirs = generate("pursuit", a.count, a.seed, out, ["--first", str(a.first)])
 
     def report(r):
         print("%-26s %-8s in view %6.1f s of %4.0f s (%3.0f %%), first seen %s, wall %.0f s"

@@ -65,12 +65,14 @@ def fly_all(dirs, out, jobs, fly, report):
 
 
 def pursuit_arguments():
-    """The options bench_pursuit.py and bench_follow.py share: --count, --seed, --pursue,
-    --jobs, --out."""
+    """The options bench_pursuit.py and bench_follow.py share: --count, --seed, --first,
+    --pursue, --jobs, --out."""
     import argparse
     ap = argparse.ArgumentParser()
     ap.add_argument("--count", type=int, default=10)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--first", type=int, default=0,
+                    help="fly scenarios FIRST .. FIRST+COUNT-1 of the seed's batch (a shard)")
     ap.add_argument("--pursue", default="true", choices=["true", "false"])
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", default=None)
