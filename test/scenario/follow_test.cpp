@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "hameritt/scenario/mission_io.h"
@@ -70,11 +71,60 @@ TEST(FollowGeneratorTest, ScenariosAreWellPosedInTheSuburbAndTheCity) {
 }
 
 TEST(FollowGeneratorTest, DeterministicAndPursuitUnchanged) {
-  // The follow scene is pursuit's with the same seed: the target, its look and its trajectory.
+  // The follow scene is pursuit's with the same seed: the target and its look (its route too,
+  // driven no faster than the cap of TargetsNeverOutrunTheUav).
   const auto [a, p] = expectDeterministicOverPursuit(ScenarioClass::kFollow, 7);
   EXPECT_DOUBLE_EQ(
       a.mission.time_limit,
       p.mission.time_limit + a.mission.phases[1].follow.approach_s + *a.mission.phases[1].duration);
+}
+
+// The fastest a trajectory moves over any stretch of at least 1 s (positions are rounded to the
+// millimetre: over a second that is at most 2 mm/s of error).
+double topSpeed(const Trajectory& tr) {
+  double top = 0.0;
+  for (std::size_t i = 0; i < tr.size(); ++i) {
+    double run = 0.0;
+    for (std::size_t j = i + 1; j < tr.size(); ++j) {
+      run += std::hypot(tr[j].x - tr[j - 1].x, tr[j].y - tr[j - 1].y);
+      if (tr[j].t - tr[i].t >= 1.0) {
+        top = std::max(top, run / (tr[j].t - tr[i].t));
+        break;
+      }
+    }
+  }
+  return top;
+}
+
+// Follow and track targets drive no faster than 0.75 of the UAV's top speed (a follower must
+// gain on them); the pursuit targets of the same seeds, drawn from car_speed up to 13 m/s, are
+// the control that the measure finds a faster car.
+TEST(FollowGeneratorTest, TargetsNeverOutrunTheUav) {
+  double fastest_pursuit = 0.0;
+  for (const auto cls : {ScenarioClass::kFollow, ScenarioClass::kTrack, ScenarioClass::kPursuit}) {
+    double fastest = 0.0;
+    int targets = 0;
+    for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+      const Scenario s = generateScenario(shippedWorld(), shippedConfig(), cls, seed);
+      const double cap = 0.75 * s.sim.uav.max_speed;
+      for (const auto& t : s.mission.objective.targets) {
+        for (const auto& e : s.sim.entities) {
+          if (e.entity.id != t.id) continue;
+          const double v = topSpeed(e.trajectory);
+          fastest = std::max(fastest, v);
+          ++targets;
+          if (cls != ScenarioClass::kPursuit) {
+            EXPECT_LE(v, cap + 0.05) << s.mission.scenario_id << " " << t.id;
+          }
+        }
+      }
+    }
+    std::printf("%s: %d targets of seeds 1-12, fastest %.2f m/s over a second\n", toString(cls),
+                targets, fastest);
+    EXPECT_GE(targets, 12);
+    if (cls == ScenarioClass::kPursuit) fastest_pursuit = fastest;
+  }
+  EXPECT_GT(fastest_pursuit, 0.75 * shippedConfig().uav_max_speed + 0.5);
 }
 
 TEST(FollowGeneratorTest, FollowPhaseRuleCatchesDoctoredMissions) {
