@@ -27,29 +27,50 @@ struct Box : ClearanceBox {
   }
 };
 
-// The pose of a footprint at scenario time t, walking its trajectory forward (t never
-// decreases between calls): the interpolation of sampleTrajectory() without its search.
+// A footprint's position at scenario times that never decrease between calls:
+// sampleTrajectory(*f.trajectory, t + f.time_shift) (or the standing pose), its segment searched
+// once and then walked on, and the yaw (two wrapPi) only when asked for; the same operations as
+// sampleTrajectory's, so the same numbers.
 class Cursor {
  public:
   explicit Cursor(const MovingFootprint& f) : f_(f) {}
 
   bool moving() const { return f_.trajectory && f_.trajectory->size() >= 2; }
 
-  TrajectoryPoint at(double t) {
-    if (!moving()) return f_.pose;
-    const Trajectory& tr = *f_.trajectory;
-    const double te = t + f_.time_shift;
-    while (i_ + 1 < tr.size() && tr[i_ + 1].t <= te) ++i_;
-    if (te <= tr.front().t) return tr.front();
-    if (i_ + 1 >= tr.size()) return tr.back();
-    const TrajectoryPoint &a = tr[i_], &b = tr[i_ + 1];
-    const double u = b.t > a.t ? (te - a.t) / (b.t - a.t) : 1.0;
-    TrajectoryPoint p;
-    p.t = te;
-    p.x = a.x + u * (b.x - a.x);
-    p.y = a.y + u * (b.y - a.y);
-    p.yaw = geometry::wrapPi(a.yaw + u * geometry::wrapPi(b.yaw - a.yaw));
-    return p;
+  // The position at t; yaw() then gives the yaw there.
+  void at(double t, double* x, double* y) {
+    pose_ = &f_.pose;
+    if (moving()) {
+      const Trajectory& tr = *f_.trajectory;
+      const double te = t + f_.time_shift;
+      const auto by_t = [](double v, const TrajectoryPoint& p) { return v < p.t; };
+      if (!searched_) {
+        const auto it = std::upper_bound(tr.begin(), tr.end(), te, by_t);
+        i_ = it == tr.begin() ? 0 : static_cast<std::size_t>(it - tr.begin()) - 1;
+        searched_ = true;
+      }
+      while (i_ + 1 < tr.size() && tr[i_ + 1].t <= te) ++i_;
+      if (te <= tr.front().t) {
+        pose_ = &tr.front();
+      } else if (i_ + 1 >= tr.size()) {
+        pose_ = &tr.back();
+      } else {
+        pose_ = nullptr;
+        const TrajectoryPoint &a = tr[i_], &b = tr[i_ + 1];
+        u_ = b.t > a.t ? (te - a.t) / (b.t - a.t) : 1.0;
+        *x = a.x + u_ * (b.x - a.x);
+        *y = a.y + u_ * (b.y - a.y);
+        return;
+      }
+    }
+    *x = pose_->x;
+    *y = pose_->y;
+  }
+
+  double yaw() const {
+    if (pose_) return pose_->yaw;
+    const TrajectoryPoint &a = (*f_.trajectory)[i_], &b = (*f_.trajectory)[i_ + 1];
+    return geometry::wrapPi(a.yaw + u_ * geometry::wrapPi(b.yaw - a.yaw));
   }
 
   // Extends b by the trajectory's vertices strictly inside (ta, tb) of scenario time, from the
@@ -68,7 +89,10 @@ class Cursor {
 
  private:
   const MovingFootprint& f_;
-  std::size_t i_ = 0;
+  std::size_t i_ = 0;  // the segment [i_, i_ + 1] under the last time asked
+  bool searched_ = false;
+  double u_ = 0.0;
+  const TrajectoryPoint* pose_ = nullptr;  // a standing or clamped pose, else interpolated
 };
 
 std::size_t fineSamples(double duration) {
@@ -83,16 +107,17 @@ double reach(const MovingFootprint& f, double margin) {
 // grown by r: a trajectory is straight between its points, so its positions over the interval
 // lie in the box of its ends and the points between them.
 Box boxOver(Cursor& c, double ta, double tb, double r) {
-  const TrajectoryPoint a = c.at(ta);
+  double ax = 0, ay = 0, ex = 0, ey = 0;
+  c.at(ta, &ax, &ay);
   Box b;
-  b.min_x = b.max_x = a.x;
-  b.min_y = b.max_y = a.y;
+  b.min_x = b.max_x = ax;
+  b.min_y = b.max_y = ay;
   c.vertices(ta, tb, &b);
-  const TrajectoryPoint e = c.at(tb);
-  b.min_x = std::min(b.min_x, e.x) - r;
-  b.max_x = std::max(b.max_x, e.x) + r;
-  b.min_y = std::min(b.min_y, e.y) - r;
-  b.max_y = std::max(b.max_y, e.y) + r;
+  c.at(tb, &ex, &ey);
+  b.min_x = std::min(b.min_x, ex) - r;
+  b.max_x = std::max(b.max_x, ex) + r;
+  b.min_y = std::min(b.min_y, ey) - r;
+  b.max_y = std::max(b.max_y, ey) + r;
   return b;
 }
 
@@ -148,65 +173,11 @@ std::vector<Box> cachedBlockBoxes(const MovingFootprint& f, std::size_t n) {
   return out;
 }
 
-// sampleTrajectory(*f.trajectory, t + f.time_shift) (or the standing pose) at times that never
-// decrease between calls: the segment is searched once and then walked on, and the position
-// comes first, the yaw (two wrapPi) only when asked for; both are the same operations as
-// sampleTrajectory's, so the same numbers.
-class Walker {
- public:
-  explicit Walker(const MovingFootprint& f)
-      : tr_(f.trajectory && f.trajectory->size() >= 2 ? f.trajectory : nullptr), f_(f) {}
-
-  // The position at t; yaw() then gives the yaw there.
-  void at(double t, double* x, double* y) {
-    if (!tr_) {
-      pose_ = &f_.pose;
-      *x = pose_->x;
-      *y = pose_->y;
-      return;
-    }
-    const Trajectory& tr = *tr_;
-    const double te = t + f_.time_shift;
-    if (te <= tr.front().t || te >= tr.back().t) {
-      pose_ = te <= tr.front().t ? &tr.front() : &tr.back();
-      *x = pose_->x;
-      *y = pose_->y;
-      return;
-    }
-    pose_ = nullptr;
-    if (i_ == 0) {
-      i_ = static_cast<std::size_t>(
-          std::upper_bound(tr.begin() + 1, tr.end(), te,
-                           [](double v, const TrajectoryPoint& p) { return v < p.t; }) -
-          tr.begin());
-    }
-    while (tr[i_].t <= te) ++i_;  // te < back().t: stops inside
-    const TrajectoryPoint &a = tr[i_ - 1], &b = tr[i_];
-    const double span = b.t - a.t;
-    u_ = span > 0 ? (te - a.t) / span : 1.0;
-    *x = a.x + u_ * (b.x - a.x);
-    *y = a.y + u_ * (b.y - a.y);
-  }
-
-  double yaw() const {
-    if (pose_) return pose_->yaw;
-    const TrajectoryPoint &a = (*tr_)[i_ - 1], &b = (*tr_)[i_];
-    return geometry::wrapPi(a.yaw + u_ * geometry::wrapPi(b.yaw - a.yaw));
-  }
-
- private:
-  const Trajectory* tr_;
-  const MovingFootprint& f_;
-  std::size_t i_ = 0;
-  double u_ = 0.0;
-  const TrajectoryPoint* pose_ = nullptr;
-};
-
 // The first fine sample of block `j` at which a and b overlap (grown by margin).
 std::optional<double> overlapInBlock(const MovingFootprint& a, const MovingFootprint& b,
                                      std::size_t j, std::size_t n, double margin) {
   const double rr = reach(a, margin) + reach(b, margin);
-  Walker wa(a), wb(b);
+  Cursor wa(a), wb(b);
   for (std::size_t k = j * kBlock; k < std::min((j + 1) * kBlock, n); ++k) {
     const double t = static_cast<double>(k) * kClearanceStep;
     double px = 0, py = 0, qx = 0, qy = 0;
