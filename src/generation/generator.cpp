@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <set>
 #include <unordered_map>
@@ -1524,8 +1525,8 @@ class ScenarioBuilder {
   // ------------------------------------------------------------------ track
   // The track class: pursuit's scene with one or two moving targets (the second, drawn from
   // track_targets_min/max, waits in the lane 12 m behind the first one's kerb slot and drives
-  // the same streets 2.5 s after it, as route search's convoy: when no such route exists the
-  // scenario keeps one target), in two phases: find them, then keep them in a camera's view for
+  // the same streets two seconds behind it, a convoy: when no such route exists the scenario
+  // keeps one target), in two phases: find them, then keep them in a camera's view for
   // a drawn duration. Look-alike parked cars (addConfusers) stand along the streets, and the
   // routes pass the street trees and buildings that occlude the targets. The time limit is
   // pursuit's plus the duration.
@@ -1569,9 +1570,32 @@ class ScenarioBuilder {
   }
 
   // The track class's second target: a car of its own look that waits in the lane 12 m behind
-  // the first target's kerb slot, departs 2.5 s after the first target has pulled out into the
-  // lane and stops 12 m short of the first target's stop, on the same streets (checked: else
-  // none).
+  // the first target's kerb slot, drives the same streets kConvoyTimeGap behind the first
+  // target at cruise (the two-second rule; both set off from rest and speed up alike, so the
+  // gap is never less) and stops 12 m short of the first target's stop (checked: else none).
+  // It sets off before the first target has pulled out when the wait's 22 m exceed the gap.
+  static constexpr double kConvoyTimeGap = 2.0;  // s
+  // The point of a trajectory `arc` m of path on from its point `from` (its last if shorter).
+  static TrajectoryPoint arcPoint(const Trajectory& traj, std::size_t from, double arc) {
+    for (std::size_t i = from + 1; i < traj.size(); ++i) {
+      arc -= std::hypot(traj[i].x - traj[i - 1].x, traj[i].y - traj[i - 1].y);
+      if (arc <= 0.0) return traj[i];
+    }
+    return traj.back();
+  }
+  // When a trajectory passes closest to a point (linear between its samples).
+  static double passTime(const Trajectory& traj, const TrajectoryPoint& at) {
+    double best = std::numeric_limits<double>::infinity(), t = traj.front().t;
+    for (std::size_t i = 1; i < traj.size(); ++i) {
+      const Vec2 a(traj[i - 1].x, traj[i - 1].y), b(traj[i].x, traj[i].y), q(at.x, at.y);
+      const Vec2 ab = b - a;
+      const double u = std::clamp(ab.squaredNorm() > 1e-12 ? (q - a).dot(ab) / ab.squaredNorm()
+                                                           : 0.0, 0.0, 1.0);
+      const double d = (a + u * ab - q).squaredNorm();
+      if (d < best) best = d, t = traj[i - 1].t + u * (traj[i].t - traj[i - 1].t);
+    }
+    return t;
+  }
   void addConvoyTarget() {
     Mission& m = sc_.mission;
     const catalog::CarModel* model;
@@ -1589,7 +1613,7 @@ class ScenarioBuilder {
     TrajectoryPoint start = p;
     start.x = roundMilli(p.x - back * std::cos(p.yaw));
     start.y = roundMilli(p.y - back * std::sin(p.yaw));
-    start.t = roundMilli(p.t + 2.5);
+    start.t = p.t;
     const TrajectoryPoint& le = pursuit_route_.end;
     planning::RouteGoal g;
     g.pose = TrajectoryPoint{0.0, roundMilli(le.x - 12.0 * std::cos(le.yaw)),
@@ -1599,8 +1623,16 @@ class ScenarioBuilder {
     std::vector<int> fnodes = follow.nodes;
     fnodes.push_back(pursuit_route_.nodes.back());
     if (!follow.ok() || follow.trajectory.size() < 2 || fnodes != pursuit_route_.nodes) return;
+    // Both cars set off from rest on the same streets with the same speeds, so past the first
+    // car's speed-up (and a first corner's) their time gap stays what it is 60 m on: the
+    // second car's departure is shifted to make it kConvoyTimeGap (and at least 0.5 s in the
+    // lane). Times are linear in the departure, so the shift is the replanned trajectory.
+    const double gap = passTime(follow.trajectory, arcPoint(lead->trajectory, 11, 60.0)) -
+                       arcPoint(lead->trajectory, 11, 60.0).t;
+    const double depart = roundMilli(std::max(p.t + kConvoyTimeGap - gap, 0.5));
     Trajectory traj = follow.trajectory;
-    TrajectoryPoint wait = start;
+    for (auto& q : traj) q.t = roundMilli(q.t + (depart - p.t));
+    TrajectoryPoint wait = traj.front();
     wait.t = 0.0;
     traj.insert(traj.begin(), wait);  // waits in its lane until it departs
     // In the city it stops 12 m behind the first target (else none).
