@@ -172,6 +172,7 @@ int main(int argc, char** argv) {
   }
   const GeneratorConfig gc = loadGeneratorConfig(defaultConfigDir() + "/generator.json");
   auto t0 = std::chrono::steady_clock::now();
+  keepFreedMemoryForBatches();  // as hameritt_generate
   const World world = generateWorld(wp);
   const double world_s = seconds(t0);
 

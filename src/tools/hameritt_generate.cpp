@@ -91,6 +91,7 @@ int main(int argc, char** argv) {
   std::string spec_file, sampler_name = "random";
   std::vector<std::string> params;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  hameritt::scenario::keepFreedMemoryForBatches();
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
