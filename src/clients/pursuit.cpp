@@ -207,6 +207,29 @@ double levelReach(const scenario::CameraSpec& camera, double height) {
   return std::max(0.0, height) * std::hypot(th, tv);
 }
 
+geometry::Vec2 tiltedAxisShift(const scenario::CameraSpec& camera,
+                               const Eigen::Quaterniond& attitude, double height) {
+  constexpr double kDeg = geometry::kPi / 180.0;
+  // The optical axis in the body frame: x turned by the mount's yaw, pitch (positive looks
+  // down) and roll.
+  const Eigen::Matrix3d mount =
+      (Eigen::AngleAxisd(camera.mount_rpy.z() * kDeg, Vec3::UnitZ()) *
+       Eigen::AngleAxisd(camera.mount_rpy.y() * kDeg, Vec3::UnitY()) *
+       Eigen::AngleAxisd(camera.mount_rpy.x() * kDeg, Vec3::UnitX()))
+          .toRotationMatrix();
+  const Vec3 body_axis = mount * Vec3::UnitX();
+  // The same heading, level.
+  const Vec3 fwd = attitude * Vec3::UnitX();
+  const double yaw = std::atan2(fwd.y(), fwd.x());
+  const Vec3 tilted = attitude * body_axis;
+  const Vec3 level = Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * body_axis;
+  const double min_down = std::sin(10.0 * kDeg);
+  if (-tilted.z() < min_down || -level.z() < min_down || height <= 0.0) return Vec2::Zero();
+  const Vec2 hit_tilted = tilted.head<2>() * (height / -tilted.z());
+  const Vec2 hit_level = level.head<2>() * (height / -level.z());
+  return hit_tilted - hit_level;
+}
+
 ViewpointChooser::ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
                                    const std::vector<scenario::KeepOutZone>& kozs,
                                    const PursuitSettings& settings)

@@ -51,6 +51,10 @@ constexpr double kBranchAfter = 0.5;
 constexpr double kParkedRadius = 1.5;
 // Several targets held in one image: metres to spare beyond the outermost ones.
 constexpr double kGroupMargin = 4.0;
+// Per pursuit tick (10 Hz by default): the tilt shift's running average, about 4 s.
+constexpr double kTiltAveraging = 0.025;
+// The tilt is averaged only while the UAV is within this many metres of its shifted viewpoint.
+constexpr double kTiltStation = 8.0;
 // A sighting this close to the pursued vehicle's prediction is that vehicle.
 constexpr double kSameVehicle = 6.0;
 // A prediction this fast (m/s) is of a vehicle driving: a look-alike standing still is not it.
@@ -669,6 +673,7 @@ void CoverageSearchClientRos::startPursuit(const std::string& why) {
   planner_sent_at_ = -1e9;
   lost_ = false;
   losses_ = 0;
+  tilt_shift_.setZero();
   const auto& s = predictor_->last();
   ROS_INFO("%s: %s: pursuing it from (%.1f, %.1f), %.1f m/s, standoff %.1f m, height %.1f m",
            kClientName, why.c_str(), s.position.x(), s.position.y(), s.speed, pursuit_.standoff,
@@ -697,6 +702,7 @@ void CoverageSearchClientRos::onPursuitTick() {
                                   : predictor_->predict(t + pursuit_.lead);
   // A track phase with several targets in the ADK's state: all of them in the scored camera,
   // from above their midpoint, high enough to hold them across the image.
+  bool grouped = false;
   if (track_phase_ && !lost_ && track_camera_) {
     std::vector<clients::VehicleState> group{v};
     for (const auto& kv : other_targets_) {
@@ -710,12 +716,36 @@ void CoverageSearchClientRos::onPursuitTick() {
       }
     }
     if (group.size() > 1) {
+      grouped = true;
       const clients::GroupView g = clients::groupView(group, *track_camera_, kGroupMargin);
       v = g.centre;
       climb = std::max(climb, g.height - pursuit_.height);
     }
   }
-  const clients::PursuitView view = chooser_->choose(v, uav, t, climb);
+  clients::PursuitView view = chooser_->choose(v, uav, t, climb);
+  if (track_phase_ && track_camera_) {
+    // The UAV tilts into its flight and the nadir camera with it: fly the difference ahead, so
+    // that the tilted axis, not the point below the UAV, lies on the target. Averaged over
+    // about 4 s: the tilt that flying ahead itself causes (a speed-up, then braking) averages
+    // out, the steady tilt against drag and wind stays (a shorter average fed back on itself:
+    // speeding up tilts more, which moves the viewpoint farther ahead).
+    // Only the tilt of keeping station counts: not that of catching up from afar.
+    const geometry::Vec2 station = view.position.head<2>() - tilt_shift_;
+    if ((uav.head<2>() - station).norm() < kTiltStation) {
+      const auto& q = odom_->pose.pose.orientation;
+      const Eigen::Quaterniond attitude(q.w, q.x, q.y, q.z);
+      const geometry::Vec2 shift = clients::tiltedAxisShift(
+          *track_camera_, attitude.normalized(), uav.z() - v.position.z());
+      tilt_shift_ += kTiltAveraging * (shift - tilt_shift_);
+    }
+    view.position.head<2>() -= tilt_shift_;
+    // Straight above one vehicle, the image's wider axis along its way (as the group view lays
+    // it along the cars' line): the leading edge is then half the horizontal field ahead, not
+    // half the vertical one.
+    if (!grouped && (view.position - v.position).head<2>().norm() < 12.0) {
+      view.yaw = std::remainder(v.yaw + 0.5 * geometry::kPi, 2.0 * geometry::kPi);
+    }
+  }
   const ros::Time now = ros::Time::now();
   ROS_INFO_THROTTLE(10.0,
                     "%s: pursuit t %.1f: UAV (%.1f, %.1f, %.1f), last sighting %.1f s ago at "

@@ -460,6 +460,49 @@ TEST(Pursuit, NothingBeyondALevelCamerasReachIsInItsImage) {
               beyond_seen, inside, inside_seen, inside);
 }
 
+// A quadrotor tilts into its flight, and its nadir camera looks behind the point below it:
+// tiltedAxisShift gives where the axis meets the ground less where it meets it level, by hand:
+// pitched 15 degrees nose down heading north from 22.5 m, 22.5 tan 15 = 6.03 m south; rolled 10
+// degrees (left side up) heading east, 22.5 tan 10 = 3.97 m north (the left); level, or a
+// camera that does not look down 10 degrees (the front camera, level), none.
+TEST(Pursuit, ATiltedNadirCameraLooksBehindThePointBelowIt) {
+  const scenario::CameraSpec *down = nullptr, *front = nullptr;
+  for (const auto& c : sim().uav.cameras) {
+    if (c.name == "down") down = &c;
+    if (c.name == "front") front = &c;
+  }
+  ASSERT_TRUE(down && front);
+  using Eigen::AngleAxisd;
+  const double deg = geometry::kPi / 180.0;
+  const Eigen::Quaterniond north_nose_down(AngleAxisd(90 * deg, Vec3::UnitZ()) *
+                                           AngleAxisd(15 * deg, Vec3::UnitY()));
+  const Vec2 a = tiltedAxisShift(*down, north_nose_down, 22.5);
+  EXPECT_NEAR(a.x(), 0.0, 1e-9);
+  EXPECT_NEAR(a.y(), -22.5 * std::tan(15 * deg), 1e-9);
+  const Eigen::Quaterniond east_rolled(AngleAxisd(10 * deg, Vec3::UnitX()));
+  const Vec2 b = tiltedAxisShift(*down, east_rolled, 22.5);
+  EXPECT_NEAR(b.x(), 0.0, 1e-9);
+  EXPECT_NEAR(b.y(), 22.5 * std::tan(10 * deg), 1e-9);
+  const Eigen::Quaterniond level(AngleAxisd(1.3, Vec3::UnitZ()));
+  EXPECT_NEAR(tiltedAxisShift(*down, level, 40.0).norm(), 0.0, 1e-9);
+  EXPECT_EQ(tiltedAxisShift(*front, level, 40.0), Vec2::Zero());  // looks down 6 degrees
+  EXPECT_EQ(tiltedAxisShift(*down, north_nose_down, -1.0), Vec2::Zero());
+  // The shift, flown ahead, puts the tilted axis where the level axis from the point meets the
+  // ground (a check by the camera's own rays, not the formula).
+  const Eigen::Matrix3d mount = (AngleAxisd(down->mount_rpy.z() * deg, Vec3::UnitZ()) *
+                                 AngleAxisd(down->mount_rpy.y() * deg, Vec3::UnitY()) *
+                                 AngleAxisd(down->mount_rpy.x() * deg, Vec3::UnitX()))
+                                    .toRotationMatrix();
+  const Vec3 ray = north_nose_down * (mount * Vec3::UnitX());
+  const Vec3 from(10.0 - a.x(), 20.0 - a.y(), 22.5);
+  const Vec3 hit = from + ray * (from.z() / -ray.z());
+  const Vec3 level_ray = AngleAxisd(90 * deg, Vec3::UnitZ()) * (mount * Vec3::UnitX());
+  const Vec3 level_hit = Vec3(10.0, 20.0, 22.5) + level_ray * (22.5 / -level_ray.z());
+  EXPECT_NEAR(hit.x(), level_hit.x(), 1e-9);
+  EXPECT_NEAR(hit.y(), level_hit.y(), 1e-9);
+  EXPECT_GT(from.y() - 20.0, 6.0);  // flown 6 m ahead (north) of the point
+}
+
 TEST(Pursuit, AGroupViewHoldsEveryVehicleInTheDownCamera) {
   // Two cars 25 m apart on a street line: from the group view's height above their midpoint,
   // yawed across their line, the down camera sees both body centres. Negative controls: yawed

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "hameritt/geometry/types.h"
 #include "hameritt/scenario/scenario.h"
 #include "hameritt/scenario/world.h"
@@ -97,6 +99,16 @@ GroupView groupView(const std::vector<VehicleState>& vehicles, const scenario::C
 // still be in its image: half the image's diagonal on the ground. A sighting farther than this
 // came while the UAV was tilted (a manoeuvre's glimpse), not from a camera that holds it.
 double levelReach(const scenario::CameraSpec& camera, double height);
+
+// Where a camera's optical axis meets the ground `height` m below it, tilted with the UAV's
+// attitude (`attitude`: body FLU to world, unit), less where it meets it when the UAV is level
+// with the same heading (horizontal, world frame). A quadrotor tilts into its flight: at 9 m/s
+// against its drag the Sentinel pitches about 15 degrees nose down, so a nadir camera then looks
+// 6 m behind the point below it from 22 m up, and 15 m behind it in a headwind of 8 m/s: the
+// pursuit aims the axis, not the UAV, at the target by flying this much ahead of it. Zero when
+// the tilted axis does not look down at least 10 degrees below the horizon.
+geometry::Vec2 tiltedAxisShift(const scenario::CameraSpec& camera, const Eigen::Quaterniond& attitude,
+                               double height);
 
 // A place to look from.
 struct PursuitView {

@@ -168,6 +168,8 @@ class CoverageSearchClientRos {
   // A track phase: metres behind the predicted vehicle (0: straight above it), where the
   // scored camera (~track_claim_camera) looks down on it.
   double track_standoff_ = 0.0;
+  // The smoothed ground shift of the scored camera's axis by the UAV's tilt (tiltedAxisShift).
+  geometry::Vec2 tilt_shift_{0.0, 0.0};
 
   // Avoid.
   bool avoid_enabled_ = true, avoid_planned_ = false, avoid_arrived_ = false;
