@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "hameritt/clients/color_detector.h"
 #include "hameritt/geometry/segment.h"
 #include "hameritt/planning/look_at.h"
 #include "hameritt/scenario/error.h"
@@ -209,21 +210,16 @@ double levelReach(const scenario::CameraSpec& camera, double height) {
 
 geometry::Vec2 tiltedAxisShift(const scenario::CameraSpec& camera,
                                const Eigen::Quaterniond& attitude, double height) {
-  constexpr double kDeg = geometry::kPi / 180.0;
-  // The optical axis in the body frame: x turned by the mount's yaw, pitch (positive looks
-  // down) and roll.
-  const Eigen::Matrix3d mount =
-      (Eigen::AngleAxisd(camera.mount_rpy.z() * kDeg, Vec3::UnitZ()) *
-       Eigen::AngleAxisd(camera.mount_rpy.y() * kDeg, Vec3::UnitY()) *
-       Eigen::AngleAxisd(camera.mount_rpy.x() * kDeg, Vec3::UnitX()))
-          .toRotationMatrix();
-  const Vec3 body_axis = mount * Vec3::UnitX();
-  // The same heading, level.
+  // The optical axis (the optical frame's z) with the UAV's attitude, and with the same
+  // heading, level.
+  const auto axis = [&](const Eigen::Quaterniond& q) -> Vec3 {
+    return opticalPose(Eigen::Isometry3d(q), Vec3::Zero(), camera.mount_rpy).linear().col(2);
+  };
   const Vec3 fwd = attitude * Vec3::UnitX();
-  const double yaw = std::atan2(fwd.y(), fwd.x());
-  const Vec3 tilted = attitude * body_axis;
-  const Vec3 level = Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * body_axis;
-  const double min_down = std::sin(10.0 * kDeg);
+  const Vec3 tilted = axis(attitude);
+  const Vec3 level =
+      axis(Eigen::Quaterniond(Eigen::AngleAxisd(std::atan2(fwd.y(), fwd.x()), Vec3::UnitZ())));
+  const double min_down = std::sin(10.0 * geometry::kPi / 180.0);
   if (-tilted.z() < min_down || -level.z() < min_down || height <= 0.0) return Vec2::Zero();
   const Vec2 hit_tilted = tilted.head<2>() * (height / -tilted.z());
   const Vec2 hit_level = level.head<2>() * (height / -level.z());

@@ -1627,8 +1627,8 @@ class ScenarioBuilder {
     // car's speed-up (and a first corner's) their time gap stays what it is 60 m on: the
     // second car's departure is shifted to make it kConvoyTimeGap (and at least 0.5 s in the
     // lane). Times are linear in the departure, so the shift is the replanned trajectory.
-    const double gap = passTime(follow.trajectory, arcPoint(lead->trajectory, 11, 60.0)) -
-                       arcPoint(lead->trajectory, 11, 60.0).t;
+    const TrajectoryPoint mark = arcPoint(lead->trajectory, 11, 60.0);
+    const double gap = passTime(follow.trajectory, mark) - mark.t;
     const double depart = roundMilli(std::max(p.t + kConvoyTimeGap - gap, 0.5));
     Trajectory traj = follow.trajectory;
     for (auto& q : traj) q.t = roundMilli(q.t + (depart - p.t));
