@@ -1792,9 +1792,9 @@ class ScenarioBuilder {
   }
 
   // 2-6 aircraft: the first half cross the reference flight about when the UAV would get
-  // there (at 60 % of its top speed after the climb), the rest circle near it. Each clears
-  // the static obstacles, keeps 20 m from the start's column and the goal radius + 15 m from
-  // the goal horizontally, and 10 m from the aircraft before it.
+  // there (at 60 % of its top speed after the climb), the rest circle near it (or cross where
+  // no lap fits). Each clears the static obstacles, keeps 20 m from the start's column and the
+  // goal radius + 15 m from the goal horizontally, and 10 m from the aircraft before it.
   void addAircraft(const ReferenceFlight& ref, const Vec3& start, const Vec3& goal,
                    const planning::ValiditySettings& vs) {
     const planning::WorldValidity band(world_, std::vector<KeepOutZone>{}, vs);
@@ -1821,35 +1821,51 @@ class ScenarioBuilder {
       ac.model = fixed_wing ? "fixed_wing" : "quadrotor";
       ac.size = fixed_wing ? Vec3(1.2, 2.0, 0.35) : Vec3(0.6, 0.6, 0.25);
       const double speed = fixed_wing ? rng_.uniform(10.0, 16.0) : rng_.uniform(4.0, 9.0);
+      bool crossed = false;  // the kind of the pattern that fitted
       for (int attempt = 0; attempt < 60 && ac.trajectory.empty(); ++attempt) {
         // Among tall buildings (the city) long chords and wide laps rarely fit: after 30
-        // attempts they shrink to half, and the last 15 of a crossing aircraft fly head-on.
+        // attempts they shrink to half, and the last 15 of a crossing aircraft fly head-on. An
+        // orbit that found no room in 40 attempts crosses instead (10 chords, then head-on).
         const double reach = attempt < 30 ? 1.0 : 0.5;
+        const bool crossing_slot = i < n_cross;
+        const bool cross_now = crossing_slot || attempt >= 40;
+        const bool head_on = cross_now && attempt >= (crossing_slot ? 45 : 50);
         AircraftPattern pat;
         pat.speed = roundMilli(speed);
         const double along = rng_.uniform(0.25, 0.75) * ref_len;
         const Vec2 c = geometry::polylinePointAt(ref2, along);
         const Vec2 ahead = geometry::polylinePointAt(ref2, std::min(ref_len, along + 1.0));
         const double heading = std::atan2(ahead.y() - c.y(), ahead.x() - c.x());
-        if (i < n_cross && attempt >= 45) {
+        if (head_on) {
           // Last resort among tall buildings: head-on along the reference flight's longest leg,
           // a little above it (what clears the leg clears anything higher), 25 m short of its
-          // ends.
+          // ends. An orbit's slot that gets here tries the second-longest leg and the longest
+          // one 10 m higher in turn (the longest leg may hold the crossing aircraft already).
           pat.kind = AircraftPattern::Kind::kCrossing;
           const double lift = rng_.uniform(0.5, 3.0);
           const double jitter = rng_.uniform(-6.0, 6.0);
-          std::size_t leg = 0;
-          double leg_len = 0.0, leg_start = 0.0, acc = 0.0;
+          std::size_t leg = 0, leg2 = 0;
+          double leg_len = 0.0, leg_start = 0.0, leg2_len = 0.0, leg2_start = 0.0, acc = 0.0;
           for (std::size_t k = 1; k < ref.path.size(); ++k) {
             const double h = (ref.path[k] - ref.path[k - 1]).head<2>().norm();
-            if (h > leg_len) leg = k, leg_len = h, leg_start = acc;
+            if (h > leg_len) {
+              leg2 = leg, leg2_len = leg_len, leg2_start = leg_start;
+              leg = k, leg_len = h, leg_start = acc;
+            } else if (h > leg2_len) {
+              leg2 = k, leg2_len = h, leg2_start = acc;
+            }
             acc += h;
           }
+          const bool second = !crossing_slot && attempt % 2 == 1;
+          const double above = !crossing_slot && !second ? 10.0 : 0.0;
+          if (second) leg = leg2, leg_len = leg2_len, leg_start = leg2_start;
           if (leg_len < 60.0) continue;
           const Vec3 p0 = ref.path[leg - 1], p1 = ref.path[leg];
           const double u = 25.0 / leg_len;
           Vec3 a3 = p0 + (p1 - p0) * (1.0 - u), b3 = p0 + (p1 - p0) * u;  // towards the start
-          const double up = std::max(a3.z(), b3.z()) + lift <= amax ? lift : 0.0;
+          const double top = std::max(a3.z(), b3.z()) + above;
+          if (above > 0 && top > amax) continue;
+          const double up = above + (top + lift <= amax ? lift : 0.0);
           a3.z() += up;
           b3.z() += up;
           if (!clearOfEnds(a3.head<2>(), b3.head<2>())) continue;
@@ -1857,7 +1873,7 @@ class ScenarioBuilder {
           pat.b = Vec3(roundMilli(b3.x()), roundMilli(b3.y()), roundMilli(b3.z()));
           pat.cross = 0.5 * (pat.a + pat.b);
           pat.t_cross = std::max(0.0, t_climb + (leg_start + 0.5 * leg_len) / v_nominal + jitter);
-        } else if (i < n_cross) {
+        } else if (cross_now) {
           pat.kind = AircraftPattern::Kind::kCrossing;
           const double turn = rng_.uniform(0.7, 2.4);
           const double side = rng_.bernoulli(0.5) ? 1.0 : -1.0;
@@ -1906,10 +1922,13 @@ class ScenarioBuilder {
             ok = std::hypot(std::hypot(p.x - q.x, p.y - q.y), p.z - q.z) >= 10.0;
           }
         }
-        if (ok) ac.trajectory = std::move(traj);
+        if (ok) {
+          ac.trajectory = std::move(traj);
+          crossed = pat.kind == AircraftPattern::Kind::kCrossing;
+        }
       }
       if (ac.trajectory.empty()) continue;
-      if (i < n_cross) ++crossing;
+      if (crossed) ++crossing;
       fleet.push_back(std::move(ac));
     }
     if (fleet.size() < 2 || crossing < 1) {

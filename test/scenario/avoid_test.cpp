@@ -159,6 +159,17 @@ TEST(AvoidGeneratorTest, CityScenariosAreWellPosed) {
     }
   }
   EXPECT_EQ(generated, 40);
+  // Two scenarios of a 3,000-scenario city batch (--seed 2026) whose orbiting aircraft found no
+  // room for a lap among the towers, and a batch stopped there: such a slot crosses instead,
+  // the second on the reference flight's longest leg 10 m above the first aircraft's head-on.
+  for (const std::uint64_t seed : {618711239684142679ULL, 7283260579867774453ULL}) {
+    try {
+      expectWellPosed(cityWorld(),
+                      generateScenario(cityWorld(), shippedConfig(), ScenarioClass::kAvoid, seed));
+    } catch (const GenerationError& e) {
+      ADD_FAILURE() << "seed " << seed << ": " << e.what();
+    }
+  }
 }
 
 TEST(AvoidGeneratorTest, SameSeedSameBytesOtherSeedOtherScenario) {
