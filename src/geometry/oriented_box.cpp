@@ -111,6 +111,24 @@ bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b) const {
 
 bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b, double cy, double sy) const {
   if (!a.allFinite() || !b.allFinite()) return false;
+  const double tol = boxTolerance(*this);
+  // The vertical slab first: it needs no rotation, and a segment wholly above a box (a flight
+  // over the rooftops) ends here. (The slabs' order does not change the answer: the interval
+  // kept is their intersection with [0, 1].)
+  const double hz = 0.5 * std::abs(size.z()) + tol;
+  const double pz = a.z() - center.z(), dz = (b.z() - center.z()) - pz;
+  double t0 = 0.0;
+  double t1 = 1.0;
+  if (dz == 0.0) {
+    if (pz < -hz || pz > hz) return false;
+  } else {
+    double enter = (-hz - pz) / dz;
+    double leave = (hz - pz) / dz;
+    if (enter > leave) std::swap(enter, leave);
+    t0 = std::max(t0, enter);
+    t1 = std::min(t1, leave);
+    if (t0 > t1) return false;
+  }
   // toBody() for both ends, with one sine and cosine.
   auto body = [&](const Vec3& w) {
     const Vec3 q = w - center;
@@ -118,10 +136,8 @@ bool OrientedBox::intersectsSegment(const Vec3& a, const Vec3& b, double cy, dou
   };
   const Vec3 p = body(a);
   const Vec3 d = body(b) - p;
-  const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(boxTolerance(*this));
-  double t0 = 0.0;
-  double t1 = 1.0;
-  for (int k = 0; k < 3; ++k) {
+  const Vec3 half = 0.5 * size.cwiseAbs() + Vec3::Constant(tol);
+  for (int k = 0; k < 2; ++k) {
     if (d[k] == 0.0) {
       if (p[k] < -half[k] || p[k] > half[k]) return false;
       continue;
