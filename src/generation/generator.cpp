@@ -1375,7 +1375,10 @@ class ScenarioBuilder {
     // The target waits at the kerb, the pedestrians run at it, and it drives off: it pulls out
     // into its lane ahead of the slot, then follows a planned route (planVehicleRoute) to a
     // node 6-12 street edges away.
-    const double depart = std::round(rangeDraw(rng_, cfg_.depart_time));
+    // (A track target waits longer, and its UAV starts nearer: see placeUavStart.)
+    const double depart = std::round(rangeDraw(
+        rng_, cls_ == ScenarioClass::kTrack ? cfg_.track_depart_time : cfg_.depart_time));
+    depart_ = depart;
     int slot = -1;
     Trajectory traj = driveOff(depart, true, &model, &slot, &pursuit_route_);
     const ParkingSlot& sl = world_.slots()[static_cast<std::size_t>(slot)];
@@ -1994,9 +1997,19 @@ class ScenarioBuilder {
       sc_.sim.uav = uav_;
       return;
     }
+    // A track mission's search must be feasible: the UAV starts within max(240 m, 60 % of its
+    // top speed x (departure - kTrackLead)) of the target, so that even at top speed (240 m:
+    // 20 s) it arrives kTrackLead s before the target departs and the area's window closes,
+    // for its climb and the sweep of the area's likeliest cell (track departures are 50-80 s).
+    // Elsewhere the start lies 120-600 m from the target.
+    constexpr double kTrackLead = 30.0;  // s
+    const double far =
+        cls_ == ScenarioClass::kTrack
+            ? std::clamp(0.6 * uav_.max_speed * (depart_ - kTrackLead), 240.0, 600.0)
+            : 600.0;
     for (int attempt = 0; attempt < kMaxAttempts; ++attempt) {
       const Vec2 p = world_.nodes()[static_cast<std::size_t>(randomNode())].position;
-      if (!allowed(p, 600.0)) continue;
+      if (!allowed(p, far)) continue;
       uav_.start = {0.0, p.x(), p.y(), 0.0,
                     roundMilli(rng_.uniform(-geometry::kPi, geometry::kPi))};
       sc_.sim.uav = uav_;
@@ -2346,6 +2359,7 @@ class ScenarioBuilder {
   UavSpec uav_;
   std::vector<char> slot_taken_;
   DriveOffRoute pursuit_route_;  // the pursuit target's route (track: the convoy follows it)
+  double depart_ = 0.0;          // when the pursuit target drives off (s)
   std::vector<int> car_ids_, ped_ids_;
   std::vector<Group> extra_groups_;
   const ScenarioPlan* plan_;

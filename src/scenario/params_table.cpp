@@ -58,6 +58,7 @@ constexpr RangeField kRangeFields[] = {
     {"runner_speed", &GeneratorConfig::runner_speed},
     {"band_width", &GeneratorConfig::band_width},
     {"depart_time", &GeneratorConfig::depart_time},
+    {"track_depart_time", &GeneratorConfig::track_depart_time},
     {"uav_altitude_min", &GeneratorConfig::uav_altitude_min},
     {"uav_altitude_max", &GeneratorConfig::uav_altitude_max},
     {"time_of_day", &GeneratorConfig::time_of_day},
@@ -378,6 +379,10 @@ void GeneratorConfig::validate() const {
   }
   if (depart_time.min < 10 || depart_time.max > time_limit_pursuit.min - 30) {
     throw ConfigError("generator.depart_time: expected 10 s to time_limit_pursuit.min - 30 s");
+  }
+  if (track_depart_time.min < 10 || track_depart_time.max > time_limit_pursuit.min - 30) {
+    throw ConfigError(
+        "generator.track_depart_time: expected 10 s to time_limit_pursuit.min - 30 s");
   }
 }
 

@@ -188,6 +188,34 @@ TEST(TrackGeneratorTest, TheConvoysSecondCarDrivesTwoSecondsBehind) {
   EXPECT_GE(convoys, 4);
 }
 
+// The search phase is feasible: the target waits 50-80 s (its area's window), and the UAV starts
+// near enough to arrive 30 s before it drives off even at top speed, within max(240 m, 60 % of
+// the top speed x (departure - 30 s)). (With pursuit's 20-60 s wait and a start up to 600 m
+// away, 11 of the 14 searches that failed in 45 lock-step missions could reach no cell of the
+// area inside its window: seen failing with pursuit's timing.)
+TEST(TrackGeneratorTest, TheUavCanReachTheTargetBeforeItDeparts) {
+  for (const World* w : {&shippedWorld(), &shippedCityWorld()}) {
+    for (std::uint64_t i = 0; i < 12; ++i) {
+      const Scenario s =
+          generateScenario(*w, shippedConfig(), ScenarioClass::kTrack, batchSeed(3, i));
+      ASSERT_FALSE(s.mission.aois.empty());
+      ASSERT_TRUE(s.mission.aois[0].window.nlt.has_value());
+      const double depart = *s.mission.aois[0].window.nlt;
+      EXPECT_GE(depart, 50.0);
+      EXPECT_LE(depart, 80.0);
+      const ScenarioEntity* target = entity(s, s.mission.objective.targets.at(0).id);
+      ASSERT_NE(target, nullptr);
+      // Standing at the kerb until the departure.
+      const TrajectoryPoint a = sampleTrajectory(target->trajectory, 0.0);
+      const TrajectoryPoint b = sampleTrajectory(target->trajectory, depart);
+      EXPECT_LT(std::hypot(a.x - b.x, a.y - b.y), 1e-6);
+      const double d = std::hypot(s.sim.uav.start.x - a.x, s.sim.uav.start.y - a.y);
+      EXPECT_LE(d, std::max(240.0, 0.6 * s.sim.uav.max_speed * (depart - 30.0)) + 1.0);
+      EXPECT_LE(d / s.sim.uav.max_speed, depart - 30.0 + 0.1) << "seed index " << i;
+    }
+  }
+}
+
 TEST(TrackGeneratorTest, DeterministicAndPursuitUnchanged) {
   // The track scene is pursuit's with the same seed: the first target, its look and its route.
   const auto [a, p] = expectDeterministicOverPursuit(ScenarioClass::kTrack, 7);
@@ -231,6 +259,10 @@ TEST(TrackGeneratorTest, ConfigRangesAreChecked) {
   c = shippedConfig();
   c.track_min_visible_fraction = 1.5;
   EXPECT_NE(messageOf([&] { c.validate(); }).find("track_min_visible_fraction"), std::string::npos);
+  c = shippedConfig();
+  c.track_depart_time = {5, 60};
+  EXPECT_NE(messageOf([&] { c.validate(); }).find("generator.track_depart_time"),
+            std::string::npos);
   c = shippedConfig();
   EXPECT_EQ(messageOf([&] { c.validate(); }), "(no error)");
 }

@@ -46,6 +46,9 @@ struct GeneratorConfig {
   int route_edges_min = 3;
   int route_edges_max = 6;
   Range depart_time{20, 60};
+  // A track target's wait: the UAV starts close enough to reach its area of interest and sweep
+  // the likeliest cell before the window (until the departure) closes.
+  Range track_depart_time{50, 80};
   Range uav_altitude_min{15, 30};
   Range uav_altitude_max{45, 120};
   double uav_max_speed = 12.0;
