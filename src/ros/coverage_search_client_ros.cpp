@@ -65,6 +65,10 @@ constexpr double kConvoyRadius = 80.0;
 // And one of a target's description is claimed only beside a sighting of another target's
 // description (within kConvoyRadius) of the last this many seconds.
 constexpr double kConvoyWindow = 20.0;
+// Before a convoy sets off, its cars wait together (the second one in the lane 22 m behind the
+// first one's kerb slot): a standing car of another target's description this near (m) the
+// held vehicle, itself standing, is its partner, not a parked look-alike.
+constexpr double kConvoyWait = 30.0;
 // A claim's sighting lies within this many times a level camera's reach of the UAV (a little
 // tilt is the flight's own).
 constexpr double kLevelMargin = 1.25;
@@ -525,6 +529,10 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       const bool held = tracking && !lost_;
       const bool pursued = held && from_pursued <= kSameVehicle;
       const bool apart = held && from_pursued > kConvoyRadius;
+      // The convoy waiting to set off: beside the held vehicle, both standing. (Else the partner
+      // could not be claimed before the departure, and the area's window closes with it.)
+      const bool waiting_partner = held && !pursued && from_pursued <= kConvoyWait &&
+                                   predictor_->last().speed < kDriving;
       // With several targets (a convoy), one of another description sighted near it lately.
       const bool in_convoy =
           mission_->objective.targets.size() < 2 || convoy_.besideAnother(target.id, p, t);
@@ -535,8 +543,9 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
         held_in_view = std::hypot(o.x - p.x(), o.y - p.y()) <=
                        kLevelMargin * clients::levelReach(*track_camera_, o.z - p.z());
       }
-      if (msg->camera != track_claim_camera_ || parked || (standing && !pursued) || apart ||
-          !in_convoy || !held_in_view || track_claimed_.count(id)) {
+      if (msg->camera != track_claim_camera_ || parked ||
+          (standing && !pursued && !waiting_partner) || apart || !in_convoy || !held_in_view ||
+          track_claimed_.count(id)) {
         continue;
       }
       track_claimed_.insert(id);
