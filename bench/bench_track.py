@@ -11,7 +11,10 @@ wall time, and the success count with the failures grouped by cause.
 
   /usr/bin/python3 bench/bench_track.py [--seeds 1-10] [--pursue true|false]
       [--use-target-state true|false] [--track-boxes perfect_perception|detector]
-      [--out DIR] [--jobs 1]
+      [--world suburb|city] [--out DIR] [--jobs 1]
+
+--world city generates each seed's scenario in the generated city (`hameritt_generate --world
+city`).
 
 --track-boxes detector: the reported boxes come from the colour/shape detector's blobs in the
 down camera's rendered frames instead of the perfect-perception report.
@@ -77,12 +80,13 @@ def main():
     ap.add_argument("--track-boxes", default="perfect_perception",
                     choices=["perfect_perception", "detector"])
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--world", default="suburb", choices=["suburb", "city"])
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     out = a.out or tempfile.mkdtemp(prefix="hameritt_bench_track.")
     jobs = []
     for s in a.seeds:
-        [d] = generate("track", 1, s, os.path.join(out, "seed_%02d" % s))
+        [d] = generate("track", 1, s, os.path.join(out, "seed_%02d" % s), ["--world", a.world])
         jobs.append((d, s))
     args = ["found_by_sighting:=false", "pursue:=" + a.pursue,
             "use_target_state:=" + a.use_target_state, "track_boxes:=" + a.track_boxes]
@@ -102,11 +106,11 @@ def main():
                       lambda d, o, port: fly(d, seed_of[d], o, args, port), report)
     ok = sum(r["outcome"] == "success" for r in results)
     causes = collections.Counter(cause(r) for r in results if r["outcome"] != "success")
-    print("pursue %s, use_target_state %s, seeds %s: %d of %d succeeded; failures: %s" % (
-        a.pursue, a.use_target_state, ",".join(str(s) for s in a.seeds), ok, len(results),
+    print("%s, pursue %s, use_target_state %s, seeds %s: %d of %d succeeded; failures: %s" % (
+        a.world, a.pursue, a.use_target_state, ",".join(str(s) for s in a.seeds), ok, len(results),
         ", ".join("%s %d" % kv for kv in sorted(causes.items())) or "none"))
     with open(os.path.join(out, "summary.json"), "w") as f:
-        json.dump({"seeds": a.seeds, "pursue": a.pursue, "use_target_state": a.use_target_state,
+        json.dump({"seeds": a.seeds, "world": a.world, "pursue": a.pursue, "use_target_state": a.use_target_state,
                    "track_boxes": a.track_boxes,
                    "succeeded": ok, "failures": dict(causes), "runs": results}, f, indent=1)
     print("results in", out)
