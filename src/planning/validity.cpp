@@ -249,8 +249,15 @@ bool WorldValidity::staticValid(const Vec3& p, double slack) const {
 bool WorldValidity::staticSegmentValid(const Vec3& a, const Vec3& b, double slack) const {
   // The band and the bounds are convex: the endpoints decide.
   if (!staticValid(a, slack) || !staticValid(b, slack)) return false;
-  if (slack <= 0) return obstacles_->index.clear(a, b);
-  geometry::Aabb2 box{a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())};
+  return obstacleSegmentClear(a, b, std::max(0.0, slack));
+}
+
+bool WorldValidity::obstacleSegmentClear(const Vec3& a, const Vec3& b, double slack) const {
+  if (slack == 0) return obstacles_->index.clear(a, b);
+  // A negative slack grows the boxes: the candidates are looked up that much wider.
+  const Vec2 pad = Vec2::Constant(std::max(0.0, -slack));
+  geometry::Aabb2 box{a.head<2>().cwiseMin(b.head<2>()) - pad,
+                      a.head<2>().cwiseMax(b.head<2>()) + pad};
   for (int i : obstacles_->index.candidates(box)) {
     geometry::OrientedBox o = obstacles_->index.box(i);
     o.size -= Vec3(2 * slack, 2 * slack, 2 * slack);

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "hameritt/FollowProgress.h"
+#include "hameritt/planning/follow.h"
 #include "hameritt/planning/request_checks.h"
 #include "hameritt/ros/conversions.h"
 #include "hameritt/ros/log_throttle.h"
@@ -45,6 +46,7 @@ PlannerRos::PlannerRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("acceptance_radius", acceptance_, acceptance_);
   pnh.param("koz_horizon", koz_horizon_, koz_horizon_);
   pnh.param("max_deviation", max_deviation_, max_deviation_);
+  pnh.param("carrot_clearance", clearance_, clearance_);
   pnh.param("seed", seed, seed);
   pnh.param<std::string>("algorithm", algorithm, "rrt_connect");
   seed_ = static_cast<std::uint64_t>(seed);
@@ -65,6 +67,11 @@ PlannerRos::PlannerRos(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
   validity_settings_ = planning::validitySettingsFor(sim_.uav, margin);
   validity_settings_.validate();
+  if (!(clearance_ > 0 && clearance_ <= margin)) {
+    throw scenario::ConfigError("~carrot_clearance: expected metres in (0, ~margin = " +
+                                scenario::formatNumber(margin) + "], got " +
+                                scenario::formatNumber(clearance_));
+  }
   settings_.algorithm = parseAlgorithm(algorithm);
   settings_.speed.max_speed = sim_.uav.max_speed;
   settings_.validate();
@@ -275,7 +282,10 @@ void PlannerRos::onTick() {
     return;
   }
   for (const auto& k : zones) committed_.insert(k.id);
-  const scenario::TrajectoryPoint sp = scenario::sampleTrajectory(path_, plan_t + lookahead_);
+  // The carrot, pulled back along the path until the line to it clears the buildings.
+  const double carrot_t =
+      planning::clearCarrotTime(*full_validity_, path_, here, plan_t, lookahead_, clearance_);
+  const scenario::TrajectoryPoint sp = scenario::sampleTrajectory(path_, carrot_t);
   gate_->publish(setpoint_pub_, toPoseMsg(sp, ros::Time::now()));
   publishProgress("following", "");
 }

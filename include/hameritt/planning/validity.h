@@ -58,6 +58,10 @@ class WorldValidity {
   bool staticValid(const geometry::Vec3& p, double slack = 0.0) const;
   bool staticSegmentValid(const geometry::Vec3& a, const geometry::Vec3& b,
                           double slack = 0.0) const;
+  // The obstacles alone (no band, no bounds): the segment meets no obstacle box inflated by the
+  // margin less `slack` (a negative slack inflates them more). Exact.
+  bool obstacleSegmentClear(const geometry::Vec3& a, const geometry::Vec3& b,
+                            double slack = 0.0) const;
   // p is clear of every keep-out zone active at some instant of [t0, t1].
   bool kozClear(const geometry::Vec3& p, double t0, double t1, double slack = 0.0) const;
   // The segment, traversed with time linear from ta (at a) to tb (at b), never meets an

@@ -23,7 +23,9 @@ namespace hameritt::ros_wrappers {
 
 // Parameters (private): ~mission, ~sim_config (paths, required), ~margin (1.0 m),
 // ~algorithm (rrt_connect | rrt_star), ~rate_hz (10), ~lookahead (1.5 s: the setpoint is the
-// planned point this far, in plan time, ahead of the UAV's progress along the path),
+// planned point this far, in plan time, ahead of the UAV's progress along the path, pulled back
+// to 3/4, 1/2, 1/4 or 1/8 of it while the straight line to it passes nearer than
+// ~carrot_clearance (0.5 m, at most ~margin) to an obstacle: planning/follow.h),
 // ~acceptance_radius (2.0 m), ~koz_horizon (15 s: the follower commits to keep-out zones active
 // now or opening within this many seconds), ~max_deviation (6 m: farther than this from the path
 // is "blocked"), ~seed.
@@ -58,6 +60,7 @@ class PlannerRos {
   std::unique_ptr<planning::WorldValidity> full_validity_;
   planning::UavPlannerSettings settings_;
   double lookahead_ = 1.5, acceptance_ = 2.0, koz_horizon_ = 15.0, max_deviation_ = 6.0;
+  double clearance_ = 0.5;
   std::uint64_t seed_ = 1;
 
   bool have_odom_ = false;
