@@ -250,6 +250,36 @@ double heightForPixels(const scenario::CameraSpec& camera, double size, double p
   return size * f / pixels;
 }
 
+WaypointRepairs clearWaypoints(SearchPlan* plan, const planning::WorldValidity& validity,
+                               double above) {
+  WaypointRepairs out;
+  const double top = validity.settings().altitude_max;
+  std::vector<SearchLeg> legs;
+  for (SearchLeg& leg : plan->legs) {
+    std::vector<SearchWaypoint> kept;
+    for (SearchWaypoint w : leg.waypoints) {
+      if (validity.staticValid(w.position)) {
+        kept.push_back(w);
+        continue;
+      }
+      Vec3 q = w.position;
+      while (q.z() + 1.0 <= top && !validity.staticValid(q)) q.z() += 1.0;
+      q.z() = std::min(q.z() + above, top);
+      if (validity.staticValid(q)) {
+        w.position = q;
+        kept.push_back(w);
+        ++out.lifted;
+      } else {
+        ++out.dropped;
+      }
+    }
+    leg.waypoints = std::move(kept);
+    if (!leg.waypoints.empty()) legs.push_back(std::move(leg));
+  }
+  plan->legs = std::move(legs);
+  return out;
+}
+
 double flightTime(double distance, double max_speed, double accel) {
   if (distance <= 0) return 0.0;
   const double ramp = max_speed * max_speed / accel;  // distance to speed up and brake

@@ -11,6 +11,8 @@
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/mission_io.h"
 #include "hameritt/scenario/rng.h"
+#include "hameritt/scenario/world.h"
+#include "../scenario/test_util.h"
 
 namespace hameritt::clients {
 namespace {
@@ -389,6 +391,45 @@ TEST(Coverage, PlansAreDeterministicAndFlightTimeIsTrapezoidal) {
   EXPECT_DOUBLE_EQ(flightTime(72, 12, 2), 12.0);  // exactly the ramp: 6 s up, 6 s down
   EXPECT_DOUBLE_EQ(flightTime(172, 12, 2), 12.0 + 100.0 / 12.0);
   EXPECT_DOUBLE_EQ(flightTime(8, 12, 2), 4.0);
+}
+
+// In the city a rooftop can stand above the sweep altitude: the waypoint is lifted over it (the
+// raw box's top plus the margin, independently), a tower above the band drops its waypoint (and
+// an emptied leg), and a free waypoint is left alone.
+TEST(CoverageTest, SweepWaypointsAreLiftedOverRooftopsAndDroppedAboveTheBand) {
+  const scenario::World& city = scenario::testing::shippedCityWorld();
+  planning::ValiditySettings vs;  // margin 1 m
+  vs.altitude_min = 20.0;
+  vs.altitude_max = 62.0;
+  const planning::WorldValidity validity(city, std::vector<scenario::KeepOutZone>{}, vs);
+  const geometry::OrientedBox* low = nullptr;
+  const geometry::OrientedBox* tower = nullptr;
+  for (const auto& e : city.entities()) {
+    if (e.cls != scenario::EntityClass::kBuilding) continue;
+    const double top = e.box.maxZ();
+    if (!low && top > 30.0 && top < 50.0) low = &e.box;
+    if (!tower && top > 70.0) tower = &e.box;
+  }
+  ASSERT_TRUE(low && tower);
+  // A free point: high above the low building.
+  const Vec3 free(low->center.x(), low->center.y(), 60.0);
+  ASSERT_TRUE(validity.staticValid(free));
+  SearchPlan plan;
+  SearchLeg a, b;
+  a.waypoints = {{Vec3(low->center.x(), low->center.y(), 26.0), 10.0}, {free, 20.0}};
+  b.waypoints = {{Vec3(tower->center.x(), tower->center.y(), 26.0), 30.0}};
+  plan.legs = {a, b};
+  const WaypointRepairs r = clearWaypoints(&plan, validity);
+  EXPECT_EQ(r.lifted, 1);
+  EXPECT_EQ(r.dropped, 1);
+  ASSERT_EQ(plan.legs.size(), 1u);
+  ASSERT_EQ(plan.legs[0].waypoints.size(), 2u);
+  const Vec3 lifted = plan.legs[0].waypoints[0].position;
+  EXPECT_DOUBLE_EQ(lifted.x(), low->center.x());
+  EXPECT_GT(lifted.z(), low->maxZ() + vs.margin);
+  EXPECT_LE(lifted.z(), low->maxZ() + vs.margin + 2.0 + 1e-9);
+  EXPECT_EQ(plan.legs[0].waypoints[0].eta, 10.0);
+  EXPECT_EQ(plan.legs[0].waypoints[1].position, free);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "hameritt/geometry/polygon.h"
 #include "hameritt/geometry/time_window.h"
 #include "hameritt/geometry/types.h"
+#include "hameritt/planning/validity.h"
 #include "hameritt/scenario/scenario.h"
 
 namespace hameritt::clients {
@@ -118,6 +119,18 @@ struct SearchPlan {
 // Waypoints expected after the region's window closes (or the time limit) are dropped.
 SearchPlan planSearch(const scenario::Mission& mission, const CoverageSettings& settings,
                       const SearchProgress& progress);
+
+// The sweep flies at one altitude; in the city a rooftop can stand above it. Each waypoint of
+// `plan` that `validity` finds invalid (inside an obstacle box inflated by its margin) is lifted
+// in 1 m steps until it is valid, then `above` metres more; a waypoint that cannot be lifted
+// inside the altitude band (a tower, or a point outside the bounds) is dropped, and a leg left
+// without waypoints with it. Returns how many were lifted and dropped.
+struct WaypointRepairs {
+  int lifted = 0;
+  int dropped = 0;
+};
+WaypointRepairs clearWaypoints(SearchPlan* plan, const planning::WorldValidity& validity,
+                               double above = 1.0);
 
 // The lawnmower lines (pairs of endpoints, in flying order, alternating direction, at z = 0)
 // whose swaths cover `polygon`; exposed for tests and tools.
