@@ -241,6 +241,12 @@ double ViewpointChooser::safeAltitude(const Vec2& p, double wanted) const {
   return z;
 }
 
+bool ViewpointChooser::usable(const Vec3& p, double t) const {
+  // Above the band: the roof of a tower beside the vehicle lifted it there (safeAltitude).
+  const double top = std::max(uav_.altitude_min + 1.5, uav_.altitude_max - 1.5);
+  return p.z() <= top + 1e-9 && !inKoz(p, t);
+}
+
 bool ViewpointChooser::inKoz(const Vec3& p, double t) const {
   for (const auto& k : kozs_) {
     if (!k.window.active(t)) continue;
@@ -294,7 +300,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
       settings_.envelope_radius > 0.0 ? 0.4 * settings_.envelope_height : climb;
   const double h0 = settings_.height + std::clamp(climb, 0.0, std::max(0.0, max_climb));
   const PursuitView preferred = candidate(0.0, settings_.standoff, h0);
-  if (!inKoz(preferred.position, t)) {
+  if (usable(preferred.position, t)) {
     if (auto cam = seenBy(preferred.position, preferred.yaw, target)) {
       PursuitView v = preferred;
       v.visible = true;
@@ -307,7 +313,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
   // A candidate outside the keep-out zones, kept when it is the cheapest that sees the vehicle
   // (or, while none does, the cheapest): close to the preferred viewpoint, then to the UAV.
   auto consider = [&](PursuitView v) {
-    if (inKoz(v.position, t)) return;
+    if (!usable(v.position, t)) return;
     const double cost = (v.position - preferred.position).norm() + 0.5 * (v.position - uav).norm();
     if (cost >= seen_cost) return;
     if (const auto cam = seenBy(v.position, v.yaw, target)) {
@@ -331,7 +337,7 @@ PursuitView ViewpointChooser::choose(const VehicleState& vehicle, const Vec3& ua
       }
     }
     if (seen) return *seen;
-    if (!inKoz(preferred.position, t)) return preferred;
+    if (usable(preferred.position, t)) return preferred;
     if (fallback) return *fallback;
   }
   // The ring's scale: the standoff, at least 6 m (straight above, a ring of 0 m is one point).

@@ -78,6 +78,9 @@ constexpr double kConvoyWait = 30.0;
 constexpr double kLeadReach = 20.0;
 constexpr double kAbandonAfter = 10.0;
 constexpr double kFalseLeadRadius = 8.0;
+// The pursuit flies straight at its viewpoint only this far (beyond the 1 m margin) from every
+// obstacle, else through the planner.
+constexpr double kStraightClearance = 2.0;
 // A claim's sighting lies within this many times a level camera's reach of the UAV (a little
 // tilt is the flight's own).
 constexpr double kLevelMargin = 1.25;
@@ -163,9 +166,11 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   settings_.validate();
   claims_ = clients::ClaimLedger(claim_radius, claim_hold);
   detections_ = clients::ClaimLedger(claim_radius, 0.0);
-  if ((claim_ && use_context_) || pursue_ || avoid_enabled_) {
-    world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
-  }
+  world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
+  obstacles_ = std::make_unique<planning::WorldValidity>(
+      *world_, std::vector<scenario::KeepOutZone>{}, planning::validitySettingsFor(sim_.uav));
+  // The context filter reads the world only where the claims use the context.
+  if ((claim_ && use_context_) || pursue_ || avoid_enabled_) context_world_ = world_.get();
 
   waypoints_pub_ = gate_->advertise<nav_msgs::Path>(nh, "planner/waypoints", 1, true);
   plan_pub_ = gate_->advertise<nav_msgs::Path>(pnh, "plan", 1, true);
@@ -220,7 +225,7 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   if (!m) return;
   if (mission_ && mission_->scenario_id == m->scenario_id) return;  // the same, again
   mission_ = std::move(*m);
-  filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get());
+  filter_ = std::make_unique<clients::ContextFilter>(*mission_, context_world_);
   track_phase_ = std::any_of(mission_->phases.begin(), mission_->phases.end(),
                              [](const auto& p) { return p.type == scenario::PhaseType::kTrack; });
   // A follow phase states where to be: its envelope's d* behind and h* above the target.
@@ -306,9 +311,14 @@ void CoverageSearchClientRos::replan(const std::string& why) {
       // What the search finds past the windows may have driven off from its area since.
       clients::ContextSettings context;
       context.drive_off_speed = drive_off_speed_;
-      filter_ = std::make_unique<clients::ContextFilter>(*mission_, world_.get(), context);
+      filter_ = std::make_unique<clients::ContextFilter>(*mission_, context_world_, context);
       ROS_INFO("%s: no cell can be reached inside the windows: searching the areas past them",
                kClientName);
+    }
+    const clients::WaypointRepairs fixed = clients::clearWaypoints(&plan_, *obstacles_);
+    if (fixed.lifted + fixed.dropped > 0) {
+      ROS_INFO("%s: %d sweep waypoints lifted over rooftops, %d dropped (above the band)",
+               kClientName, fixed.lifted, fixed.dropped);
     }
   } catch (const std::exception& e) {
     ROS_ERROR("%s: planning the search failed: %s", kClientName, e.what());
@@ -807,7 +817,11 @@ void CoverageSearchClientRos::onPursuitTick() {
                     predictor_->last().position.x(), predictor_->last().position.y(),
                     predictor_->last().speed, view.position.x(), view.position.y(),
                     view.position.z(), view.visible ? "" : ", no line of sight");
-  if (chooser_->kozClear(uav, view.position, t)) {
+  // Straight at the viewpoint when nothing lies between; in the city a building can. The
+  // straight flight keeps 3 m from the walls: the viewpoint moves while the UAV flies at it, and
+  // a UAV at speed close beside a wall has no room to turn when the planner takes over.
+  if (chooser_->kozClear(uav, view.position, t) &&
+      obstacles_->obstacleSegmentClear(uav, view.position, -kStraightClearance)) {
     if (planner_flying_) {
       nav_msgs::Path stop_planner;  // empty: the planner stops following
       stop_planner.header.stamp = now;
@@ -817,7 +831,7 @@ void CoverageSearchClientRos::onPursuitTick() {
     }
     gate_->publish(pose_pub_, poseAt(view.position, view.yaw, now));
   } else if (t - planner_sent_at_ > 3.0) {
-    // A keep-out zone lies between: the planner finds the way round.
+    // A keep-out zone or a building lies between: the planner finds the way round.
     nav_msgs::Path path;
     path.header.stamp = now;
     path.header.frame_id = "map";

@@ -14,6 +14,7 @@
 #include "hameritt/planning/look_at.h"
 #include "hameritt/scenario/error.h"
 #include "hameritt/scenario/sim_config_io.h"
+#include "../scenario/test_util.h"
 
 namespace hameritt::clients {
 namespace {
@@ -545,6 +546,32 @@ TEST(Pursuit, AGroupViewHoldsEveryVehicleInTheDownCamera) {
   const GroupView g1 = groupView({one}, *down, 3.0);
   EXPECT_EQ(g1.height, 0.0);
   EXPECT_EQ(g1.centre.yaw, 0.3);
+}
+
+// In the city a tower beside the vehicle lifts the viewpoints near it above its roof, and so
+// above the altitude band: those are skipped, and the view chosen lies inside the band.
+TEST(Pursuit, ViewpointsLiftedAboveTheBandByATowerAreSkipped) {
+  const scenario::World& city = scenario::testing::shippedCityWorld();
+  scenario::UavSpec uav = sim().uav;
+  uav.altitude_min = 21.0;
+  uav.altitude_max = 62.0;
+  const ViewpointChooser chooser(city, uav, {}, PursuitSettings());
+  int towers = 0;
+  for (const auto& e : city.entities()) {
+    if (e.cls != scenario::EntityClass::kBuilding || e.box.maxZ() < 75.0) continue;
+    // The vehicle 3 m out from the middle of the tower's long side, driving along it.
+    const double c = std::cos(e.box.yaw), s = std::sin(e.box.yaw);
+    const Vec2 side(-s, c);
+    const Vec2 p = e.box.center2() + (0.5 * e.box.size.y() + 3.0) * side;
+    VehicleState v;
+    v.position = Vec3(p.x(), p.y(), 0.0);
+    v.yaw = e.box.yaw;
+    const PursuitView view = chooser.choose(v, v.position + Vec3(0, 0, 40.0), 0.0);
+    EXPECT_LE(view.position.z(), uav.altitude_max - 1.5 + 1e-9) << e.id;
+    EXPECT_GE(view.position.z(), uav.altitude_min + 1.5 - 1e-9) << e.id;
+    if (++towers == 5) break;
+  }
+  EXPECT_EQ(towers, 5);
 }
 
 }  // namespace

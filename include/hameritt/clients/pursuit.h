@@ -125,7 +125,8 @@ struct PursuitView {
 // (PursuitSettings::envelope_radius), the candidates lie inside it (8 bearings at 0.6 of its
 // radius x 3 heights) and its centre is kept when none sees the vehicle; the ring only when
 // the whole envelope is in a keep-out zone. All candidates are clamped into the altitude band
-// and kept `clearance` above nearby occluders.
+// and kept `clearance` above nearby occluders; one that this lifts above the band (a tower
+// beside the vehicle in the city) is skipped like one in a keep-out zone.
 class ViewpointChooser {
  public:
   ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
@@ -146,6 +147,8 @@ class ViewpointChooser {
  private:
   double safeAltitude(const geometry::Vec2& p, double wanted) const;
   bool inKoz(const geometry::Vec3& p, double t) const;
+  // Inside the altitude band (less 1.5 m) and outside the keep-out zones active at t.
+  bool usable(const geometry::Vec3& p, double t) const;
 
   const scenario::World& world_;
   scenario::UavSpec uav_;

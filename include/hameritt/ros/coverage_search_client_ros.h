@@ -120,6 +120,10 @@ class CoverageSearchClientRos {
   // First, destroyed last: the subscriptions and the tick go through it.
   std::unique_ptr<LockstepGate> gate_;
   std::unique_ptr<scenario::World> world_;
+  // The world's obstacles with the follower's default margin: sweep waypoints inside a building
+  // are lifted over its roof (clients::clearWaypoints).
+  std::unique_ptr<planning::WorldValidity> obstacles_;
+  const scenario::World* context_world_ = nullptr;  // world_ where the claims use the context
   clients::CoverageSettings settings_;
   std::optional<scenario::Mission> mission_;
   // Once the search goes on past the areas' windows, the context filter accepts a sighting
