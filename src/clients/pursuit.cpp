@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "hameritt/clients/color_detector.h"
 #include "hameritt/geometry/segment.h"
@@ -233,9 +234,20 @@ ViewpointChooser::ViewpointChooser(const scenario::World& world, const scenario:
   settings_.validate();
 }
 
+namespace {
+
+// The altitudes a viewpoint may take: the band, 1.5 m inside each end (its floor when the band
+// is narrower than 3 m).
+std::pair<double, double> viewBand(const scenario::UavSpec& uav) {
+  const double lo = uav.altitude_min + 1.5;
+  return {lo, std::max(lo, uav.altitude_max - 1.5)};
+}
+
+}  // namespace
+
 double ViewpointChooser::safeAltitude(const Vec2& p, double wanted) const {
-  const double lo = uav_.altitude_min + 1.5, hi = uav_.altitude_max - 1.5;
-  double z = std::clamp(wanted, lo, std::max(lo, hi));
+  const auto [lo, hi] = viewBand(uav_);
+  double z = std::clamp(wanted, lo, hi);
   const auto& occ = world_.occluders();
   for (int i : occ.near(p, 6.0)) z = std::max(z, occ.box(i).maxZ() + settings_.clearance);
   return z;
@@ -243,8 +255,7 @@ double ViewpointChooser::safeAltitude(const Vec2& p, double wanted) const {
 
 bool ViewpointChooser::usable(const Vec3& p, double t) const {
   // Above the band: the roof of a tower beside the vehicle lifted it there (safeAltitude).
-  const double top = std::max(uav_.altitude_min + 1.5, uav_.altitude_max - 1.5);
-  return p.z() <= top + 1e-9 && !inKoz(p, t);
+  return p.z() <= viewBand(uav_).second + 1e-9 && !inKoz(p, t);
 }
 
 bool ViewpointChooser::inKoz(const Vec3& p, double t) const {
