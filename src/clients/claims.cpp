@@ -83,4 +83,41 @@ bool ConvoySightings::besideAnother(const std::string& key, const geometry::Vec3
   });
 }
 
+FalseLeads::FalseLeads(double reach, double after, double radius)
+    : reach_(reach), after_(after), radius_(radius) {
+  if (!(reach > 0) || !std::isfinite(reach) || !(after >= 0) || !std::isfinite(after) ||
+      !(radius >= 0) || !std::isfinite(radius)) {
+    throw scenario::ConfigError("false leads: expected reach > 0 m, after >= 0 s and radius >= 0 "
+                                "m, got " + scenario::formatNumber(reach) + " m, " +
+                                scenario::formatNumber(after) + " s, " +
+                                scenario::formatNumber(radius) + " m");
+  }
+}
+
+bool FalseLeads::giveUp(double t, bool lost, bool confirmed, const geometry::Vec2& uav,
+                        const geometry::Vec2& prediction, double confirm_by) {
+  if (!confirmed && t > confirm_by) return true;
+  if (!lost || confirmed || !((uav - prediction).norm() <= reach_)) {
+    reached_at_ = -1.0;
+    return false;
+  }
+  if (reached_at_ < 0) reached_at_ = t;
+  return t - reached_at_ > after_;
+}
+
+void FalseLeads::setAside(const geometry::Vec2& p) {
+  leads_.push_back(p);
+  reached_at_ = -1.0;
+}
+
+bool FalseLeads::near(const geometry::Vec2& p) const {
+  return std::any_of(leads_.begin(), leads_.end(),
+                     [&](const geometry::Vec2& q) { return (q - p).norm() <= radius_; });
+}
+
+void FalseLeads::clear() {
+  leads_.clear();
+  reached_at_ = -1.0;
+}
+
 }  // namespace hameritt::clients

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "hameritt/clients/claims.h"
 #include "hameritt/clients/public_config.h"
@@ -224,6 +225,57 @@ TEST(ClaimLedger, OneClaimPerPlaceUntilTheHoldExpires) {
   EXPECT_TRUE(forever.claim(Vec3(0, 0, 0), 0.0));
   EXPECT_FALSE(forever.claim(Vec3(0, 0, 0), 1e6));
   EXPECT_THROW(ClaimLedger(-1.0, 1.0), scenario::ConfigError);
+}
+
+// The pursuit of the failed pursuit mission (a look-alike claimed, lost 2 s later, the UAV then at
+// its prediction): given up once the UAV has been lost within reach of the prediction for more
+// than 10 s, not before; never while the find is confirmed (the ADK's target state), nor while
+// the UAV is still on its way, nor when the target was reacquired in between.
+TEST(FalseLeads, ALostUnconfirmedPursuitAtItsPredictionIsGivenUpAfterTheWait) {
+  const Vec2 lead(175.7, -168.2), here(175.3, -184.2);  // 16 m off: within reach
+  FalseLeads leads(20.0, 10.0, 8.0);
+  EXPECT_FALSE(leads.giveUp(30.0, true, false, Vec2(108.8, -356.4), lead));  // on its way
+  double given_up_at = -1;
+  for (int k = 0; k <= 200 && given_up_at < 0; ++k) {
+    const double t = 40.0 + 0.1 * k;
+    if (leads.giveUp(t, true, false, here, lead)) given_up_at = t;
+  }
+  EXPECT_GT(given_up_at, 50.0 - 1e-9);  // the first tick more than 10 s after arrival
+  EXPECT_LT(given_up_at, 50.1 + 1e-9);
+  leads.setAside(lead);
+  EXPECT_EQ(leads.size(), 1u);
+  EXPECT_TRUE(leads.near(Vec2(175.7, -161.0)));   // the look-alike, 7.2 m on
+  EXPECT_FALSE(leads.near(Vec2(175.7, -159.0)));  // 9.2 m: another vehicle
+  // Confirmed (or reacquired, or out of reach) on one tick: the count starts again.
+  FalseLeads other(20.0, 10.0, 8.0);
+  for (int k = 0; k <= 300; ++k) {
+    const double t = 0.1 * k;
+    EXPECT_FALSE(other.giveUp(t, true, true, here, lead)) << t;  // the ADK's state holds it
+  }
+  EXPECT_FALSE(other.giveUp(30.0, true, false, here, lead));
+  EXPECT_FALSE(other.giveUp(39.0, true, false, here, lead));
+  EXPECT_FALSE(other.giveUp(39.5, false, false, here, lead));  // reacquired
+  EXPECT_FALSE(other.giveUp(45.0, true, false, here, lead));
+  EXPECT_FALSE(other.giveUp(54.0, true, false, here, lead));
+  EXPECT_FALSE(other.giveUp(55.0, true, false, Vec2(175.3, -230.0), lead));  // 62 m off
+  EXPECT_FALSE(other.giveUp(56.0, true, false, here, lead));
+  other.restart();  // a new pursuit
+  EXPECT_FALSE(other.giveUp(65.0, true, false, here, lead));
+  EXPECT_TRUE(other.giveUp(75.5, true, false, here, lead));
+  other.clear();
+  EXPECT_FALSE(other.near(lead));
+  // maneuver_only: a find is confirmed within 3 s of the claim, or never. The second look-alike
+  // of that mission, held in view (not lost) and unconfirmed: given up just past the wait; a
+  // confirmed pursuit never is.
+  FalseLeads held(20.0, 10.0, 8.0);
+  const Vec2 parked(291.7, -125.9), above(291.2, -133.9);
+  EXPECT_FALSE(held.giveUp(59.0, false, false, above, parked, 56.4 + 3.0));
+  EXPECT_FALSE(held.giveUp(59.4, false, false, above, parked, 56.4 + 3.0));
+  EXPECT_TRUE(held.giveUp(59.5, false, false, above, parked, 56.4 + 3.0));
+  EXPECT_FALSE(held.giveUp(59.5, false, true, above, parked, 56.4 + 3.0));
+  EXPECT_FALSE(held.giveUp(300.0, true, true, above, parked, 56.4 + 3.0));
+  EXPECT_THROW(FalseLeads(0.0, 10.0, 8.0), scenario::ConfigError);
+  EXPECT_THROW(FalseLeads(20.0, std::nan(""), 8.0), scenario::ConfigError);
 }
 
 // A look-alike parked beside the road stands from 3 s after its first sighting on; a car of the

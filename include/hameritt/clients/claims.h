@@ -3,6 +3,7 @@
 // not at every frame. ROS-free.
 
 #include <deque>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -81,6 +82,39 @@ class ConvoySightings {
   };
   double radius_, window_;
   std::deque<Sighting> seen_;
+};
+
+// Leads a pursuit set aside. A pursuit whose find is not confirmed (no target state from the ADK,
+// no target claimed on a track phase), lost, with the UAV within `reach` metres (in the plane) of
+// its prediction for more than `after` seconds, followed a false lead: a look-alike seen once,
+// standing out of sight, or a car glimpsed from afar that drove off. Where it was last seen is set
+// aside: a sighting within `radius` metres of it starts no pursuit and no claim again.
+class FalseLeads {
+ public:
+  FalseLeads(double reach = 20.0, double after = 10.0, double radius = 8.0);
+
+  // One pursuit tick at time t (not before the previous one's): true when the pursuit is to be
+  // given up now. Any tick that is not lost, confirmed or out of reach restarts the count.
+  // `confirm_by`: where a true find is confirmed at once (in maneuver_only mode the ADK sends a
+  // found target's state within a tracker's period of the claim), the time by which it would
+  // have been: past it, an unconfirmed pursuit is given up at once, lost or not (a look-alike
+  // that the context could not tell apart, claimed, held in view and hovered over to the end).
+  bool giveUp(double t, bool lost, bool confirmed, const geometry::Vec2& uav,
+              const geometry::Vec2& prediction,
+              double confirm_by = std::numeric_limits<double>::infinity());
+  // A new pursuit: the count starts again.
+  void restart() { reached_at_ = -1.0; }
+  // Sets aside the lead last seen at p (and restarts the count).
+  void setAside(const geometry::Vec2& p);
+  // Whether p lies within the radius of a lead set aside.
+  bool near(const geometry::Vec2& p) const;
+  std::size_t size() const { return leads_.size(); }
+  void clear();
+
+ private:
+  double reach_, after_, radius_;
+  double reached_at_ = -1.0;  // since when the UAV, lost, is within reach of the prediction
+  std::vector<geometry::Vec2> leads_;
 };
 
 }  // namespace hameritt::clients
