@@ -69,15 +69,22 @@ constexpr double kConvoyWindow = 20.0;
 // first one's kerb slot): a standing car of another target's description this near (m) the
 // held vehicle, itself standing, is its partner, not a parked look-alike.
 constexpr double kConvoyWait = 30.0;
-// A track phase's pursuit lost before any target is claimed, with the UAV within kLeadReach (m,
-// horizontally) of the prediction for kAbandonAfter s, was a false lead: the search goes on, and
-// a sighting within kFalseLeadRadius (m) of where it was last seen starts no pursuit again (else
-// the client hovered at the prediction of a look-alike seen once, standing, or of a car glimpsed
-// from afar that drove off). (Lost on the way, a glimpse 150-250 m off is reacquired on arrival:
+// A pursuit lost before the find is confirmed (no target state from the ADK and, on a track
+// phase, no target claimed), with the UAV within kLeadReach (m, horizontally) of the prediction
+// for kAbandonAfter s, was a false lead: the search goes on, and a sighting within
+// kFalseLeadRadius (m) of where it was last seen starts no pursuit and no claim again (else the
+// client hovered at the prediction of a look-alike seen once, standing, or of a car glimpsed
+// from afar that drove off: a pursuit mission's search claimed a look-alike no relation could
+// check, lost it 2 s later and hovered there for 220 s). (Lost on the way, a glimpse 150-250 m off is reacquired on arrival:
 // 16-22 s lost in 11 of 46 successful missions.)
 constexpr double kLeadReach = 20.0;
 constexpr double kAbandonAfter = 10.0;
 constexpr double kFalseLeadRadius = 8.0;
+// maneuver_only: the ADK sends a found target's state from the find on (10 Hz of sim time). A
+// pursuit class's pursuit starts with its claim: no state this long (s) after it, the claim was of
+// a look-alike (the second look-alike of the mission above, standing, was held in view to the
+// end) and the pursuit is given up as a false lead at once.
+constexpr double kConfirmWait = 3.0;
 // The pursuit flies straight at its viewpoint only this far (beyond the 1 m margin) from every
 // obstacle, else through the planner.
 constexpr double kStraightClearance = 2.0;
@@ -165,6 +172,7 @@ CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeH
   settings_.cover_zero_cells = cover_zero;
   settings_.validate();
   claims_ = clients::ClaimLedger(claim_radius, claim_hold);
+  false_leads_ = clients::FalseLeads(kLeadReach, kAbandonAfter, kFalseLeadRadius);
   detections_ = clients::ClaimLedger(claim_radius, 0.0);
   world_ = std::make_unique<scenario::World>(scenario::generateCheckedWorld(sim_, sim_path));
   obstacles_ = std::make_unique<planning::WorldValidity>(
@@ -535,10 +543,8 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
     const bool restart = defer_claims && tracking && lost_ && !parked &&
                          msg->camera == track_claim_camera_ &&
                          t - predictor_->last().t > kLostAfter;
-    const bool false_lead =
-        !tracking && std::any_of(false_leads_.begin(), false_leads_.end(), [&](const auto& q) {
-          return (q - p.head<2>()).norm() <= kFalseLeadRadius;
-        });
+    const bool at_false_lead = false_leads_.near(p.head<2>());
+    const bool false_lead = !tracking && at_false_lead;
     if (pursue_ && predictor_ && (!tracking || restart) && !associated && !false_lead) {
       associated = std::make_pair(p, static_cast<double>(e.yaw));
       associated_description = target.id;
@@ -577,7 +583,7 @@ void CoverageSearchClientRos::onPerfectPerception(const hameritt::PerceptionRepo
       if (track_claimed_.size() >= mission_->objective.targets.size()) {
         reports_after_ = msg->header.stamp.toSec();
       }
-    } else if (!claims_.claim(p, t)) {
+    } else if (at_false_lead || !claims_.claim(p, t)) {
       continue;
     }
     const double confidence =
@@ -639,6 +645,11 @@ void CoverageSearchClientRos::onTargetState(const hameritt::EntityStateArray::Co
     state_target_ = pick->id;
     ROS_INFO("%s: the ADK's target state feeds the pursuit from t %.1f: (%.1f, %.1f), %.1f m/s",
              kClientName, t, v.position.x(), v.position.y(), v.speed);
+  }
+  // The target found (by a sighting, ~found_by_sighting) while the search goes on, a false lead
+  // set aside: the pursuit class pursues it. (A track phase's pursuit waits for its claims.)
+  if (!pursuing_ && pursue_ && !track_phase_ && mission_->objective.type == "track") {
+    startPursuit("the ADK's target state: found");
   }
 }
 
@@ -706,7 +717,8 @@ void CoverageSearchClientRos::startPursuit(const std::string& why) {
   planner_sent_at_ = -1e9;
   lost_ = false;
   losses_ = 0;
-  lead_reached_at_ = -1.0;
+  false_leads_.restart();
+  pursuit_started_at_ = missionTime();
   tilt_shift_.setZero();
   const auto& s = predictor_->last();
   ROS_INFO("%s: %s: pursuing it from (%.1f, %.1f), %.1f m/s, standoff %.1f m, height %.1f m",
@@ -714,13 +726,14 @@ void CoverageSearchClientRos::startPursuit(const std::string& why) {
            pursuit_.height);
 }
 
-// A track phase's pursuit lost before any claim: set the lead aside and go on with the search.
+// A pursuit lost before the find was confirmed: set the lead aside and go on with the search.
 void CoverageSearchClientRos::abandonPursuit(double t) {
   const geometry::Vec2 lead = predictor_->last().position.head<2>();
-  false_leads_.push_back(lead);
-  ROS_INFO("%s: pursuit: lost for %.1f s before any claim: back to the search (the lead at "
-           "(%.1f, %.1f) set aside, %zu in all)",
-           kClientName, t - predictor_->last().t, lead.x(), lead.y(), false_leads_.size());
+  false_leads_.setAside(lead);
+  ROS_INFO("%s: pursuit: not confirmed %.1f s after it started (last seen %.1f s ago): back to "
+           "the search (the lead at (%.1f, %.1f) set aside, %zu in all)",
+           kClientName, t - pursuit_started_at_, t - predictor_->last().t, lead.x(), lead.y(),
+           false_leads_.size());
   pursuing_ = false;
   lost_ = false;
   predictor_ = std::make_unique<clients::StreetPredictor>(*world_, pursuit_);
@@ -753,15 +766,15 @@ void CoverageSearchClientRos::onPursuitTick() {
   // Lost, it flies to where the vehicle must pass: the next intersection with a choice.
   clients::VehicleState v = lost_ ? predictor_->predictToJunction(t + pursuit_.lead)
                                   : predictor_->predict(t + pursuit_.lead);
-  if (track_phase_ && lost_ && track_claimed_.empty() && state_target_.empty() &&
-      (uav.head<2>() - v.position.head<2>()).norm() <= kLeadReach) {
-    if (lead_reached_at_ < 0) lead_reached_at_ = t;
-    if (t - lead_reached_at_ > kAbandonAfter) {
-      abandonPursuit(t);
-      return;
-    }
-  } else {
-    lead_reached_at_ = -1.0;
+  const bool confirmed = !state_target_.empty() || (track_phase_ && !track_claimed_.empty());
+  // (A track phase's pursuit starts before its claims, at the first sighting.)
+  const bool state_expected = !track_phase_ && use_target_state_ && target_state_sub_ &&
+                              target_state_sub_.getNumPublishers() > 0;
+  const double confirm_by = state_expected ? pursuit_started_at_ + kConfirmWait
+                                           : std::numeric_limits<double>::infinity();
+  if (false_leads_.giveUp(t, lost_, confirmed, uav.head<2>(), v.position.head<2>(), confirm_by)) {
+    abandonPursuit(t);
+    return;
   }
   // A track phase with several targets in the ADK's state: all of them in the scored camera,
   // from above their midpoint, high enough to hold them across the image.

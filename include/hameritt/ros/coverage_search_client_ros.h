@@ -175,10 +175,10 @@ class CoverageSearchClientRos {
   double track_standoff_ = 0.0;
   // The smoothed ground shift of the scored camera's axis by the UAV's tilt (tiltedAxisShift).
   geometry::Vec2 tilt_shift_{0.0, 0.0};
-  // A track phase: where pursuits lost before any claim last saw their vehicle (a look-alike, or
-  // a glimpse that drove off); a sighting there starts no pursuit again.
-  std::vector<geometry::Vec2> false_leads_;
-  double lead_reached_at_ = -1.0;  // since when the UAV, lost before a claim, is at the prediction
+  // Where pursuits lost before their find was confirmed last saw their vehicle (a look-alike, or
+  // a glimpse that drove off); a sighting there starts no pursuit and no claim again.
+  clients::FalseLeads false_leads_;
+  double pursuit_started_at_ = 0.0;  // mission time
 
   // Avoid.
   bool avoid_enabled_ = true, avoid_planned_ = false, avoid_arrived_ = false;
