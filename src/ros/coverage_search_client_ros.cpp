@@ -75,8 +75,8 @@ constexpr double kConvoyWait = 30.0;
 // kFalseLeadRadius (m) of where it was last seen starts no pursuit and no claim again (else the
 // client hovered at the prediction of a look-alike seen once, standing, or of a car glimpsed
 // from afar that drove off: a pursuit mission's search claimed a look-alike no relation could
-// check, lost it 2 s later and hovered there for 220 s). (Lost on the way, a glimpse 150-250 m off is reacquired on arrival:
-// 16-22 s lost in 11 of 46 successful missions.)
+// check, lost it 2 s later and hovered there for 220 s). (Lost on the way, a glimpse 150-250 m
+// off is reacquired on arrival: 16-22 s lost in 11 of 46 successful track missions.)
 constexpr double kLeadReach = 20.0;
 constexpr double kAbandonAfter = 10.0;
 constexpr double kFalseLeadRadius = 8.0;
@@ -646,8 +646,9 @@ void CoverageSearchClientRos::onTargetState(const hameritt::EntityStateArray::Co
     ROS_INFO("%s: the ADK's target state feeds the pursuit from t %.1f: (%.1f, %.1f), %.1f m/s",
              kClientName, t, v.position.x(), v.position.y(), v.speed);
   }
-  // The target found (by a sighting, ~found_by_sighting) while the search goes on, a false lead
-  // set aside: the pursuit class pursues it. (A track phase's pursuit waits for its claims.)
+  // The target found before the client's own claim (by a sighting, ~found_by_sighting), e.g.
+  // while the search goes on after a false lead was set aside: the pursuit class pursues it.
+  // (A track phase's pursuit waits for its claims.)
   if (!pursuing_ && pursue_ && !track_phase_ && mission_->objective.type == "track") {
     startPursuit("the ADK's target state: found");
   }
