@@ -227,6 +227,18 @@ geometry::Vec2 tiltedAxisShift(const scenario::CameraSpec& camera,
   return hit_tilted - hit_level;
 }
 
+TiltAverage::TiltAverage(double rate, double station_radius, double steady_speed)
+    : rate_(rate), station_radius_(station_radius), steady_speed_(steady_speed) {}
+
+const Vec2& TiltAverage::update(const Vec2& uav, const Vec2& uav_velocity, const Vec2& station,
+                                const Vec2& vehicle_velocity, const Vec2& measured) {
+  if ((uav - station).norm() < station_radius_ &&
+      (uav_velocity - vehicle_velocity).norm() < steady_speed_) {
+    shift_ += rate_ * (measured - shift_);
+  }
+  return shift_;
+}
+
 ViewpointChooser::ViewpointChooser(const scenario::World& world, const scenario::UavSpec& uav,
                                    const std::vector<scenario::KeepOutZone>& kozs,
                                    const PursuitSettings& settings)

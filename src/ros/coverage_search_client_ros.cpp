@@ -53,8 +53,10 @@ constexpr double kParkedRadius = 1.5;
 constexpr double kGroupMargin = 4.0;
 // Per pursuit tick (10 Hz by default): the tilt shift's running average, about 4 s.
 constexpr double kTiltAveraging = 0.025;
-// The tilt is averaged only while the UAV is within this many metres of its shifted viewpoint.
+// The tilt is averaged only while the UAV is within this many metres of its shifted viewpoint
+// and its velocity within this many m/s of the vehicle's (clients::TiltAverage).
 constexpr double kTiltStation = 8.0;
+constexpr double kTiltSteady = 1.5;
 // A sighting this close to the pursued vehicle's prediction is that vehicle.
 constexpr double kSameVehicle = 6.0;
 // A prediction this fast (m/s) is of a vehicle driving: a look-alike standing still is not it.
@@ -97,7 +99,7 @@ constexpr double kAssociationGate = 15.0;
 }  // namespace
 
 CoverageSearchClientRos::CoverageSearchClientRos(ros::NodeHandle& nh, ros::NodeHandle& pnh)
-    : convoy_(kConvoyRadius, kConvoyWindow) {
+    : convoy_(kConvoyRadius, kConvoyWindow), tilt_(kTiltAveraging, kTiltStation, kTiltSteady) {
   gate_ = std::make_unique<LockstepGate>(nh, pnh);
   std::string sim_path, camera = "down";
   if (!pnh.getParam("sim_config", sim_path)) {
@@ -720,7 +722,7 @@ void CoverageSearchClientRos::startPursuit(const std::string& why) {
   losses_ = 0;
   false_leads_.restart();
   pursuit_started_at_ = missionTime();
-  tilt_shift_.setZero();
+  tilt_.reset();
   const auto& s = predictor_->last();
   ROS_INFO("%s: %s: pursuing it from (%.1f, %.1f), %.1f m/s, standoff %.1f m, height %.1f m",
            kClientName, why.c_str(), s.position.x(), s.position.y(), s.speed, pursuit_.standoff,
@@ -807,15 +809,18 @@ void CoverageSearchClientRos::onPursuitTick() {
     // out, the steady tilt against drag and wind stays (a shorter average fed back on itself:
     // speeding up tilts more, which moves the viewpoint farther ahead).
     // Only the tilt of keeping station counts: not that of catching up from afar.
-    const geometry::Vec2 station = view.position.head<2>() - tilt_shift_;
-    if ((uav.head<2>() - station).norm() < kTiltStation) {
-      const auto& q = odom_->pose.pose.orientation;
-      const Eigen::Quaterniond attitude(q.w, q.x, q.y, q.z);
-      const geometry::Vec2 shift = clients::tiltedAxisShift(
-          *track_camera_, attitude.normalized(), uav.z() - v.position.z());
-      tilt_shift_ += kTiltAveraging * (shift - tilt_shift_);
-    }
-    view.position.head<2>() -= tilt_shift_;
+    // Only the tilt of keeping station, moving with the vehicle (clients::TiltAverage).
+    const auto& q = odom_->pose.pose.orientation;
+    const Eigen::Quaterniond attitude = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+    const auto& vb = odom_->twist.twist.linear;  // body frame
+    const geometry::Vec3 uav_velocity = attitude * geometry::Vec3(vb.x, vb.y, vb.z);
+    const geometry::Vec2 vehicle_velocity =
+        v.speed * geometry::Vec2(std::cos(v.yaw), std::sin(v.yaw));
+    const geometry::Vec2 shift =
+        clients::tiltedAxisShift(*track_camera_, attitude, uav.z() - v.position.z());
+    view.position.head<2>() -=
+        tilt_.update(uav.head<2>(), uav_velocity.head<2>(),
+                     view.position.head<2>() - tilt_.shift(), vehicle_velocity, shift);
     // Straight above one vehicle, the image's wider axis along its way (as the group view lays
     // it along the cars' line): the leading edge is then half the horizontal field ahead, not
     // half the vertical one.

@@ -461,6 +461,43 @@ TEST(Pursuit, NothingBeyondALevelCamerasReachIsInItsImage) {
               beyond_seen, inside, inside_seen, inside);
 }
 
+// The tilt shift is averaged only while the UAV keeps station. Circling a standing car 5 m from
+// its station at 6 m/s, tilted 30 degrees into the turn from 42.5 m (the city flight whose
+// averaged circling tilt held it circling), the shift stays where it was; so does it while the
+// UAV brakes into station at 8 m/s, and 9 m off station. Following a car at 9 m/s with the UAV
+// at the car's speed, it converges on the steady tilt's shift (300 ticks, 30 s at 10 Hz).
+TEST(Pursuit, TheTiltShiftAveragesOnlyTheTiltOfKeepingStation) {
+  const double deg = geometry::kPi / 180.0, h = 42.5;
+  TiltAverage circling(0.025, 8.0, 1.5);
+  const Vec2 station(0.0, 0.0);
+  for (int k = 0; k < 300; ++k) {
+    const double a = 0.1 * k * 6.0 / 5.0;  // angular position (rad): 6 m/s on a 5 m circle
+    const Vec2 at = 5.0 * Vec2(std::cos(a), std::sin(a));
+    const Vec2 velocity = 6.0 * Vec2(-std::sin(a), std::cos(a));
+    // Tilted towards the centre: the nadir axis looks outwards, h tan 30 = 24.5 m.
+    const Vec2 measured = at.normalized() * h * std::tan(30 * deg);
+    circling.update(at, velocity, station, Vec2::Zero(), measured);
+  }
+  EXPECT_EQ(circling.shift(), Vec2::Zero());
+  TiltAverage braking(0.025, 8.0, 1.5);
+  braking.update(Vec2(5.0, 0.0), Vec2(-8.0, 0.0), station, Vec2::Zero(), Vec2(-20.0, 0.0));
+  EXPECT_EQ(braking.shift(), Vec2::Zero());
+  TiltAverage away(0.025, 8.0, 1.5);
+  away.update(Vec2(9.0, 0.0), Vec2::Zero(), station, Vec2::Zero(), Vec2(-3.0, 0.0));
+  EXPECT_EQ(away.shift(), Vec2::Zero());
+  // Following east at 9 m/s, 1 m/s of the UAV's speed off the car's: every tick counts.
+  TiltAverage following(0.025, 8.0, 1.5);
+  const Vec2 steady(-h * std::tan(15 * deg), 0.0);
+  for (int k = 0; k < 300; ++k) {
+    const Vec2 car(0.9 * k, 0.0);
+    following.update(car + Vec2(2.0, 1.0), Vec2(9.0 + (k % 2 ? 1.0 : -1.0), 0.0), car,
+                     Vec2(9.0, 0.0), steady);
+  }
+  EXPECT_NEAR((following.shift() - steady).norm(), 0.0, 1e-3 * steady.norm());
+  following.reset();
+  EXPECT_EQ(following.shift(), Vec2::Zero());
+}
+
 // A quadrotor tilts into its flight, and its nadir camera looks behind the point below it:
 // tiltedAxisShift gives where the axis meets the ground less where it meets it level, by hand:
 // pitched 15 degrees nose down heading north from 22.5 m, 22.5 tan 15 = 6.03 m south; rolled 10

@@ -174,7 +174,7 @@ class CoverageSearchClientRos {
   // scored camera (~track_claim_camera) looks down on it.
   double track_standoff_ = 0.0;
   // The smoothed ground shift of the scored camera's axis by the UAV's tilt (tiltedAxisShift).
-  geometry::Vec2 tilt_shift_{0.0, 0.0};
+  clients::TiltAverage tilt_;
   // Where pursuits lost before their find was confirmed last saw their vehicle (a look-alike, or
   // a glimpse that drove off); a sighting there starts no pursuit and no claim again.
   clients::FalseLeads false_leads_;
