@@ -779,6 +779,9 @@ void CoverageSearchClientRos::onPursuitTick() {
     abandonPursuit(t);
     return;
   }
+  // The vehicle's own velocity (a group's centre below takes a yaw across the vehicles' line).
+  const geometry::Vec2 vehicle_velocity =
+      v.speed * geometry::Vec2(std::cos(v.yaw), std::sin(v.yaw));
   // A track phase with several targets in the ADK's state: all of them in the scored camera,
   // from above their midpoint, high enough to hold them across the image.
   bool grouped = false;
@@ -808,19 +811,19 @@ void CoverageSearchClientRos::onPursuitTick() {
     // about 4 s: the tilt that flying ahead itself causes (a speed-up, then braking) averages
     // out, the steady tilt against drag and wind stays (a shorter average fed back on itself:
     // speeding up tilts more, which moves the viewpoint farther ahead).
-    // Only the tilt of keeping station counts: not that of catching up from afar.
-    // Only the tilt of keeping station, moving with the vehicle (clients::TiltAverage).
+    // Only the tilt of keeping station counts (clients::TiltAverage): moving with the vehicle,
+    // near where the autopilot's lag puts a UAV sent `lead` seconds ahead of it; not that of
+    // catching up, braking or circling.
     const auto& q = odom_->pose.pose.orientation;
     const Eigen::Quaterniond attitude = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
     const auto& vb = odom_->twist.twist.linear;  // body frame
     const geometry::Vec3 uav_velocity = attitude * geometry::Vec3(vb.x, vb.y, vb.z);
-    const geometry::Vec2 vehicle_velocity =
-        v.speed * geometry::Vec2(std::cos(v.yaw), std::sin(v.yaw));
     const geometry::Vec2 shift =
         clients::tiltedAxisShift(*track_camera_, attitude, uav.z() - v.position.z());
     view.position.head<2>() -=
         tilt_.update(uav.head<2>(), uav_velocity.head<2>(),
-                     view.position.head<2>() - tilt_.shift(), vehicle_velocity, shift);
+                     view.position.head<2>() - tilt_.shift() - pursuit_.lead * vehicle_velocity,
+                     vehicle_velocity, shift);
     // Straight above one vehicle, the image's wider axis along its way (as the group view lays
     // it along the cars' line): the leading edge is then half the horizontal field ahead, not
     // half the vertical one.

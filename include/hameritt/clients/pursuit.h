@@ -111,8 +111,8 @@ geometry::Vec2 tiltedAxisShift(const scenario::CameraSpec& camera, const Eigen::
                                double height);
 
 // The running average of tiltedAxisShift that the pursuit flies ahead by. It takes a sample only
-// while the UAV keeps station: within `station_radius` (horizontally) of where it is sent (the
-// viewpoint less the shift) and moving with the vehicle (their horizontal velocities within `steady_speed`). The tilt of
+// while the UAV keeps station: within `station_radius` (horizontally) of its station (where it is
+// sent, less the autopilot's lag behind a moving setpoint) and moving with the vehicle (their horizontal velocities within `steady_speed`). The tilt of
 // catching up, of braking or of circling is not the steady tilt against drag and wind; averaged
 // in, it moves the viewpoint, which tilts the UAV again, and from 40 m up (a viewpoint above the
 // roofs beside a tower) the loop held a UAV circling a standing car at 34 degrees of tilt with
@@ -121,7 +121,7 @@ class TiltAverage {
  public:
   TiltAverage(double rate = 0.025, double station_radius = 8.0, double steady_speed = 1.5);
   void reset() { shift_.setZero(); }
-  // One tick: the UAV's horizontal position and velocity, where it is sent, the vehicle's
+  // One tick: the UAV's horizontal position and velocity, its station, the vehicle's
   // horizontal velocity and the shift the UAV's attitude gives now. Returns shift().
   const geometry::Vec2& update(const geometry::Vec2& uav, const geometry::Vec2& uav_velocity,
                                const geometry::Vec2& station,
