@@ -658,6 +658,8 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
     }
   }
   const std::size_t nc = cars.size();
+  double longest = 0.0;
+  for (const Car& c : cars) longest = std::max(longest, c.length);
   for (std::size_t i = 0; i < nc; ++i) {
     cars[i].turn_rng = deriveSeed(seed, 0x5455524E00000000ULL + i);
   }
@@ -727,6 +729,10 @@ TrafficEpisode runCars(const World& world, std::uint64_t seed, double horizon,
       bool has_lead = false;
       for (std::size_t q = c.at > 0 ? c.at - 1 : 0; q < c.path.size(); ++q) {
         if (c.base[q] > front + kLookAhead) break;
+        // A car on this piece or a later one has its centre at least half its length before
+        // the piece's start, so its gap is at least base - longest - front: past the lead found,
+        // no later car can be nearer (1e-6: far beyond the gaps' rounding).
+        if (has_lead && c.base[q] - longest - front > gap + 1e-6) break;
         for (const Occupant& o : occupants[c.path[q]]) {
           if (o.car == i) continue;
           const double centre = c.base[q] + o.rel;
