@@ -235,7 +235,11 @@ void CoverageSearchClientRos::onMission(const hameritt::Mission::ConstPtr& msg) 
   if (!m) return;
   if (mission_ && mission_->scenario_id == m->scenario_id) return;  // the same, again
   mission_ = std::move(*m);
-  filter_ = std::make_unique<clients::ContextFilter>(*mission_, context_world_);
+  // A track mission's search goes on past its areas' windows (a false lead can take the time),
+  // and what it finds then may have driven off from its area since (~drive_off_speed).
+  clients::ContextSettings context;
+  if (mission_->objective.type == "track") context.drive_off_speed = drive_off_speed_;
+  filter_ = std::make_unique<clients::ContextFilter>(*mission_, context_world_, context);
   track_phase_ = std::any_of(mission_->phases.begin(), mission_->phases.end(),
                              [](const auto& p) { return p.type == scenario::PhaseType::kTrack; });
   // A follow phase states where to be: its envelope's d* behind and h* above the target.
@@ -318,10 +322,6 @@ void CoverageSearchClientRos::replan(const std::string& why) {
       scenario::Mission open = *mission_;
       for (auto& a : open.aois) a.window.nlt.reset();
       plan_ = clients::planSearch(open, settings_, progress);
-      // What the search finds past the windows may have driven off from its area since.
-      clients::ContextSettings context;
-      context.drive_off_speed = drive_off_speed_;
-      filter_ = std::make_unique<clients::ContextFilter>(*mission_, context_world_, context);
       ROS_INFO("%s: no cell can be reached inside the windows: searching the areas past them",
                kClientName);
     }

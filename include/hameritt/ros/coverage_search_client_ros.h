@@ -63,9 +63,9 @@ namespace hameritt::ros_wrappers {
 // (0 m: on a track phase, this far behind the predicted vehicle, ~pursuit_height above it),
 // ~use_target_state (true: while pursuing, the pursued target's state on adk/target_state,
 // published in maneuver_only from its find on, feeds the prediction instead of the
-// sightings), ~drive_off_speed (13 m/s, the generator's fastest car: once the search goes on past
-// the areas' windows, a sighting that far from its area per second since the window closed still
-// passes the context filter). Avoid
+// sightings), ~drive_off_speed (track missions; 13 m/s, the generator's fastest car: once the
+// search goes on past the areas' windows, a sighting that far from its area per second since the
+// window closed still passes the context filter). Avoid
 // missions: sub adk/traffic (hameritt/EntityStateArray), pub uav/cmd_pose.
 class CoverageSearchClientRos {
  public:
