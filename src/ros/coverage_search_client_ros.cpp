@@ -53,8 +53,9 @@ constexpr double kParkedRadius = 1.5;
 constexpr double kGroupMargin = 4.0;
 // Per pursuit tick (10 Hz by default): the tilt shift's running average, about 4 s.
 constexpr double kTiltAveraging = 0.025;
-// The tilt is averaged only while the UAV is within this many metres of its shifted viewpoint
-// and its velocity within this many m/s of the vehicle's (clients::TiltAverage).
+// The tilt is averaged only while the UAV is within this many metres of its station (its shifted
+// viewpoint less the lag behind it) and its velocity within this many m/s of the vehicle's
+// (clients::TiltAverage).
 constexpr double kTiltStation = 8.0;
 constexpr double kTiltSteady = 1.5;
 // A sighting this close to the pursued vehicle's prediction is that vehicle.

@@ -112,11 +112,12 @@ geometry::Vec2 tiltedAxisShift(const scenario::CameraSpec& camera, const Eigen::
 
 // The running average of tiltedAxisShift that the pursuit flies ahead by. It takes a sample only
 // while the UAV keeps station: within `station_radius` (horizontally) of its station (where it is
-// sent, less the autopilot's lag behind a moving setpoint) and moving with the vehicle (their horizontal velocities within `steady_speed`). The tilt of
-// catching up, of braking or of circling is not the steady tilt against drag and wind; averaged
-// in, it moves the viewpoint, which tilts the UAV again, and from 40 m up (a viewpoint above the
-// roofs beside a tower) the loop held a UAV circling a standing car at 34 degrees of tilt with
-// the car out of the nadir camera's image half of the time. Outside station the average holds.
+// sent, less the autopilot's lag behind a moving setpoint) and moving with the vehicle (their
+// horizontal velocities within `steady_speed`). The tilt of catching up, of braking or of
+// circling is not the steady tilt against drag and wind; averaged in, it moves the viewpoint,
+// which tilts the UAV again, and from 40 m up (a viewpoint above the roofs beside a tower) the
+// loop held a UAV circling a standing car at 34 degrees of tilt with the car out of the nadir
+// camera's image half of the time. Outside station the average holds.
 class TiltAverage {
  public:
   TiltAverage(double rate = 0.025, double station_radius = 8.0, double steady_speed = 1.5);
