@@ -8,6 +8,7 @@
 #include <map>
 
 #include "hameritt/clients/public_config.h"
+#include "hameritt/ros/adk_conversions.h"
 #include "hameritt/ros/client_conversions.h"
 #include "hameritt/ros/mission_conversions.h"
 #include "hameritt/scenario/error.h"
@@ -817,8 +818,7 @@ void CoverageSearchClientRos::onPursuitTick() {
     // catching up, braking or circling.
     const auto& q = odom_->pose.pose.orientation;
     const Eigen::Quaterniond attitude = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
-    const auto& vb = odom_->twist.twist.linear;  // body frame
-    const geometry::Vec3 uav_velocity = attitude * geometry::Vec3(vb.x, vb.y, vb.z);
+    const geometry::Vec3 uav_velocity = worldVelocityOf(*odom_);
     const geometry::Vec2 shift =
         clients::tiltedAxisShift(*track_camera_, attitude, uav.z() - v.position.z());
     view.position.head<2>() -=
